@@ -1,0 +1,75 @@
+// The procedural default river: a meandering centreline in the XZ plane (glTF conventions:
+// metres, +Y up), a width profile, and the valley terrain with the riverbed it runs in.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "sim/status.h"
+
+namespace siviflow {
+
+struct ProceduralRiverParams {
+  float length = 240.0f;              // metres along +Z, centred on the origin
+  float meander_amplitude = 14.0f;    // metres of lateral swing of the centreline
+  float meander_wavelength = 110.0f;  // metres per full meander
+  float width = 12.0f;                // mean water width, metres
+  float width_variation = 0.25f;      // relative swing of the width along the river
+  float depth = 1.6f;                 // riverbed depth below the water surface at the centre
+  float bank_height = 1.2f;           // height of the banks above the water
+  float valley_half_width = 70.0f;    // distance from the centreline to the valley walls
+  float valley_wall_height = 22.0f;   // height the valley walls rise to
+  uint32_t seed = 7;
+  // The water-surface strip mesh (generate_mesh): sections across the flow, this far apart
+  // along the centreline, each with this many vertices from bank to bank.
+  float section_spacing = 1.0f;  // metres
+  uint32_t vertices_across = 13;
+};
+
+// The river's water surface as a strip, ready for RiverSurface::build. The river flows along +Z:
+// section 0 is at z = -length/2, vertex 0 is its left-bank corner (+X side).
+struct RiverMesh {
+  std::vector<glm::vec3> positions;  // vertex k * vertices_across + j: section k, j = 0 on the left
+  std::vector<uint32_t> indices;     // triangles, counter-clockwise seen from +Y
+  std::vector<glm::vec2> uvs;        // u across (0 left bank .. 1 right bank), v along, metres
+  std::vector<float> depth;          // water depth under each vertex, metres, >= 0
+  uint32_t section_count = 0;
+  uint32_t vertices_across = 0;
+};
+
+class ProceduralRiver {
+ public:
+  explicit ProceduralRiver(const ProceduralRiverParams& params);
+
+  const ProceduralRiverParams& params() const { return params_; }
+
+  // X of the centreline at the given Z.
+  float centreline_x(float z) const;
+  // Water width at the given Z.
+  float width_at(float z) const;
+  // Signed lateral distance of (x, z) from the centreline, measured across the flow.
+  float lateral_distance(float x, float z) const;
+  // Height of the terrain (riverbed under the water, banks and valley beyond).
+  float terrain_height(float x, float z) const;
+  // Height of the water surface (flat for now: the default river is level).
+  float water_level() const { return 0.0f; }
+  // Water depth at (x, z): water level minus the riverbed, 0 out of the river.
+  float depth_at(float x, float z) const;
+
+  // Checks the parameters (ranges, sizes); the message names the parameter.
+  static Status validate(const ProceduralRiverParams& params);
+  // Builds the water-surface strip following the centreline and width profile. Fails on bad
+  // parameters or when the meander is too tight for the width (sections would cross).
+  Status generate_mesh(RiverMesh* out) const;
+
+ private:
+  ProceduralRiverParams params_;
+  float phase_a_ = 0.0f;  // seeded phases of the two meander harmonics
+  float phase_b_ = 0.0f;
+  float phase_w_ = 0.0f;  // seeded phase of the width profile
+};
+
+}  // namespace siviflow

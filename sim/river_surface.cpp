@@ -1,0 +1,684 @@
+#include "sim/river_surface.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numeric>
+#include <string>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "sim/river_tuning.h"
+#include "sim/text_format.h"
+
+namespace siviflow {
+namespace {
+
+constexpr uint32_t kUnset = std::numeric_limits<uint32_t>::max();
+
+using DVec3 = glm::dvec3;
+
+DVec3 to_d(const glm::vec3& v) { return DVec3(v); }
+
+uint32_t float_key(float f) {
+  if (f == 0.0f) f = 0.0f;  // -0 and +0 weld together
+  uint32_t u = 0;
+  std::memcpy(&u, &f, sizeof(u));
+  return u;
+}
+
+uint64_t hash_position(const glm::vec3& p) {
+  uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (const float c : {p.x, p.y, p.z}) {
+    h ^= float_key(c);
+    h *= 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 31;
+  }
+  return h;
+}
+
+// A CSR adjacency: neighbours of node n are list[start[n] .. start[n+1]).
+struct Csr {
+  std::vector<uint32_t> start;
+  std::vector<uint32_t> list;
+  std::span<const uint32_t> of(uint32_t n) const {
+    return {list.data() + start[n], start[n + 1] - start[n]};
+  }
+};
+
+// What a successful layering from one candidate upstream end gives.
+struct Layering {
+  std::vector<uint32_t> layer;          // section of every node
+  std::vector<uint32_t> chain_start;    // per section, offset into chain_nodes (+1 at the end)
+  std::vector<uint32_t> chain_nodes;    // sections, each from bank_a to bank_b
+  std::vector<uint32_t> bank_a;         // shore node of every section on one bank
+  std::vector<uint32_t> bank_b;         // ... and on the other
+};
+
+// Everything the layering reads: the welded mesh and its border.
+struct MeshView {
+  const std::vector<uint32_t>* tris;
+  const Csr* adjacency;
+  const std::vector<uint32_t>* node_vertex;  // node -> first input vertex, for messages
+};
+
+std::string vertex_name(const MeshView& mesh, uint32_t node) {
+  return std::to_string((*mesh.node_vertex)[node]);
+}
+
+// Splits the mesh into sections by hop distance from the upstream end `end_a` (a border path),
+// then checks that the result is a strip: every triangle joins two neighbouring sections, every
+// section is one chain from bank to bank, each bank holds exactly one vertex per section, and the
+// last section is the far end `end_b`. bank_1 runs from end_a.back() to end_b.front(), bank_2
+// from end_a.front() to end_b.back().
+Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
+                   const std::vector<uint32_t>& end_b, const std::vector<uint32_t>& bank_1,
+                   const std::vector<uint32_t>& bank_2, Layering* out) {
+  const Csr& adj = *mesh.adjacency;
+  const std::vector<uint32_t>& tris = *mesh.tris;
+  const size_t node_count = adj.start.size() - 1;
+
+  if (bank_1.size() != bank_2.size()) {
+    return Status::error(text_format(
+        "the river mesh is not a strip of sections: its banks have different vertex counts "
+        "(%zu from vertex %s and %zu from vertex %s)",
+        bank_1.size(), vertex_name(mesh, bank_1.front()).c_str(), bank_2.size(),
+        vertex_name(mesh, bank_2.front()).c_str()));
+  }
+
+  std::vector<uint32_t> layer(node_count, kUnset);
+  std::vector<uint32_t> queue;
+  queue.reserve(node_count);
+  for (const uint32_t n : end_a) {
+    layer[n] = 0;
+    queue.push_back(n);
+  }
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const uint32_t n = queue[head];
+    for (const uint32_t m : adj.of(n)) {
+      if (layer[m] == kUnset) {
+        layer[m] = layer[n] + 1;
+        queue.push_back(m);
+      }
+    }
+  }
+  uint32_t max_layer = 0;
+  for (const uint32_t l : layer) max_layer = std::max(max_layer, l);  // connected: all set
+  const size_t section_count = size_t{max_layer} + 1;
+  if (section_count < 2) {
+    return Status::error("the river mesh has a single section: a river needs at least two");
+  }
+
+  for (size_t t = 0; t < tris.size() / 3; ++t) {
+    const uint32_t a = tris[3 * t], b = tris[3 * t + 1], c = tris[3 * t + 2];
+    if (layer[a] == layer[b] && layer[b] == layer[c]) {
+      return Status::error(text_format(
+          "the river mesh is not a strip of sections: triangle %zu (vertices %s, %s, %s) lies "
+          "inside section %u instead of joining two neighbouring sections",
+          t, vertex_name(mesh, a).c_str(), vertex_name(mesh, b).c_str(),
+          vertex_name(mesh, c).c_str(), layer[a]));
+    }
+  }
+
+  for (size_t i = 0; i < bank_1.size(); ++i) {
+    for (const uint32_t n : {bank_1[i], bank_2[i]}) {
+      if (layer[n] != i) {
+        return Status::error(text_format(
+            "the river mesh is not a strip of sections: bank vertex %s is the bank's vertex %zu "
+            "but lies in section %u",
+            vertex_name(mesh, n).c_str(), i, layer[n]));
+      }
+    }
+  }
+  if (bank_1.size() != section_count) {
+    return Status::error(text_format(
+        "the river mesh is not a strip of sections: it has %zu sections but %zu vertices on each "
+        "bank",
+        section_count, bank_1.size()));
+  }
+  for (const uint32_t n : end_b) {
+    if (layer[n] != max_layer) {
+      return Status::error(text_format(
+          "the river mesh is not a strip of sections: vertex %s on the downstream end lies in "
+          "section %u, not in the last section %u",
+          vertex_name(mesh, n).c_str(), layer[n], max_layer));
+    }
+  }
+
+  // Nodes by section, each section in node order.
+  std::vector<uint32_t> layer_start(section_count + 1, 0);
+  for (const uint32_t l : layer) ++layer_start[l + 1];
+  for (size_t k = 0; k < section_count; ++k) layer_start[k + 1] += layer_start[k];
+  std::vector<uint32_t> by_layer(node_count);
+  {
+    std::vector<uint32_t> fill(layer_start.begin(), layer_start.end() - 1);
+    for (uint32_t n = 0; n < node_count; ++n) by_layer[fill[layer[n]]++] = n;
+  }
+
+  out->chain_start.assign(section_count + 1, 0);
+  out->chain_nodes.clear();
+  out->chain_nodes.reserve(node_count);
+  for (uint32_t k = 0; k < section_count; ++k) {
+    const uint32_t size = layer_start[k + 1] - layer_start[k];
+    if (size < 2) {
+      return Status::error(text_format(
+          "section %u of the river has a single vertex (%s): a section needs a non-zero width",
+          k, vertex_name(mesh, by_layer[layer_start[k]]).c_str()));
+    }
+    // Walk the chain of same-section edges from one shore to the other.
+    uint32_t prev = kUnset;
+    uint32_t cur = bank_1[k];
+    for (uint32_t steps = 0; cur != kUnset; ++steps) {
+      if (steps >= size) break;  // a cycle: reported below as an incomplete chain
+      out->chain_nodes.push_back(cur);
+      uint32_t next = kUnset;
+      uint32_t same = 0;
+      for (const uint32_t m : adj.of(cur)) {
+        if (layer[m] != k) continue;
+        ++same;
+        if (m != prev && next == kUnset) next = m;
+      }
+      const uint32_t allowed = (prev == kUnset) ? 1 : 2;  // a shore has one neighbour in its section
+      if (same > allowed) {
+        return Status::error(text_format(
+            "the river mesh is not a strip of sections: section %u branches at vertex %s "
+            "(%u neighbours in the same section)",
+            k, vertex_name(mesh, cur).c_str(), same));
+      }
+      prev = cur;
+      cur = next;
+    }
+    const uint32_t walked = static_cast<uint32_t>(out->chain_nodes.size()) - out->chain_start[k];
+    if (walked != size || out->chain_nodes.back() != bank_2[k]) {
+      return Status::error(text_format(
+          "the river mesh is not a strip of sections: section %u is not one chain of edges "
+          "from bank vertex %s to bank vertex %s (%u of its %u vertices reached)",
+          k, vertex_name(mesh, bank_1[k]).c_str(), vertex_name(mesh, bank_2[k]).c_str(), walked,
+          size));
+    }
+    out->chain_start[k + 1] = static_cast<uint32_t>(out->chain_nodes.size());
+  }
+  out->layer = std::move(layer);
+  out->bank_a = bank_1;
+  out->bank_b = bank_2;
+  return Status::success();
+}
+
+// Sum of the triangle angles at every node: about 90 degrees at the four corners of a strip,
+// about 180 degrees along its banks and ends.
+std::vector<double> angle_sums(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& tris,
+                               const std::vector<uint8_t>& on_border) {
+  std::vector<double> sum(pos.size(), 0.0);
+  for (size_t t = 0; t < tris.size() / 3; ++t) {
+    for (int i = 0; i < 3; ++i) {
+      const uint32_t n = tris[3 * t + i];
+      if (!on_border[n]) continue;
+      const DVec3 p = to_d(pos[n]);
+      const DVec3 u = glm::normalize(to_d(pos[tris[3 * t + (i + 1) % 3]]) - p);
+      const DVec3 v = glm::normalize(to_d(pos[tris[3 * t + (i + 2) % 3]]) - p);
+      sum[n] += std::acos(std::clamp(glm::dot(u, v), -1.0, 1.0));
+    }
+  }
+  return sum;
+}
+
+double path_length(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& path) {
+  double len = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) len += glm::distance(to_d(pos[path[i - 1]]), to_d(pos[path[i]]));
+  return len;
+}
+
+}  // namespace
+
+RiverVertex RiverSurface::node(uint32_t n) const {
+  RiverVertex v;
+  v.section = node_section_[n];
+  v.bank = node_bank_[n];
+  v.width = sections_[v.section].width;
+  v.d_left = node_d_left_[n];
+  v.d_right = node_d_right_[n];
+  v.flow_direction = sections_[v.section].flow_direction;
+  return v;
+}
+
+Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                           const RiverSurfaceOptions& options, RiverSurface* out) {
+  // --- Sizes, before anything is allocated or read.
+  const size_t vertex_count = positions.size();
+  if (vertex_count == 0) return Status::error("the river mesh has no vertices");
+  if (vertex_count > kMaxRiverVertices) {
+    return Status::error(text_format("the river mesh has %zu vertices, more than the limit of %zu",
+                                     vertex_count, kMaxRiverVertices));
+  }
+  const bool indexed = !indices.empty();
+  const size_t index_count = indexed ? indices.size() : vertex_count;
+  if (indexed && index_count > 3 * kMaxRiverTriangles) {
+    return Status::error(text_format(
+        "the river mesh has %zu indices, more than the limit of %zu triangles", index_count,
+        kMaxRiverTriangles));
+  }
+  if (index_count % 3 != 0) {
+    return Status::error(text_format(
+        indexed ? "the river mesh has %zu indices, not a multiple of 3: it is not a triangle list"
+                : "the non-indexed river mesh has %zu vertices, not a multiple of 3",
+        index_count));
+  }
+  const size_t tri_count = index_count / 3;
+  auto index_at = [&](size_t i) { return indexed ? indices[i] : static_cast<uint32_t>(i); };
+
+  for (size_t v = 0; v < vertex_count; ++v) {
+    const glm::vec3& p = positions[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return Status::error(text_format("river vertex %zu has a non-finite position (%g, %g, %g)",
+                                       v, p.x, p.y, p.z));
+    }
+  }
+  for (size_t i = 0; i < index_count; ++i) {
+    if (index_at(i) >= vertex_count) {
+      return Status::error(text_format(
+          "river triangle %zu refers to vertex %u, but the mesh has only %zu vertices", i / 3,
+          index_at(i), vertex_count));
+    }
+  }
+  if (options.upstream_vertex >= vertex_count) {
+    return Status::error(text_format("the upstream vertex %u is not in the river mesh (%zu vertices)",
+                                     options.upstream_vertex, vertex_count));
+  }
+
+  // --- Weld vertices at exactly the same position (open addressing on the position bits).
+  std::vector<uint32_t> node_of_vertex(vertex_count);
+  std::vector<uint32_t> node_vertex;
+  std::vector<glm::vec3> pos;
+  {
+    const size_t table_size = std::bit_ceil(2 * vertex_count);
+    std::vector<uint32_t> table(table_size, kUnset);
+    for (size_t v = 0; v < vertex_count; ++v) {
+      const glm::vec3& p = positions[v];
+      size_t slot = hash_position(p) & (table_size - 1);
+      while (table[slot] != kUnset && pos[table[slot]] != p) slot = (slot + 1) & (table_size - 1);
+      if (table[slot] == kUnset) {
+        table[slot] = static_cast<uint32_t>(pos.size());
+        pos.push_back(p);
+        node_vertex.push_back(static_cast<uint32_t>(v));
+      }
+      node_of_vertex[v] = table[slot];
+    }
+  }
+  const size_t node_count = pos.size();
+  const MeshView view_for_names{nullptr, nullptr, &node_vertex};
+
+  // --- Triangles on nodes; reject degenerate ones (they have no normal and no gradient).
+  std::vector<uint32_t> tris(index_count);
+  for (size_t t = 0; t < tri_count; ++t) {
+    const uint32_t raw[3] = {index_at(3 * t), index_at(3 * t + 1), index_at(3 * t + 2)};
+    uint32_t n[3];
+    for (int i = 0; i < 3; ++i) n[i] = tris[3 * t + i] = node_of_vertex[raw[i]];
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3;
+      if (n[i] != n[j]) continue;
+      if (raw[i] == raw[j]) {
+        return Status::error(text_format(
+            "river triangle %zu (vertices %u, %u, %u) is degenerate: it uses vertex %u twice", t,
+            raw[0], raw[1], raw[2], raw[i]));
+      }
+      return Status::error(text_format(
+          "river triangle %zu (vertices %u, %u, %u) is degenerate: vertices %u and %u are at the "
+          "same position (%g, %g, %g) - a zero-width section or a collapsed edge",
+          t, raw[0], raw[1], raw[2], raw[i], raw[j], positions[raw[i]].x, positions[raw[i]].y,
+          positions[raw[i]].z));
+    }
+    const DVec3 a = to_d(pos[n[0]]), b = to_d(pos[n[1]]), c = to_d(pos[n[2]]);
+    const double area2 = glm::length(glm::cross(b - a, c - a));
+    const double longest2 =
+        std::max({glm::dot(b - a, b - a), glm::dot(c - b, c - b), glm::dot(a - c, a - c)});
+    if (!(area2 > kDegenerateTriangleRatio * longest2)) {
+      return Status::error(text_format(
+          "river triangle %zu (vertices %u, %u, %u) is degenerate: it has zero area (its corners "
+          "are collinear)",
+          t, raw[0], raw[1], raw[2]));
+    }
+  }
+
+  // --- Node -> triangles.
+  Csr node_tris;
+  node_tris.start.assign(node_count + 1, 0);
+  for (const uint32_t n : tris) ++node_tris.start[n + 1];
+  for (size_t n = 0; n < node_count; ++n) {
+    if (node_tris.start[n + 1] == 0) {
+      return Status::error(text_format("river vertex %u is not used by any triangle",
+                                       node_vertex[n]));
+    }
+    node_tris.start[n + 1] += node_tris.start[n];
+  }
+  node_tris.list.resize(tris.size());
+  {
+    std::vector<uint32_t> fill(node_tris.start.begin(), node_tris.start.end() - 1);
+    for (size_t i = 0; i < tris.size(); ++i) node_tris.list[fill[tris[i]]++] = static_cast<uint32_t>(i / 3);
+  }
+
+  // --- Node adjacency (sorted, unique), manifold edges and the border.
+  Csr adj;
+  adj.start.assign(node_count + 1, 0);
+  adj.list.reserve(tris.size());
+  std::vector<std::array<uint32_t, 2>> border_next(node_count, {kUnset, kUnset});
+  std::vector<uint8_t> on_border(node_count, 0);
+  size_t edge_count = 0;
+  {
+    std::vector<uint32_t> scratch;
+    for (uint32_t n = 0; n < node_count; ++n) {
+      scratch.clear();
+      for (const uint32_t t : node_tris.of(n)) {
+        for (int i = 0; i < 3; ++i) {
+          if (tris[3 * t + i] != n) scratch.push_back(tris[3 * t + i]);
+        }
+      }
+      std::sort(scratch.begin(), scratch.end());
+      scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+      adj.list.insert(adj.list.end(), scratch.begin(), scratch.end());
+      adj.start[n + 1] = static_cast<uint32_t>(adj.list.size());
+      for (const uint32_t m : scratch) {
+        if (m < n) continue;
+        ++edge_count;
+        uint32_t shared = 0;
+        for (const uint32_t t : node_tris.of(n)) {
+          shared += (tris[3 * t] == m || tris[3 * t + 1] == m || tris[3 * t + 2] == m) ? 1 : 0;
+        }
+        if (shared > 2) {
+          return Status::error(text_format(
+              "the river mesh is non-manifold: the edge between vertices %u and %u is shared by "
+              "%u triangles",
+              node_vertex[n], node_vertex[m], shared));
+        }
+        if (shared == 1) {
+          for (const auto& [x, y] : {std::pair{n, m}, std::pair{m, n}}) {
+            auto& slots = border_next[x];
+            if (slots[0] == kUnset) {
+              slots[0] = y;
+            } else if (slots[1] == kUnset) {
+              slots[1] = y;
+            } else {
+              return Status::error(text_format(
+                  "the river mesh is non-manifold at vertex %u: more than two border edges meet "
+                  "there (two parts of the mesh touch at a single vertex)",
+                  node_vertex[x]));
+            }
+            on_border[x] = 1;
+          }
+        }
+      }
+    }
+  }
+
+  // --- One piece.
+  {
+    std::vector<uint32_t> piece(node_count, kUnset);
+    std::vector<uint32_t> stack;
+    uint32_t pieces = 0;
+    uint32_t second_piece_node = kUnset;
+    for (uint32_t s = 0; s < node_count; ++s) {
+      if (piece[s] != kUnset) continue;
+      if (pieces == 1) second_piece_node = s;
+      piece[s] = pieces;
+      stack.push_back(s);
+      while (!stack.empty()) {
+        const uint32_t n = stack.back();
+        stack.pop_back();
+        for (const uint32_t m : adj.of(n)) {
+          if (piece[m] == kUnset) {
+            piece[m] = pieces;
+            stack.push_back(m);
+          }
+        }
+      }
+      ++pieces;
+    }
+    if (pieces > 1) {
+      return Status::error(text_format(
+          "the river mesh is in %u disconnected pieces (vertices %u and %u are in different "
+          "pieces): a river is one strip",
+          pieces, node_vertex[0], node_vertex[second_piece_node]));
+    }
+  }
+
+  // --- The border: exactly one loop.
+  std::vector<uint32_t> loop;
+  {
+    uint32_t loops = 0;
+    uint32_t second_loop_node = kUnset;
+    std::vector<uint8_t> seen(node_count, 0);
+    for (uint32_t s = 0; s < node_count; ++s) {
+      if (!on_border[s] || seen[s]) continue;
+      if (border_next[s][1] == kUnset) {
+        return Status::error(text_format(
+            "the river mesh is non-manifold at vertex %u: a single border edge ends there",
+            node_vertex[s]));
+      }
+      if (loops == 1) second_loop_node = s;
+      ++loops;
+      uint32_t prev = kUnset, cur = s;
+      do {
+        if (loops == 1) loop.push_back(cur);
+        seen[cur] = 1;
+        const uint32_t next = border_next[cur][0] != prev ? border_next[cur][0] : border_next[cur][1];
+        prev = cur;
+        cur = next;
+      } while (cur != s && cur != kUnset && !seen[cur]);
+    }
+    if (loops == 0) {
+      return Status::error("the river mesh is closed (it has no border): a river is an open strip");
+    }
+    if (loops > 1) {
+      return Status::error(text_format(
+          "the river mesh has %u border loops where a strip has one: there is a hole (an island?) "
+          "at vertex %u; cut islands out as obstacles instead",
+          loops, node_vertex[second_loop_node]));
+    }
+  }
+  const long euler = static_cast<long>(node_count) - static_cast<long>(edge_count) +
+                     static_cast<long>(tri_count);
+  if (euler != 1) {
+    return Status::error(text_format(
+        "the river mesh is not a disc (Euler characteristic %ld, a strip has 1): it has handles",
+        euler));
+  }
+  if (loop.size() < 4) {
+    return Status::error(text_format(
+        "the river mesh has only %zu border vertices: a river needs at least two sections of two "
+        "vertices each",
+        loop.size()));
+  }
+
+  // --- Corners: the four sharpest border vertices (about 90 degrees; banks and ends are about
+  // 180). Ties go to the lower node, so the choice is deterministic.
+  const std::vector<double> angles = angle_sums(pos, tris, on_border);
+  std::vector<uint32_t> corner_at(loop.size());  // positions in the loop
+  std::iota(corner_at.begin(), corner_at.end(), 0u);
+  std::partial_sort(corner_at.begin(), corner_at.begin() + 4, corner_at.end(),
+                    [&](uint32_t i, uint32_t j) {
+                      const double ai = angles[loop[i]], aj = angles[loop[j]];
+                      return ai != aj ? ai < aj : loop[i] < loop[j];
+                    });
+  corner_at.resize(4);
+  std::sort(corner_at.begin(), corner_at.end());
+  auto side = [&](int i) {
+    std::vector<uint32_t> path;
+    size_t p = corner_at[i];
+    const size_t end = corner_at[(i + 1) % 4];
+    for (;;) {
+      path.push_back(loop[p]);
+      if (p == end) break;
+      p = (p + 1) % loop.size();
+    }
+    return path;
+  };
+  const std::array<std::vector<uint32_t>, 4> sides = {side(0), side(1), side(2), side(3)};
+
+  const uint32_t upstream_node = node_of_vertex[options.upstream_vertex];
+  if (!on_border[upstream_node]) {
+    return Status::error(text_format(
+        "river vertex %u marks the upstream end but is not on the border of the mesh: the "
+        "upstream end is the end section holding it (a corner, in the paper's meshes)",
+        options.upstream_vertex));
+  }
+  // Candidate upstream ends: the sides holding the marker, shortest first (a river is longer
+  // than it is wide, so when the marker is a corner the short side is the end).
+  std::vector<int> candidates;
+  for (int i = 0; i < 4; ++i) {
+    if (std::find(sides[i].begin(), sides[i].end(), upstream_node) != sides[i].end()) {
+      candidates.push_back(i);
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [&](int i, int j) {
+    return path_length(pos, sides[i]) < path_length(pos, sides[j]);
+  });
+
+  const MeshView mesh{&tris, &adj, &node_vertex};
+  Layering layering;
+  Status first_error;
+  bool found = false;
+  for (const int a : candidates) {
+    const std::vector<uint32_t>& end_a = sides[a];
+    const std::vector<uint32_t>& end_b = sides[(a + 2) % 4];
+    const std::vector<uint32_t> bank_1 = sides[(a + 1) % 4];
+    std::vector<uint32_t> bank_2 = sides[(a + 3) % 4];
+    std::reverse(bank_2.begin(), bank_2.end());
+    Status status = layer_strip(mesh, end_a, end_b, bank_1, bank_2, &layering);
+    if (status.ok()) {
+      found = true;
+      break;
+    }
+    if (first_error.ok()) first_error = std::move(status);
+  }
+  if (!found) {
+    std::string corners;
+    for (const uint32_t c : corner_at) {
+      corners += (corners.empty() ? "" : ", ") + vertex_name(view_for_names, loop[c]);
+    }
+    return Status::error(first_error.message() + " (corners taken at vertices " + corners + ")");
+  }
+  const size_t section_count = layering.chain_start.size() - 1;
+
+  // --- Left and right: the left bank is on the +Y x downstream side.
+  std::vector<DVec3> mid(section_count);
+  for (size_t k = 0; k < section_count; ++k) {
+    mid[k] = 0.5 * (to_d(pos[layering.bank_a[k]]) + to_d(pos[layering.bank_b[k]]));
+  }
+  auto downstream_at = [&](size_t k) {
+    return mid[std::min(k + 1, section_count - 1)] - mid[k == 0 ? 0 : k - 1];
+  };
+  double side_score = 0.0;
+  double chord_scale = 0.0;
+  for (size_t k = 0; k < section_count; ++k) {
+    const DVec3 chord = to_d(pos[layering.bank_a[k]]) - to_d(pos[layering.bank_b[k]]);
+    const DVec3 left = glm::cross(DVec3(0, 1, 0), downstream_at(k));
+    side_score += glm::dot(left, chord);
+    chord_scale += glm::length(left) * glm::length(chord);
+  }
+  if (!(std::abs(side_score) > 1e-6 * chord_scale)) {
+    return Status::error(
+        "cannot tell the river's left bank from its right: seen from +Y (up) its sections do not "
+        "run across the flow");
+  }
+  const bool a_is_left = side_score > 0.0;
+
+  // --- Bounding box, for relative tolerances.
+  DVec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (const glm::vec3& p : pos) {
+    lo = glm::min(lo, to_d(p));
+    hi = glm::max(hi, to_d(p));
+  }
+  const double extent = glm::length(hi - lo);
+
+  // --- Sections and per-node data.
+  RiverSurface s;
+  s.sections_.resize(section_count);
+  s.section_nodes_.reserve(node_count);
+  s.node_section_ = std::move(layering.layer);
+  s.node_bank_.assign(node_count, Bank::kNone);
+  s.node_d_left_.assign(node_count, 0.0f);
+  s.node_d_right_.assign(node_count, 0.0f);
+  double along = 0.0;
+  for (size_t k = 0; k < section_count; ++k) {
+    RiverSection& sec = s.sections_[k];
+    sec.first_node = static_cast<uint32_t>(s.section_nodes_.size());
+    const auto begin = layering.chain_nodes.begin() + layering.chain_start[k];
+    const auto end = layering.chain_nodes.begin() + layering.chain_start[k + 1];
+    if (a_is_left) {
+      s.section_nodes_.insert(s.section_nodes_.end(), begin, end);
+    } else {
+      s.section_nodes_.insert(s.section_nodes_.end(), std::make_reverse_iterator(end),
+                              std::make_reverse_iterator(begin));
+    }
+    sec.node_count = static_cast<uint32_t>(end - begin);
+    const std::span<const uint32_t> chain(s.section_nodes_.data() + sec.first_node, sec.node_count);
+
+    std::vector<double> arc(chain.size(), 0.0);
+    for (size_t i = 1; i < chain.size(); ++i) {
+      arc[i] = arc[i - 1] + glm::distance(to_d(pos[chain[i - 1]]), to_d(pos[chain[i]]));
+    }
+    const double width = arc.back();
+    const uint32_t left = chain.front(), right = chain.back();
+    if (!(width > kMinSectionWidthRelative * extent)) {
+      return Status::error(text_format(
+          "section %zu of the river has zero width (%g m between its shore vertices %u and %u)",
+          k, width, node_vertex[left], node_vertex[right]));
+    }
+    for (size_t i = 0; i < chain.size(); ++i) {
+      s.node_d_left_[chain[i]] = static_cast<float>(arc[i]);
+      s.node_d_right_[chain[i]] = static_cast<float>(width - arc[i]);
+    }
+    s.node_bank_[left] = Bank::kLeft;
+    s.node_bank_[right] = Bank::kRight;
+
+    // Flow direction: normal of the plane through both shores and their midpoint raised along
+    // +Y, i.e. +Y x (right - left), oriented downstream.
+    const DVec3 chord = to_d(pos[right]) - to_d(pos[left]);
+    DVec3 flow(chord.z, 0.0, -chord.x);
+    const double flow_len = glm::length(flow);
+    if (!(flow_len > kMinHorizontalChordRelative * glm::length(chord))) {
+      return Status::error(text_format(
+          "section %zu of the river runs vertically (shore vertices %u and %u are above each "
+          "other): it has no horizontal flow direction",
+          k, node_vertex[left], node_vertex[right]));
+    }
+    flow /= flow_len;
+    if (glm::dot(flow, downstream_at(k)) < 0.0) flow = -flow;
+    sec.width = static_cast<float>(width);
+    sec.midpoint = glm::vec3(mid[k]);
+    sec.flow_direction = glm::vec3(flow);
+    if (k > 0) along += glm::distance(mid[k - 1], mid[k]);
+    sec.along = static_cast<float>(along);
+    s.widest_ = std::max(s.widest_, sec.width);
+  }
+
+  // --- Wind every triangle counter-clockwise about the river's up: downstream x (left - right).
+  for (size_t t = 0; t < tri_count; ++t) {
+    uint32_t* tri = &tris[3 * t];
+    const uint32_t k = std::min({s.node_section_[tri[0]], s.node_section_[tri[1]],
+                                 s.node_section_[tri[2]]});
+    const RiverSection& sec = s.sections_[k];
+    const std::span<const uint32_t> chain(s.section_nodes_.data() + sec.first_node, sec.node_count);
+    const DVec3 across = to_d(pos[chain.front()]) - to_d(pos[chain.back()]);
+    const DVec3 up = glm::cross(mid[k + 1] - mid[k], across);
+    const DVec3 a = to_d(pos[tri[0]]);
+    const DVec3 normal = glm::cross(to_d(pos[tri[1]]) - a, to_d(pos[tri[2]]) - a);
+    if (glm::dot(normal, up) < 0.0) std::swap(tri[1], tri[2]);
+  }
+
+  s.node_of_vertex_ = std::move(node_of_vertex);
+  s.node_vertex_ = std::move(node_vertex);
+  s.node_positions_ = std::move(pos);
+  s.triangles_ = std::move(tris);
+  s.node_tri_start_ = std::move(node_tris.start);
+  s.node_tri_list_ = std::move(node_tris.list);
+  s.extent_ = static_cast<float>(extent);
+  *out = std::move(s);
+  return Status::success();
+}
+
+}  // namespace siviflow

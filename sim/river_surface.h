@@ -1,0 +1,116 @@
+// River Surface Generator (paper §2, Algorithm 1): from a plain triangle mesh, find the river's
+// sections and banks from its topology, and give every vertex its section, bank flag, section
+// width, in-river distances to both margins and the section's flow direction.
+//
+// The mesh must be a strip: a triangulated band whose rows (sections) run from bank to bank,
+// every triangle joining two neighbouring sections. Sections may differ in width and in vertex
+// count. The vertex order does not matter, except that the upstream end is the end section
+// holding vertex `RiverSurfaceOptions::upstream_vertex` (vertex 0 by default: the paper's "first
+// vertex is a corner"). The left bank is on the left looking downstream with +Y up (glTF).
+//
+// Vertices at exactly the same position are welded (a glTF export splits vertices along UV
+// seams and sharp edges, and a non-indexed mesh repeats every vertex): the topology is built on
+// the welded "nodes" and every input vertex reads its node's data.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "sim/status.h"
+
+namespace siviflow {
+
+// Which margin a vertex lies on. The values are those of the `bank` column of `siviflow flow`.
+enum class Bank : int8_t { kLeft = -1, kNone = 0, kRight = 1 };
+
+struct RiverSurfaceOptions {
+  // An input vertex on the upstream end section (a corner, in the paper's meshes).
+  uint32_t upstream_vertex = 0;
+};
+
+// One cross-section of the river, from the left shore to the right shore.
+struct RiverSection {
+  uint32_t first_node = 0;  // offset into RiverSurface::section_nodes()
+  uint32_t node_count = 0;  // >= 2: the left shore, interior vertices, the right shore
+  float width = 0.0f;       // length of the section polyline, metres
+  float along = 0.0f;       // distance of the shore midpoint from the upstream end, along the river
+  glm::vec3 midpoint{0.0f};        // midpoint of the two shore vertices
+  glm::vec3 flow_direction{0.0f};  // unit, horizontal, downstream (paper §2.1)
+};
+
+// What Algorithm 1 stores per vertex.
+struct RiverVertex {
+  uint32_t section = 0;
+  Bank bank = Bank::kNone;
+  float width = 0.0f;    // width of the vertex's section
+  float d_left = 0.0f;   // distance along the section to the left shore
+  float d_right = 0.0f;  // distance along the section to the right shore
+  glm::vec3 flow_direction{0.0f};  // the section's flow direction
+};
+
+class RiverSurface {
+ public:
+  // Builds the surface. `indices` holds three vertex indices per triangle; when empty the mesh is
+  // non-indexed (every three positions make a triangle). Fails, naming the vertex, triangle or
+  // section, on: no or too many vertices, non-finite positions, indices out of range or not a
+  // multiple of three, degenerate triangles, unused vertices, non-manifold edges or vertices,
+  // several pieces or holes, anything that is not a strip of >= 2 sections, zero-width sections.
+  // `out` is left untouched on failure.
+  static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                      const RiverSurfaceOptions& options, RiverSurface* out);
+
+  // --- Per input vertex (the accessor order of the mesh) ---
+  size_t vertex_count() const { return node_of_vertex_.size(); }
+  uint32_t node_of(size_t vertex) const { return node_of_vertex_[vertex]; }
+  RiverVertex vertex(size_t vertex) const { return node(node_of_vertex_[vertex]); }
+
+  // --- Per node (welded vertex); every index below is a node index ---
+  size_t node_count() const { return node_positions_.size(); }
+  RiverVertex node(uint32_t n) const;
+  std::span<const glm::vec3> node_positions() const { return node_positions_; }
+  std::span<const uint32_t> node_section() const { return node_section_; }
+  std::span<const Bank> node_bank() const { return node_bank_; }
+  std::span<const float> node_d_left() const { return node_d_left_; }
+  std::span<const float> node_d_right() const { return node_d_right_; }
+  // The first input vertex welded into node n (what error messages call "vertex").
+  uint32_t vertex_of_node(uint32_t n) const { return node_vertex_[n]; }
+
+  // Triangles in node indices, wound counter-clockwise seen from the river's up side (the side
+  // that downstream x left-to-right... points to), whatever the input winding was.
+  std::span<const uint32_t> triangles() const { return triangles_; }  // 3 per triangle
+  size_t triangle_count() const { return triangles_.size() / 3; }
+  // Triangles around node n, ascending.
+  std::span<const uint32_t> node_triangles(uint32_t n) const {
+    return {node_tri_list_.data() + node_tri_start_[n], node_tri_start_[n + 1] - node_tri_start_[n]};
+  }
+
+  std::span<const RiverSection> sections() const { return sections_; }
+  // Nodes of section k, from the left shore to the right shore.
+  std::span<const uint32_t> section_nodes(size_t k) const {
+    return {section_nodes_.data() + sections_[k].first_node, sections_[k].node_count};
+  }
+  float widest_section() const { return widest_; }
+  // Length of the bounding-box diagonal: the scale the geometric tolerances are relative to.
+  float extent() const { return extent_; }
+
+ private:
+  std::vector<uint32_t> node_of_vertex_;
+  std::vector<uint32_t> node_vertex_;
+  std::vector<glm::vec3> node_positions_;
+  std::vector<uint32_t> node_section_;
+  std::vector<Bank> node_bank_;
+  std::vector<float> node_d_left_;
+  std::vector<float> node_d_right_;
+  std::vector<uint32_t> triangles_;
+  std::vector<uint32_t> node_tri_start_;
+  std::vector<uint32_t> node_tri_list_;
+  std::vector<RiverSection> sections_;
+  std::vector<uint32_t> section_nodes_;
+  float widest_ = 0.0f;
+  float extent_ = 0.0f;
+};
+
+}  // namespace siviflow

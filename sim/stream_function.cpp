@@ -1,0 +1,425 @@
+#include "sim/stream_function.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "sim/text_format.h"
+
+namespace siviflow {
+namespace {
+
+using DVec3 = glm::dvec3;
+
+// The compact-support blend of eq. 2.3 as corrected: f(0) = 0, f(1) = 1, flat at both ends.
+double blend(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return t * t * t * (t * (6.0 * t - 15.0) + 10.0);
+}
+
+// r^p for r in (0, 1], with the common powers spared a pow().
+double ratio_pow(double r, double p) {
+  if (p == 1.0) return r;
+  if (p == 1.5) return r * std::sqrt(r);
+  if (p == 2.0) return r * r;
+  return std::pow(r, p);
+}
+
+glm::dvec2 xz(const glm::vec3& v) { return {v.x, v.z}; }
+
+}  // namespace
+
+Status StreamFunction::create(RiverSurface surface, const FlowParams& params, StreamFunction* out) {
+  if (!std::isfinite(params.discharge)) {
+    return Status::error(text_format("flow discharge %g is not finite", params.discharge));
+  }
+  if (!std::isfinite(params.p) || !(params.p > 0.0f) || params.p > 16.0f) {
+    return Status::error(text_format("flow power p = %g: it must be in (0, 16]", params.p));
+  }
+  if (!std::isfinite(params.search_radius) || params.search_radius < 0.0f) {
+    return Status::error(text_format(
+        "flow search radius %g m: it must be positive (or 0 for %g x the widest section)",
+        params.search_radius, kDefaultSearchRadiusFactor));
+  }
+  if (surface.node_count() == 0) return Status::error("the river surface is empty");
+
+  StreamFunction f;
+  f.params_ = params;
+  if (f.params_.search_radius == 0.0f) {
+    f.params_.search_radius = kDefaultSearchRadiusFactor * surface.widest_section();
+  }
+  f.surface_ = std::move(surface);
+  const RiverSurface& s = f.surface_;
+  const size_t nodes = s.node_count();
+  const size_t tris = s.triangle_count();
+  const double radius = f.params_.search_radius;
+
+  // Eq. 2.1 is undefined with a single boundary in reach: every vertex not on a bank needs both.
+  const auto d_left = s.node_d_left();
+  const auto d_right = s.node_d_right();
+  for (uint32_t n = 0; n < nodes; ++n) {
+    if (d_left[n] > 0.0f && d_right[n] > 0.0f && (d_left[n] >= radius || d_right[n] >= radius)) {
+      return Status::error(text_format(
+          "river vertex %u (section %u) has only one boundary within the search radius s = %g m "
+          "(%g m to the left bank, %g m to the right bank): raise the search radius above %g m",
+          s.vertex_of_node(n), s.node_section()[n], radius, d_left[n], d_right[n],
+          std::max(d_left[n], d_right[n])));
+    }
+  }
+
+  // Triangle areas (2x, as the P1 gradient wants them) and the bank tangents.
+  f.node_area_.assign(nodes, 0.0);
+  const auto pos = s.node_positions();
+  const auto tri = s.triangles();
+  std::vector<float> area2(tris);
+  for (size_t t = 0; t < tris; ++t) {
+    const DVec3 a(pos[tri[3 * t]]), b(pos[tri[3 * t + 1]]), c(pos[tri[3 * t + 2]]);
+    area2[t] = static_cast<float>(glm::length(glm::cross(b - a, c - a)));
+  }
+  for (uint32_t n = 0; n < nodes; ++n) {
+    double sum = 0.0;
+    for (const uint32_t t : s.node_triangles(n)) sum += area2[t];
+    f.node_area_[n] = sum;
+  }
+  f.bank_tangent_.assign(nodes, glm::vec3(0.0f));
+  const auto sections = s.sections();
+  for (size_t k = 0; k < sections.size(); ++k) {
+    const size_t prev = k == 0 ? 0 : k - 1;
+    const size_t next = std::min(k + 1, sections.size() - 1);
+    for (const bool left : {true, false}) {
+      auto shore = [&](size_t j) { return left ? s.section_nodes(j).front() : s.section_nodes(j).back(); };
+      const DVec3 d = DVec3(pos[shore(next)]) - DVec3(pos[shore(prev)]);
+      f.bank_tangent_[shore(k)] = glm::vec3(glm::normalize(d));
+    }
+  }
+  f.triangle_area2_ = std::move(area2);
+
+  f.psi_free_.resize(nodes);
+  for (uint32_t n = 0; n < nodes; ++n) {
+    bool wet = true;
+    f.psi_free_[n] = f.evaluate(n, false, &wet);
+  }
+  f.triangle_velocity_.assign(tris, glm::vec3(0.0f));
+  f.node_velocity_.assign(nodes, glm::vec3(0.0f));
+  f.solve_full();
+  *out = std::move(f);
+  return Status::success();
+}
+
+double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const {
+  *wet = true;
+  const double s = params_.search_radius;
+  const double q = params_.discharge;
+  const double dl = surface_.node_d_left()[n];
+  const double dr = surface_.node_d_right()[n];
+  const bool obstacles = use_obstacles && !active_.empty();
+
+  // Pass 1: dry?, on a boundary?, and the nearest boundary distance (the weights' scale).
+  double nearest = std::numeric_limits<double>::max();
+  if (dl < s) nearest = dl;
+  if (dr < s) nearest = std::min(nearest, dr);
+  const double* on_obstacle = nullptr;
+  if (obstacles) {
+    for (const uint32_t j : active_) {
+      const ObstacleState& st = state_[j];
+      if (!influences(st, j, n)) continue;
+      const double d = footprint_distance(obstacles_[j], xz(st.centre), xz(surface_.node_positions()[n]));
+      if (d < 0.0) {
+        *wet = false;
+        return st.psi;
+      }
+      if (d == 0.0 && on_obstacle == nullptr) on_obstacle = &st.psi;
+      nearest = std::min(nearest, d);
+    }
+  }
+  if (dl <= 0.0) return q;
+  if (dr <= 0.0) return 0.0;
+  if (on_obstacle != nullptr) return *on_obstacle;
+
+  // Pass 2: w_i scaled by nearest^p, which is the product form of algorithms.md §1.1 divided by
+  // a common factor: finite and exact on a boundary, no overflow however many boundaries.
+  const double p = params_.p;
+  double num = 0.0, den = 0.0;
+  auto add = [&](double d, double value) {
+    const double w = blend(1.0 - d / s) * ratio_pow(nearest / d, p);
+    num += w * value;
+    den += w;
+  };
+  if (dl < s) add(dl, q);
+  if (dr < s) add(dr, 0.0);
+  if (obstacles) {
+    for (const uint32_t j : active_) {
+      const ObstacleState& st = state_[j];
+      if (!influences(st, j, n)) continue;
+      add(footprint_distance(obstacles_[j], xz(st.centre), xz(surface_.node_positions()[n])),
+          st.psi);
+    }
+  }
+  return den > 0.0 ? num / den : psi_free_[n];
+}
+
+bool StreamFunction::influences(const ObstacleState& st, size_t obstacle, uint32_t n) const {
+  const double s = params_.search_radius;
+  const float along = surface_.sections()[surface_.node_section()[n]].along;
+  // Only vertices within s along the river: the next loop of a meander, close across the land,
+  // must not feel an object in this one.
+  if (along < st.along_lo - s || along > st.along_hi + s) return false;
+  const glm::vec3& p = surface_.node_positions()[n];
+  if (p.x <= st.lo.x - s || p.x >= st.hi.x + s || p.z <= st.lo.y - s || p.z >= st.hi.y + s) {
+    return false;
+  }
+  return footprint_distance(obstacles_[obstacle], xz(st.centre), xz(p)) < s;
+}
+
+void StreamFunction::update_triangle(uint32_t t) {
+  const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
+  const auto pos = surface_.node_positions();
+  const DVec3 a(pos[tri[0]]), b(pos[tri[1]]), c(pos[tri[2]]);
+  const double pa = psi_[tri[0]];
+  // grad(psi) x n = sum_i psi_i e_i / (2 area), e_i the edge opposite vertex i, counter-clockwise
+  // about n; the edges sum to zero, so psi_a drops out (and with it the rounding of large psi).
+  const DVec3 g = (psi_[tri[1]] - pa) * (a - c) + (psi_[tri[2]] - pa) * (b - a);
+  triangle_velocity_[t] = glm::vec3(g / double{triangle_area2_[t]});
+}
+
+void StreamFunction::update_node_velocity(uint32_t n) {
+  if (!wet_[n]) {
+    node_velocity_[n] = glm::vec3(0.0f);
+    return;
+  }
+  DVec3 sum(0.0);
+  for (const uint32_t t : surface_.node_triangles(n)) {
+    sum += double{triangle_area2_[t]} * DVec3(triangle_velocity_[t]);
+  }
+  glm::vec3 v(sum / node_area_[n]);
+  const glm::vec3 tangent = bank_tangent_[n];
+  if (tangent != glm::vec3(0.0f)) v = glm::dot(v, tangent) * tangent;  // a bank is a streamline
+  node_velocity_[n] = v;
+}
+
+void StreamFunction::solve_full() {
+  const size_t nodes = surface_.node_count();
+  psi_.resize(nodes);
+  wet_.resize(nodes);
+  for (uint32_t n = 0; n < nodes; ++n) {
+    bool wet = true;
+    psi_[n] = evaluate(n, true, &wet);
+    wet_[n] = wet ? 1 : 0;
+  }
+  const size_t tris = surface_.triangle_count();
+  for (uint32_t t = 0; t < tris; ++t) update_triangle(t);
+  for (uint32_t n = 0; n < nodes; ++n) update_node_velocity(n);
+  stats_ = {nodes, tris, nodes};
+}
+
+void StreamFunction::build_grids() {
+  if (!node_grid_.empty()) return;
+  const auto pos = surface_.node_positions();
+  glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (const glm::vec3& p : pos) {
+    lo = glm::min(lo, xz(p));
+    hi = glm::max(hi, xz(p));
+  }
+  // Cells of about two triangle edges hold a few vertices each in the river, whatever its shape.
+  double mean_area2 = 0.0;
+  for (const float a : triangle_area2_) mean_area2 += a;
+  mean_area2 /= static_cast<double>(std::max<size_t>(triangle_area2_.size(), 1));
+  const double cell = std::max(2.0 * std::sqrt(mean_area2), 1e-6 * surface_.extent());
+  const size_t max_cells = static_cast<size_t>(kMaxGridCellsPerVertex * static_cast<double>(pos.size())) + 16;
+  node_grid_.init(lo, hi, cell, max_cells);
+  node_grid_.insert_points(pos);
+  triangle_grid_.init(lo, hi, cell, max_cells);
+  triangle_grid_.insert_triangles(pos, surface_.triangles());
+  node_stamp_.assign(pos.size(), 0);
+  triangle_stamp_.assign(surface_.triangle_count(), 0);
+  stamp_ = 0;
+}
+
+StreamFunction::ObstacleState StreamFunction::place(size_t obstacle, const glm::vec3& centre) const {
+  const Obstacle& o = obstacles_[obstacle];
+  ObstacleState st;
+  st.centre = centre;
+  const glm::dvec2 c = xz(centre);
+  footprint_bounds(o, c, &st.lo, &st.hi);
+  const auto pos = surface_.node_positions();
+  const auto tri = surface_.triangles();
+  const auto node_section = surface_.node_section();
+  const auto sections = surface_.sections();
+  auto corners = [&](uint32_t t) {
+    return std::array<glm::dvec2, 3>{xz(pos[tri[3 * t]]), xz(pos[tri[3 * t + 1]]),
+                                     xz(pos[tri[3 * t + 2]])};
+  };
+  auto interpolate = [&](uint32_t t, const glm::dvec3& bary) {
+    return bary.x * psi_free_[tri[3 * t]] + bary.y * psi_free_[tri[3 * t + 1]] +
+           bary.z * psi_free_[tri[3 * t + 2]];
+  };
+
+  // Wet footprint: the triangles it overlaps, and their span along the river.
+  float along_lo = std::numeric_limits<float>::max(), along_hi = -along_lo;
+  uint32_t nearest_tri = std::numeric_limits<uint32_t>::max();
+  double nearest_dist = std::numeric_limits<double>::max();
+  triangle_grid_.for_each_in(st.lo, st.hi, [&](uint32_t t) {
+    const auto corner = corners(t);
+    if (!footprint_overlaps_triangle(o, c, corner)) return;
+    st.in_water = true;
+    for (int i = 0; i < 3; ++i) {
+      const float along = sections[node_section[tri[3 * t + i]]].along;
+      along_lo = std::min(along_lo, along);
+      along_hi = std::max(along_hi, along);
+    }
+    const glm::dvec3 b = closest_barycentric(corner, c);
+    const double d = glm::length(b.x * corner[0] + b.y * corner[1] + b.z * corner[2] - c);
+    if (d < nearest_dist || (d == nearest_dist && t < nearest_tri)) {
+      nearest_dist = d;
+      nearest_tri = t;
+    }
+  });
+  if (!st.in_water) return st;
+  st.along_lo = along_lo;
+  st.along_hi = along_hi;
+
+  // psi of the obstacle: the obstacle-free field at its centre. Where the river passes over
+  // itself, the triangle nearest the centre in height wins; a centre over land takes the
+  // nearest wet point of the footprint.
+  uint32_t best = std::numeric_limits<uint32_t>::max();
+  double best_dy = std::numeric_limits<double>::max();
+  glm::dvec3 best_bary(0.0);
+  triangle_grid_.for_each_in(c, c, [&](uint32_t t) {
+    const auto corner = corners(t);
+    const glm::dvec3 b = closest_barycentric(corner, c);
+    const glm::dvec2 p = b.x * corner[0] + b.y * corner[1] + b.z * corner[2];
+    if (glm::length(p - c) > 1e-9 * (1.0 + glm::length(c))) return;  // not under the centre
+    const double y = b.x * pos[tri[3 * t]].y + b.y * pos[tri[3 * t + 1]].y + b.z * pos[tri[3 * t + 2]].y;
+    const double dy = std::abs(y - double{centre.y});
+    if (dy < best_dy || (dy == best_dy && t < best)) {
+      best_dy = dy;
+      best = t;
+      best_bary = b;
+    }
+  });
+  if (best == std::numeric_limits<uint32_t>::max()) {
+    best = nearest_tri;
+    best_bary = closest_barycentric(corners(best), c);
+  }
+  st.psi = interpolate(best, best_bary);
+  return st;
+}
+
+void StreamFunction::refresh_active() {
+  active_.clear();
+  for (uint32_t j = 0; j < state_.size(); ++j) {
+    if (state_[j].in_water) active_.push_back(j);
+  }
+}
+
+Status StreamFunction::set_obstacles(std::vector<Obstacle> obstacles, double time) {
+  if (obstacles.size() > kMaxObstacles) {
+    return Status::error(text_format("%zu obstacles, more than the limit of %zu",
+                                     obstacles.size(), kMaxObstacles));
+  }
+  for (size_t i = 0; i < obstacles.size(); ++i) SIVIFLOW_TRY(validate_obstacle(obstacles[i], i));
+  if (!obstacles.empty()) build_grids();
+  obstacles_ = std::move(obstacles);
+  state_.clear();
+  for (size_t i = 0; i < obstacles_.size(); ++i) {
+    state_.push_back(place(i, obstacle_centre_at(obstacles_[i], time)));
+  }
+  refresh_active();
+  solve_full();
+  return Status::success();
+}
+
+Status StreamFunction::move_obstacle(size_t index, const glm::vec3& centre) {
+  if (index >= obstacles_.size()) {
+    return Status::error(text_format("no obstacle %zu to move (there are %zu)", index,
+                                     obstacles_.size()));
+  }
+  if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) {
+    return Status::error(text_format("obstacle %zu: the new centre is not finite", index));
+  }
+  stats_ = {};
+  move_incremental(index, centre);
+  return Status::success();
+}
+
+Status StreamFunction::set_time(double t) {
+  if (!std::isfinite(t)) return Status::error(text_format("flow time %g is not finite", t));
+  stats_ = {};
+  for (size_t j = 0; j < obstacles_.size(); ++j) {
+    if (obstacles_[j].keys.empty()) continue;
+    const glm::vec3 c = obstacle_centre_at(obstacles_[j], t);
+    if (c != state_[j].centre) move_incremental(j, c);
+  }
+  return Status::success();
+}
+
+void StreamFunction::move_incremental(size_t j, const glm::vec3& centre) {
+  const double s = params_.search_radius;
+  // Fresh generation stamps (on wrap-around, clear them).
+  auto next_stamp = [&] {
+    if (++stamp_ == 0) {
+      std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
+      std::fill(triangle_stamp_.begin(), triangle_stamp_.end(), 0u);
+      stamp_ = 1;
+    }
+    return stamp_;
+  };
+
+  // 1. The vertices within s of the old and of the new footprint.
+  uint32_t gen = next_stamp();
+  scratch_nodes_.clear();
+  auto collect = [&](const ObstacleState& st) {
+    if (!st.in_water) return;
+    node_grid_.for_each_in(st.lo - s, st.hi + s, [&](uint32_t n) {
+      if (node_stamp_[n] != gen && influences(st, j, n)) {
+        node_stamp_[n] = gen;
+        scratch_nodes_.push_back(n);
+      }
+    });
+  };
+  const ObstacleState old_state = state_[j];
+  collect(old_state);
+  state_[j] = place(j, centre);
+  if (state_[j].in_water != old_state.in_water) refresh_active();
+  collect(state_[j]);
+  for (const uint32_t n : scratch_nodes_) {
+    bool wet = true;
+    psi_[n] = evaluate(n, true, &wet);
+    wet_[n] = wet ? 1 : 0;
+  }
+
+  // 2. The triangles around them, 3. the vertex velocities around those.
+  scratch_triangles_.clear();
+  for (const uint32_t n : scratch_nodes_) {
+    for (const uint32_t t : surface_.node_triangles(n)) {
+      if (triangle_stamp_[t] != gen) {
+        triangle_stamp_[t] = gen;
+        scratch_triangles_.push_back(t);
+        update_triangle(t);
+      }
+    }
+  }
+  const size_t resolved = scratch_nodes_.size();
+  gen = next_stamp();
+  scratch_nodes_.clear();
+  const auto tri = surface_.triangles();
+  for (const uint32_t t : scratch_triangles_) {
+    for (int i = 0; i < 3; ++i) {
+      const uint32_t n = tri[3 * size_t{t} + i];
+      if (node_stamp_[n] != gen) {
+        node_stamp_[n] = gen;
+        scratch_nodes_.push_back(n);
+        update_node_velocity(n);
+      }
+    }
+  }
+  stats_.nodes_resolved += resolved;
+  stats_.triangles_updated += scratch_triangles_.size();
+  stats_.nodes_velocity += scratch_nodes_.size();
+}
+
+}  // namespace siviflow

@@ -1,0 +1,126 @@
+// Stream-function flow on the river surface (paper §2.2.1, eq. 2.1-2.3; algorithms.md §1.1, §1.6).
+//
+// psi(P) = sum_i w(d_i) psi_i / sum_i w(d_i),  w(d) = d^-p f(1 - d/s) for d < s, else 0,
+// f(t) = 6t^5 - 15t^4 + 10t^3 (t clamped to [0, 1]).
+//
+// Boundaries: the left bank (psi = Q), the right bank (psi = 0), with in-river distances measured
+// along each vertex's section, and the obstacles in the water, at the XZ distance to their
+// footprint, each with psi = the obstacle-free field at its centre (so the total discharge is
+// kept and an object entering the water does not make the flow pop).
+// Velocity: per triangle v = grad(psi) x n (P1, tangent to the surface, divergence-free, pointing
+// downstream); per vertex the area-weighted mean of its triangles, slid along the bank on a bank
+// vertex (a bank is a streamline), zero on a dry vertex (inside an obstacle).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "sim/obstacle.h"
+#include "sim/river_surface.h"
+#include "sim/river_tuning.h"
+#include "sim/spatial_grid.h"
+#include "sim/status.h"
+
+namespace siviflow {
+
+struct FlowParams {
+  float discharge = 1.0f;              // Q = psi_left - psi_right, m^2/s (speed Q/W when uniform)
+  float p = kDefaultShepardPower;      // Shepard power, in (0, 16]
+  float search_radius = 0.0f;          // s in metres; 0: kDefaultSearchRadiusFactor x widest section
+};
+
+// What the last update re-solved (a full solve counts everything).
+struct FlowUpdateStats {
+  size_t nodes_resolved = 0;     // psi evaluated
+  size_t triangles_updated = 0;  // triangle velocities recomputed
+  size_t nodes_velocity = 0;     // vertex velocities recomputed
+};
+
+class StreamFunction {
+ public:
+  // Takes the surface and solves the obstacle-free field. Fails on bad parameters, or naming the
+  // section and vertex, when an interior vertex does not have both banks within s.
+  static Status create(RiverSurface surface, const FlowParams& params, StreamFunction* out);
+
+  const RiverSurface& surface() const { return surface_; }
+  const FlowParams& params() const { return params_; }  // search_radius resolved
+  float search_radius() const { return params_.search_radius; }
+
+  // Replaces the obstacles, places the keyframed ones at `time`, and re-solves everything.
+  // On failure (naming the obstacle) the previous obstacles stay.
+  Status set_obstacles(std::vector<Obstacle> obstacles, double time = 0.0);
+  std::span<const Obstacle> obstacles() const { return obstacles_; }
+  // Moves obstacle `index` to `centre` and re-solves only the vertices within s of its old or
+  // new footprint (and the triangles and vertex velocities around them). The result equals a
+  // full re-solve, bit for bit. The obstacle keeps its keys: the next set_time() uses them.
+  Status move_obstacle(size_t index, const glm::vec3& centre);
+  // Places every keyframed obstacle at time t, incrementally.
+  Status set_time(double t);
+  // Re-solves every vertex for the obstacles where they are now.
+  void solve_full();
+  const FlowUpdateStats& last_update() const { return stats_; }
+
+  // --- Per input vertex.
+  double psi(size_t vertex) const { return psi_[surface_.node_of(vertex)]; }
+  glm::vec3 velocity(size_t vertex) const { return node_velocity_[surface_.node_of(vertex)]; }
+  bool wet(size_t vertex) const { return wet_[surface_.node_of(vertex)] != 0; }
+
+  // --- Per node (RiverSurface node indices) and per triangle (RiverSurface::triangles()).
+  std::span<const double> node_psi() const { return psi_; }
+  std::span<const double> node_psi_free() const { return psi_free_; }  // without obstacles
+  std::span<const glm::vec3> node_velocity() const { return node_velocity_; }
+  std::span<const uint8_t> node_wet() const { return wet_; }
+  std::span<const glm::vec3> triangle_velocity() const { return triangle_velocity_; }
+
+  // --- Per obstacle.
+  glm::vec3 obstacle_centre(size_t i) const { return state_[i].centre; }
+  bool obstacle_in_water(size_t i) const { return state_[i].in_water; }
+  double obstacle_psi(size_t i) const { return state_[i].psi; }
+
+ private:
+  struct ObstacleState {
+    glm::vec3 centre{0.0f};
+    glm::dvec2 lo{0.0}, hi{0.0};     // footprint bounds, XZ
+    bool in_water = false;           // the footprint overlaps a river triangle
+    double psi = 0.0;                // psi_free at the centre (or the nearest wet point)
+    float along_lo = 0.0f, along_hi = 0.0f;  // along-river span of the wet footprint
+  };
+
+  double evaluate(uint32_t node, bool use_obstacles, bool* wet) const;
+  bool influences(const ObstacleState& state, size_t obstacle, uint32_t node) const;
+  void update_triangle(uint32_t t);
+  void update_node_velocity(uint32_t n);
+  void build_grids();
+  ObstacleState place(size_t obstacle, const glm::vec3& centre) const;
+  void refresh_active();
+  void move_incremental(size_t obstacle, const glm::vec3& centre);
+
+  RiverSurface surface_;
+  FlowParams params_;
+  std::vector<double> psi_free_;
+  std::vector<double> psi_;
+  std::vector<uint8_t> wet_;
+  std::vector<glm::vec3> triangle_velocity_;
+  std::vector<glm::vec3> node_velocity_;
+  std::vector<float> triangle_area2_;        // 2 x area of every triangle
+  std::vector<double> node_area_;            // sum of 2 x area of the node's triangles
+  std::vector<glm::vec3> bank_tangent_;      // unit, downstream, on bank nodes; zero elsewhere
+  std::vector<Obstacle> obstacles_;
+  std::vector<ObstacleState> state_;
+  std::vector<uint32_t> active_;             // obstacles in the water, ascending
+  XzGrid node_grid_;
+  XzGrid triangle_grid_;
+  // Scratch for incremental updates: generation stamps avoid clearing per update.
+  std::vector<uint32_t> node_stamp_;
+  std::vector<uint32_t> triangle_stamp_;
+  uint32_t stamp_ = 0;
+  std::vector<uint32_t> scratch_nodes_;
+  std::vector<uint32_t> scratch_triangles_;
+  FlowUpdateStats stats_;
+};
+
+}  // namespace siviflow
