@@ -1,0 +1,166 @@
+// EXR read-back for tests and golden comparisons: every channel as a float plane.
+#include <ImfChannelList.h>
+#include <ImfCheckFile.h>
+#include <ImfFloatAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfStringAttribute.h>
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <exception>
+
+#include "capture/atomic_file.h"
+#include "siviflow/image_files.h"
+
+namespace siviflow {
+namespace {
+
+// Caps on what a (possibly corrupt) header may make us allocate: 2^28 pixels, 4 GiB of floats.
+constexpr int64_t kMaxReadPixels = int64_t{1} << 28;
+constexpr int64_t kMaxReadSamples = int64_t{1} << 30;
+
+const char* compression_name(Imf::Compression compression) {
+  switch (compression) {
+    case Imf::NO_COMPRESSION: return "none";
+    case Imf::RLE_COMPRESSION: return "rle";
+    case Imf::ZIPS_COMPRESSION: return "zips";
+    case Imf::ZIP_COMPRESSION: return "zip";
+    case Imf::PIZ_COMPRESSION: return "piz";
+    case Imf::PXR24_COMPRESSION: return "pxr24";
+    case Imf::B44_COMPRESSION: return "b44";
+    case Imf::B44A_COMPRESSION: return "b44a";
+    case Imf::DWAA_COMPRESSION: return "dwaa";
+    case Imf::DWAB_COMPRESSION: return "dwab";
+    default: return "unknown";
+  }
+}
+
+ExrPixelType pixel_type(Imf::PixelType type) {
+  switch (type) {
+    case Imf::UINT: return ExrPixelType::kUint;
+    case Imf::HALF: return ExrPixelType::kHalf;
+    default: return ExrPixelType::kFloat;
+  }
+}
+
+// Opening a FIFO or device would block or read endlessly: regular files only.
+Status check_regular_file(const std::string& path, const std::string& what) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return Status::error(what + ": " + errno_message(errno));
+  if (!S_ISREG(st.st_mode)) return Status::error(what + ": not a regular file");
+  return Status::success();
+}
+
+Status read_exr_impl(const std::string& path, ExrImage* out) {
+  const std::string what = "cannot read EXR '" + path + "'";
+  if (out == nullptr) return Status::error(what + ": no output image");
+  SIVIFLOW_TRY(check_regular_file(path, what));
+
+  Imf::InputFile file(path.c_str());
+  const Imf::Header& header = file.header();
+  const Imath::Box2i window = header.dataWindow();
+  const int64_t width = int64_t{window.max.x} - window.min.x + 1;
+  const int64_t height = int64_t{window.max.y} - window.min.y + 1;
+  if (width <= 0 || height <= 0 || width * height > kMaxReadPixels) {
+    return Status::error(what + ": unsupported data window " + std::to_string(width) + "x" +
+                         std::to_string(height));
+  }
+  const int64_t pixel_count = width * height;
+
+  ExrImage image;
+  image.width = static_cast<int>(width);
+  image.height = static_cast<int>(height);
+  image.compression = compression_name(header.compression());
+
+  Imf::FrameBuffer frame_buffer;
+  int64_t samples = 0;
+  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+    const Imf::Channel& channel = it.channel();
+    if (channel.xSampling != 1 || channel.ySampling != 1) {
+      return Status::error(what + ": channel '" + it.name() + "' is subsampled (unsupported)");
+    }
+    samples += pixel_count;
+    if (samples > kMaxReadSamples) return Status::error(what + ": too many samples");
+    ExrPlane& plane = image.channels[it.name()];
+    plane.type = pixel_type(channel.type);
+    plane.pixels.assign(static_cast<size_t>(pixel_count), 0.0f);
+    frame_buffer.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, plane.pixels.data(), window,
+                                                    sizeof(float),
+                                                    sizeof(float) * static_cast<size_t>(width)));
+  }
+  file.setFrameBuffer(frame_buffer);
+  file.readPixels(window.min.y, window.max.y);
+
+  for (auto it = header.begin(); it != header.end(); ++it) {
+    const Imf::Attribute& attribute = it.attribute();
+    if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&attribute)) {
+      image.string_attributes[it.name()] = s->value();
+    } else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&attribute)) {
+      image.int_attributes[it.name()] = i->value();
+    } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&attribute)) {
+      image.float_attributes[it.name()] = f->value();
+    }
+  }
+  if (auto s = image.string_attributes.find(kExrAttrScene); s != image.string_attributes.end()) {
+    image.metadata.scene = s->second;
+  }
+  if (auto s = image.string_attributes.find(kExrAttrSoftware);
+      s != image.string_attributes.end()) {
+    image.metadata.software_version = s->second;
+  }
+  if (auto i = image.int_attributes.find(kExrAttrFrame); i != image.int_attributes.end()) {
+    image.metadata.frame = i->second;
+  }
+  if (auto i = image.int_attributes.find(kExrAttrSeed); i != image.int_attributes.end()) {
+    image.metadata.seed = i->second;
+  }
+  if (auto f = image.float_attributes.find(kExrAttrTime); f != image.float_attributes.end()) {
+    image.metadata.time_seconds = f->second;
+  }
+
+  *out = std::move(image);
+  return Status::success();
+}
+
+}  // namespace
+
+const std::vector<float>* ExrImage::find(const std::string& name) const {
+  auto it = channels.find(name);
+  return it == channels.end() ? nullptr : &it->second.pixels;
+}
+
+Status read_exr(const std::string& path, ExrImage* image) {
+  try {
+    return read_exr_impl(path, image);
+  } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception in 3.x
+    try {
+      return Status::error("cannot read EXR '" + path + "': " + e.what());
+    } catch (...) {
+      return Status::error("out of memory");
+    }
+  }
+}
+
+Status check_exr_file(const std::string& path) {
+  try {
+    const std::string what = "invalid EXR '" + path + "'";
+    SIVIFLOW_TRY(check_regular_file(path, what));
+    // Full (not reduced) checks, plus the OpenEXRCore pass: goldens are small.
+    if (Imf::checkOpenEXRFile(path.c_str(), false, false, true)) {
+      return Status::error(what + ": OpenEXR's file check found problems");
+    }
+    return Status::success();
+  } catch (const std::exception& e) {
+    try {
+      return Status::error("cannot check EXR '" + path + "': " + e.what());
+    } catch (...) {
+      return Status::error("out of memory");
+    }
+  }
+}
+
+}  // namespace siviflow

@@ -1,0 +1,150 @@
+// EXR frames through OpenEXR's general interface, encoded in memory and written atomically
+// (RgbaOutputFile can report success after a failed final write; see reliability.md 5/21).
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfOutputFile.h>
+#include <ImfFloatAttribute.h>
+#include <ImfIntAttribute.h>
+#include <ImfStringAttribute.h>
+#include <Imath/half.h>
+
+#include <cstring>
+#include <exception>
+#include <set>
+
+#include "capture/atomic_file.h"
+#include "siviflow/image_files.h"
+
+namespace siviflow {
+namespace {
+
+// Grows `bytes` as OpenEXR writes and seeks (it seeks back to fill in the line offset table).
+class MemoryOStream final : public Imf::OStream {
+ public:
+  MemoryOStream(std::vector<char>* bytes, const char* name) : Imf::OStream(name), bytes_(bytes) {}
+
+  void write(const char c[], int n) override {
+    if (n <= 0) return;
+    const size_t end = static_cast<size_t>(position_) + static_cast<size_t>(n);
+    try {
+      if (end > bytes_->size()) bytes_->resize(end);
+    } catch (...) {
+      // ~OutputFile swallows exceptions while writing the offset table; remember the failure.
+      failed_ = true;
+      throw;
+    }
+    std::memcpy(bytes_->data() + position_, c, static_cast<size_t>(n));
+    position_ = end;
+  }
+  uint64_t tellp() override { return position_; }
+  void seekp(uint64_t pos) override { position_ = pos; }
+
+  bool failed() const { return failed_; }
+
+ private:
+  std::vector<char>* bytes_;
+  uint64_t position_ = 0;
+  bool failed_ = false;
+};
+
+Status validate(const ExrFrame& frame, const std::string& what) {
+  if (frame.width <= 0 || frame.height <= 0) {
+    return Status::error(what + ": invalid size " + std::to_string(frame.width) + "x" +
+                         std::to_string(frame.height));
+  }
+  if (frame.rgba == nullptr) return Status::error(what + ": no RGBA pixels");
+  std::set<std::string> names = {"R", "G", "B", "A"};
+  for (const ExrChannel& channel : frame.channels) {
+    if (channel.name.empty()) return Status::error(what + ": a data channel has no name");
+    if (channel.pixels == nullptr) {
+      return Status::error(what + ": data channel '" + channel.name + "' has no pixels");
+    }
+    if (!names.insert(channel.name).second) {
+      return Status::error(what + ": channel name '" + channel.name + "' is used twice");
+    }
+  }
+  return Status::success();
+}
+
+Status encode_exr_named(const ExrFrame& frame, const std::string& name,
+                        std::vector<char>* bytes) {
+  const std::string what = "cannot encode EXR '" + name + "'";
+  if (bytes == nullptr) return Status::error(what + ": no output buffer");
+  SIVIFLOW_TRY(validate(frame, what));
+
+  const size_t width = static_cast<size_t>(frame.width);
+  Imf::Header header(frame.width, frame.height);  // display = data window, origin top-left
+  header.compression() = Imf::ZIP_COMPRESSION;
+  header.lineOrder() = Imf::INCREASING_Y;
+  // No chromaticities attribute: sRGB/Rec.709 primaries are the spec default (as pbrt-v4).
+  header.insert(kExrAttrScene, Imf::StringAttribute(frame.metadata.scene));
+  header.insert(kExrAttrFrame, Imf::IntAttribute(frame.metadata.frame));
+  header.insert(kExrAttrTime, Imf::FloatAttribute(frame.metadata.time_seconds));
+  header.insert(kExrAttrSeed, Imf::IntAttribute(frame.metadata.seed));
+  header.insert(kExrAttrSoftware, Imf::StringAttribute(frame.metadata.software_version));
+
+  // OutputFile does not convert pixel types (only InputFile does): round to half here.
+  const size_t sample_count = width * static_cast<size_t>(frame.height) * 4;
+  std::vector<half> rgba_half(sample_count);
+  for (size_t i = 0; i < sample_count; ++i) rgba_half[i] = half(frame.rgba[i]);
+  char* rgba = reinterpret_cast<char*>(rgba_half.data());
+  const size_t rgba_pixel = 4 * sizeof(half);
+  Imf::FrameBuffer frame_buffer;
+  const char* rgba_names[4] = {"R", "G", "B", "A"};
+  for (size_t c = 0; c < 4; ++c) {
+    header.channels().insert(rgba_names[c], Imf::Channel(Imf::HALF));
+    frame_buffer.insert(rgba_names[c], Imf::Slice(Imf::HALF, rgba + c * sizeof(half),
+                                                  rgba_pixel, rgba_pixel * width));
+  }
+  for (const ExrChannel& channel : frame.channels) {
+    header.channels().insert(channel.name, Imf::Channel(Imf::FLOAT));
+    // OpenEXR only reads through slice pointers when writing; its API is not const-correct.
+    char* base = const_cast<char*>(reinterpret_cast<const char*>(channel.pixels));
+    frame_buffer.insert(channel.name,
+                        Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * width));
+  }
+
+  bytes->clear();
+  MemoryOStream stream(bytes, name.c_str());
+  {
+    Imf::OutputFile file(stream, header);
+    file.setFrameBuffer(frame_buffer);
+    file.writePixels(frame.height);
+  }  // the destructor writes the line offset table
+  if (stream.failed()) {
+    bytes->clear();
+    return Status::error(what + ": out of memory while encoding");
+  }
+  return Status::success();
+}
+
+Status encode_exr_guarded(const ExrFrame& frame, const std::string& name,
+                          std::vector<char>* bytes) {
+  try {
+    return encode_exr_named(frame, name, bytes);
+  } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception in 3.x
+    if (bytes != nullptr) bytes->clear();
+    try {
+      return Status::error("cannot encode EXR '" + name + "': " + e.what());
+    } catch (...) {
+      return Status::error("out of memory");
+    }
+  }
+}
+
+}  // namespace
+
+Status encode_exr(const ExrFrame& frame, std::vector<char>* bytes) {
+  return encode_exr_guarded(frame, "<memory>", bytes);
+}
+
+Status write_exr(const std::string& path, const ExrFrame& frame) {
+  SIVIFLOW_TRY(check_output_path(path));  // fail before the costly encode
+  std::vector<char> bytes;
+  SIVIFLOW_TRY(encode_exr_guarded(frame, path, &bytes));
+  return write_file_atomically(path, bytes.data(), bytes.size());
+}
+
+}  // namespace siviflow

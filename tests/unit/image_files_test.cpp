@@ -1,0 +1,574 @@
+// Capture file writers: EXR/PNG round trips and the atomic-write guarantees.
+#include <ImfChannelList.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfStandardAttributes.h>
+#include <Imath/half.h>
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <png.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "siviflow/image_files.h"
+
+namespace siviflow {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> list_dir(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+// Deterministic, poorly compressible values in roughly [-2, 6).
+struct Noise {
+  uint32_t state = 12345u;
+  float next() {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / static_cast<float>(1u << 24) * 8.0f - 2.0f;
+  }
+};
+
+// Owns the pixel planes an ExrFrame points into.
+struct TestFrame {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgba;
+  std::vector<float> depth;
+  std::vector<float> flow_x;
+
+  TestFrame(int w, int h) : width(w), height(h) {
+    const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
+    Noise noise;
+    rgba.resize(n * 4);
+    depth.resize(n);
+    flow_x.resize(n);
+    for (float& v : rgba) v = noise.next();
+    for (float& v : depth) v = noise.next() * 1000.0f + 0.123456789f;
+    for (float& v : flow_x) v = noise.next() * 1e-3f;
+  }
+
+  ExrFrame frame() const {
+    ExrFrame f;
+    f.width = width;
+    f.height = height;
+    f.rgba = rgba.data();
+    f.channels = {{"depth.Z", depth.data()}, {"flow.X", flow_x.data()}};
+    f.metadata.scene = "straight_river";
+    f.metadata.frame = 42;
+    f.metadata.time_seconds = 1.75f;
+    f.metadata.seed = -7;
+    f.metadata.software_version = "siviflow 0.1.0-test";
+    return f;
+  }
+};
+
+class ImageFilesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "siviflow_image_files_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr) << std::strerror(errno);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(dir_, ec);
+  }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+
+  std::string dir_;
+};
+
+using ImageFilesExr = ImageFilesTest;
+using ImageFilesAtomic = ImageFilesTest;
+using ImageFilesPng = ImageFilesTest;
+
+TEST_F(ImageFilesExr, RoundTripKeepsPixelsChannelsAndMetadata) {
+  TestFrame data(7, 5);
+  // Edge values: a half rounding tie (1000.25), a half subnormal (1e-6), FLOAT max.
+  data.rgba[0] = 0.5f;
+  data.rgba[1] = 1e-6f;
+  data.rgba[2] = 1000.25f;
+  data.rgba[3] = 1.0f;
+  data.depth[0] = std::numeric_limits<float>::max();
+  data.depth[1] = 1e-30f;
+  const std::string file = path("frame.exr");
+  const Status written = write_exr(file, data.frame());
+  ASSERT_TRUE(written.ok()) << written.message();
+  EXPECT_EQ(list_dir(dir_), std::vector<std::string>{"frame.exr"});  // no temporary left
+
+  ExrImage image;
+  const Status read = read_exr(file, &image);
+  ASSERT_TRUE(read.ok()) << read.message();
+  EXPECT_EQ(image.width, 7);
+  EXPECT_EQ(image.height, 5);
+  ASSERT_EQ(image.channels.size(), 6u);
+  const char* rgba_names[4] = {"R", "G", "B", "A"};
+  for (size_t c = 0; c < 4; ++c) {
+    ASSERT_NE(image.find(rgba_names[c]), nullptr) << rgba_names[c];
+    EXPECT_EQ(image.channels.at(rgba_names[c]).type, ExrPixelType::kHalf);
+    const std::vector<float>& plane = *image.find(rgba_names[c]);
+    for (size_t i = 0; i < plane.size(); ++i) {
+      const float original = data.rgba[i * 4 + c];
+      // Exactly the round-to-nearest half, hence within half's relative precision 2^-11.
+      EXPECT_EQ(plane[i], static_cast<float>(half(original))) << rgba_names[c] << " " << i;
+      EXPECT_NEAR(plane[i], original, std::abs(original) * 4.9e-4f + 6e-8f);
+    }
+  }
+  EXPECT_EQ((*image.find("R"))[0], 0.5f);
+  EXPECT_EQ((*image.find("B"))[0], 1000.0f);  // half spacing at 1000 is 0.5: ties to even
+  EXPECT_EQ((*image.find("A"))[0], 1.0f);
+
+  ASSERT_NE(image.find("depth.Z"), nullptr);
+  ASSERT_NE(image.find("flow.X"), nullptr);
+  EXPECT_EQ(image.channels.at("depth.Z").type, ExrPixelType::kFloat);
+  EXPECT_EQ(image.channels.at("flow.X").type, ExrPixelType::kFloat);
+  EXPECT_EQ(*image.find("depth.Z"), data.depth);  // FLOAT is bit-exact
+  EXPECT_EQ(*image.find("flow.X"), data.flow_x);
+  EXPECT_EQ((*image.find("depth.Z"))[0], std::numeric_limits<float>::max());
+
+  EXPECT_EQ(image.metadata.scene, "straight_river");
+  EXPECT_EQ(image.metadata.frame, 42);
+  EXPECT_EQ(image.metadata.time_seconds, 1.75f);
+  EXPECT_EQ(image.metadata.seed, -7);
+  EXPECT_EQ(image.metadata.software_version, "siviflow 0.1.0-test");
+  EXPECT_EQ(image.string_attributes.at(kExrAttrScene), "straight_river");
+  EXPECT_EQ(image.int_attributes.at(kExrAttrFrame), 42);
+  EXPECT_EQ(image.float_attributes.at(kExrAttrTime), 1.75f);
+
+  const Status checked = check_exr_file(file);
+  EXPECT_TRUE(checked.ok()) << checked.message();
+}
+
+TEST_F(ImageFilesExr, HeaderHasZipHalfBeautyFloatDataAndTopLeftWindow) {
+  TestFrame data(16, 9);
+  const std::string file = path("frame.exr");
+  ASSERT_TRUE(write_exr(file, data.frame()).ok());
+
+  Imf::InputFile input(file.c_str());
+  const Imf::Header& header = input.header();
+  EXPECT_EQ(header.compression(), Imf::ZIP_COMPRESSION);
+  EXPECT_EQ(header.lineOrder(), Imf::INCREASING_Y);
+  EXPECT_EQ(header.dataWindow().min, Imath::V2i(0, 0));
+  EXPECT_EQ(header.dataWindow().max, Imath::V2i(15, 8));
+  EXPECT_EQ(header.displayWindow(), header.dataWindow());
+  EXPECT_EQ(header.channels().findChannel("G")->type, Imf::HALF);
+  EXPECT_EQ(header.channels().findChannel("depth.Z")->type, Imf::FLOAT);
+  EXPECT_FALSE(Imf::hasChromaticities(header));  // sRGB primaries are the spec default
+
+  ExrImage image;
+  ASSERT_TRUE(read_exr(file, &image).ok());
+  EXPECT_EQ(image.compression, "zip");
+  // Row-major, top-left origin: pixel (x=3, y=2) of the input is pixel (3, 2) of the file.
+  const size_t index = 2 * 16 + 3;
+  EXPECT_EQ((*image.find("depth.Z"))[index], data.depth[index]);
+}
+
+TEST_F(ImageFilesExr, FileBytesEqualInMemoryEncoding) {
+  TestFrame data(10, 4);
+  std::vector<char> encoded;
+  ASSERT_TRUE(encode_exr(data.frame(), &encoded).ok());
+  ASSERT_GT(encoded.size(), 0u);
+  const std::string file = path("frame.exr");
+  ASSERT_TRUE(write_exr(file, data.frame()).ok());
+  const std::string on_disk = read_text(file);
+  EXPECT_EQ(on_disk, std::string(encoded.begin(), encoded.end()));
+}
+
+TEST_F(ImageFilesExr, InvalidFramesAreRejectedWithoutFiles) {
+  TestFrame data(4, 4);
+  const std::string file = path("frame.exr");
+
+  ExrFrame zero_size = data.frame();
+  zero_size.width = 0;
+  Status s = write_exr(file, zero_size);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("invalid size 0x4"), std::string::npos) << s.message();
+
+  ExrFrame no_pixels = data.frame();
+  no_pixels.rgba = nullptr;
+  EXPECT_FALSE(write_exr(file, no_pixels).ok());
+
+  ExrFrame duplicate = data.frame();
+  duplicate.channels.push_back({"depth.Z", data.depth.data()});
+  s = write_exr(file, duplicate);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("'depth.Z' is used twice"), std::string::npos) << s.message();
+
+  ExrFrame clashes_with_beauty = data.frame();
+  clashes_with_beauty.channels.push_back({"A", data.depth.data()});
+  EXPECT_FALSE(write_exr(file, clashes_with_beauty).ok());
+
+  ExrFrame null_channel = data.frame();
+  null_channel.channels.push_back({"water.mask", nullptr});
+  s = write_exr(file, null_channel);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(file), std::string::npos) << s.message();
+
+  EXPECT_FALSE(encode_exr(data.frame(), nullptr).ok());
+  EXPECT_TRUE(list_dir(dir_).empty());
+}
+
+TEST_F(ImageFilesExr, ReadAndCheckReportTruncatedFiles) {
+  TestFrame data(32, 32);
+  const std::string file = path("frame.exr");
+  ASSERT_TRUE(write_exr(file, data.frame()).ok());
+  const std::string bytes = read_text(file);
+  const std::string truncated = path("truncated.exr");
+  write_text(truncated, bytes.substr(0, bytes.size() / 2));
+
+  ExrImage image;
+  const Status read = read_exr(truncated, &image);
+  EXPECT_FALSE(read.ok());
+  EXPECT_NE(read.message().find(truncated), std::string::npos) << read.message();
+  const Status checked = check_exr_file(truncated);
+  EXPECT_FALSE(checked.ok());
+  EXPECT_NE(checked.message().find(truncated), std::string::npos) << checked.message();
+
+  const Status missing = read_exr(path("absent.exr"), &image);
+  EXPECT_FALSE(missing.ok());
+  EXPECT_NE(missing.message().find("No such file"), std::string::npos) << missing.message();
+}
+
+TEST_F(ImageFilesExr, ReadRefusesFifoWithoutBlocking) {
+  const std::string fifo = path("pipe.exr");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  ExrImage image;
+  const Status read = read_exr(fifo, &image);
+  EXPECT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("not a regular file"), std::string::npos) << read.message();
+  EXPECT_FALSE(check_exr_file(fifo).ok());
+}
+
+// Runs write_exr in a child whose file-size limit is `limit` bytes; returns the child's
+// message. The child has its own limit, so this process keeps writing normally.
+std::string write_in_size_limited_child(const std::string& file, const ExrFrame& frame,
+                                        rlim_t limit, bool* child_reported_error) {
+  int fds[2];
+  if (::pipe(fds) != 0) return "pipe failed";
+  const pid_t pid = ::fork();
+  if (pid < 0) return "fork failed";
+  if (pid == 0) {
+    ::close(fds[0]);
+    // Without this the kernel kills the writer with SIGXFSZ instead of failing with EFBIG.
+    ::signal(SIGXFSZ, SIG_IGN);
+    const struct rlimit rl = {limit, limit};
+    if (::setrlimit(RLIMIT_FSIZE, &rl) != 0) ::_exit(3);
+    const Status s = write_exr(file, frame);
+    const std::string& message = s.message();
+    if (::write(fds[1], message.data(), message.size()) < 0) ::_exit(4);
+    ::_exit(s.ok() ? 1 : 0);
+  }
+  ::close(fds[1]);
+  std::string message;
+  char buffer[512];
+  for (;;) {
+    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+    if (n > 0) {
+      message.append(buffer, static_cast<size_t>(n));
+    } else if (n == 0 || errno != EINTR) {
+      break;
+    }
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  *child_reported_error = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  return message;
+}
+
+TEST_F(ImageFilesAtomic, FileSizeLimitReportsErrorAndLeavesNoFile) {
+  TestFrame data(64, 64);  // noise: far above the 4 KiB limit even ZIP-compressed
+  const std::string file = path("frame.exr");
+  bool child_reported_error = false;
+  const std::string message =
+      write_in_size_limited_child(file, data.frame(), 4096, &child_reported_error);
+  EXPECT_TRUE(child_reported_error) << message;
+  EXPECT_NE(message.find(file), std::string::npos) << message;
+  EXPECT_NE(message.find(std::strerror(EFBIG)), std::string::npos) << message;
+  EXPECT_TRUE(list_dir(dir_).empty());  // neither the target nor a temporary
+}
+
+TEST_F(ImageFilesAtomic, FileSizeLimitKeepsPreviousContent) {
+  TestFrame data(64, 64);
+  const std::string file = path("frame.exr");
+  write_text(file, "previous frame");
+  bool child_reported_error = false;
+  const std::string message =
+      write_in_size_limited_child(file, data.frame(), 4096, &child_reported_error);
+  EXPECT_TRUE(child_reported_error) << message;
+  EXPECT_EQ(read_text(file), "previous frame");
+  EXPECT_EQ(list_dir(dir_), std::vector<std::string>{"frame.exr"});
+}
+
+TEST_F(ImageFilesAtomic, RefusesDirectoryTargetAndLeavesItUntouched) {
+  TestFrame data(4, 4);
+  const std::string target = path("frame.exr");
+  ASSERT_TRUE(fs::create_directory(target));
+  write_text(target + "/keep.txt", "kept");
+  const Status s = write_exr(target, data.frame());
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(target), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("is a directory"), std::string::npos) << s.message();
+  EXPECT_TRUE(fs::is_directory(target));
+  EXPECT_EQ(read_text(target + "/keep.txt"), "kept");
+  EXPECT_EQ(list_dir(dir_), std::vector<std::string>{"frame.exr"});
+}
+
+TEST_F(ImageFilesAtomic, RefusesFifoTargetAndLeavesItUntouched) {
+  TestFrame data(4, 4);
+  const std::string target = path("frame.exr");
+  ASSERT_EQ(::mkfifo(target.c_str(), 0600), 0) << std::strerror(errno);
+  const Status s = write_exr(target, data.frame());
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(target), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("FIFO"), std::string::npos) << s.message();
+  struct stat st {};
+  ASSERT_EQ(::lstat(target.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  EXPECT_EQ(list_dir(dir_), std::vector<std::string>{"frame.exr"});
+
+  const Status png = write_png(target, data.width, data.height, data.rgba.data());
+  EXPECT_FALSE(png.ok());
+  ASSERT_EQ(::lstat(target.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+}
+
+TEST_F(ImageFilesAtomic, RefusesSymlinkTarget) {
+  TestFrame data(4, 4);
+  const std::string real = path("real.exr");
+  write_text(real, "real");
+  const std::string link = path("frame.exr");
+  fs::create_symlink(real, link);
+  const Status s = write_exr(link, data.frame());
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("symbolic link"), std::string::npos) << s.message();
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(read_text(real), "real");
+  EXPECT_EQ(list_dir(dir_), (std::vector<std::string>{"frame.exr", "real.exr"}));
+}
+
+TEST_F(ImageFilesAtomic, MissingFolderIsNamedInTheError) {
+  TestFrame data(4, 4);
+  const std::string folder = path("missing");
+  const std::string target = folder + "/frame.exr";
+  const Status s = write_exr(target, data.frame());
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("'" + folder + "' does not exist"), std::string::npos)
+      << s.message();
+  EXPECT_NE(s.message().find(target), std::string::npos) << s.message();
+  EXPECT_FALSE(fs::exists(folder));
+
+  write_text(path("plain"), "x");
+  const Status not_folder = write_exr(path("plain") + "/frame.exr", data.frame());
+  EXPECT_FALSE(not_folder.ok());
+  EXPECT_NE(not_folder.message().find("is not a folder"), std::string::npos)
+      << not_folder.message();
+  EXPECT_EQ(list_dir(dir_), std::vector<std::string>{"plain"});
+}
+
+TEST_F(ImageFilesAtomic, UnwritableFolderIsReported) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root ignores folder permissions";
+  TestFrame data(4, 4);
+  const std::string folder = path("readonly");
+  ASSERT_TRUE(fs::create_directory(folder));
+  ASSERT_EQ(::chmod(folder.c_str(), 0555), 0);
+  const Status s = write_exr(folder + "/frame.exr", data.frame());
+  ::chmod(folder.c_str(), 0755);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(std::strerror(EACCES)), std::string::npos) << s.message();
+  EXPECT_TRUE(list_dir(folder).empty());
+}
+
+TEST_F(ImageFilesAtomic, OverwritesExistingRegularFile) {
+  TestFrame data(8, 8);
+  const std::string file = path("frame.exr");
+  write_text(file, "stale content that is not an EXR");
+  ExrFrame first = data.frame();
+  ASSERT_TRUE(write_exr(file, first).ok());
+  ExrFrame second = data.frame();
+  second.metadata.frame = 43;
+  const Status s = write_exr(file, second);
+  ASSERT_TRUE(s.ok()) << s.message();
+
+  ExrImage image;
+  const Status read = read_exr(file, &image);
+  ASSERT_TRUE(read.ok()) << read.message();
+  EXPECT_EQ(image.metadata.frame, 43);
+  EXPECT_EQ(*image.find("depth.Z"), data.depth);
+  EXPECT_EQ(list_dir(dir_), std::vector<std::string>{"frame.exr"});
+}
+
+TEST_F(ImageFilesAtomic, RelativePathAndFolderPathAreHandled) {
+  TestFrame data(4, 4);
+  const Status folder_path = write_exr(dir_ + "/", data.frame());
+  EXPECT_FALSE(folder_path.ok());
+  EXPECT_NE(folder_path.message().find("names a folder"), std::string::npos)
+      << folder_path.message();
+  EXPECT_FALSE(write_exr("", data.frame()).ok());
+
+  const fs::path previous = fs::current_path();
+  fs::current_path(dir_);
+  const Status relative = write_exr("relative.exr", data.frame());
+  fs::current_path(previous);
+  EXPECT_TRUE(relative.ok()) << relative.message();
+  EXPECT_EQ(list_dir(dir_), std::vector<std::string>{"relative.exr"});
+}
+
+struct DecodedPng {
+  png_uint_32 width = 0;
+  png_uint_32 height = 0;
+  bool has_alpha = false;
+  std::vector<unsigned char> rgba;  // always 4 channels after decoding
+};
+
+bool decode_png(const std::string& file, DecodedPng* out) {
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, file.c_str())) return false;
+  out->width = image.width;
+  out->height = image.height;
+  out->has_alpha = (image.format & PNG_FORMAT_FLAG_ALPHA) != 0;
+  image.format = PNG_FORMAT_RGBA;
+  out->rgba.resize(PNG_IMAGE_SIZE(image));
+  if (!png_image_finish_read(&image, nullptr, out->rgba.data(), 0, nullptr)) {
+    png_image_free(&image);
+    return false;
+  }
+  return true;
+}
+
+// Independent sRGB reference: IEC 61966-2-1 in double precision.
+int srgb8(double linear) {
+  const double c = std::clamp(linear, 0.0, 1.0);
+  const double e = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+  return static_cast<int>(std::lround(e * 255.0));
+}
+
+TEST_F(ImageFilesPng, RoundTripIsSrgbEncodedAndClamped) {
+  const int width = 5;
+  const int height = 3;
+  std::vector<float> rgba(static_cast<size_t>(width * height) * 4, 0.0f);
+  auto pixel = [&](int x, int y) { return rgba.data() + (static_cast<size_t>(y) * width + x) * 4; };
+  float* p = pixel(2, 1);
+  p[0] = 0.5f;
+  p[1] = 0.18f;
+  p[2] = 0.002f;
+  p[3] = 0.5f;
+  float* q = pixel(4, 2);
+  q[0] = 2.0f;
+  q[1] = -1.0f;
+  q[2] = std::numeric_limits<float>::quiet_NaN();
+  q[3] = 7.0f;
+  const std::string file = path("preview.png");
+  const Status s = write_png(file, width, height, rgba.data(), PngChannels::kRgba);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(list_dir(dir_), std::vector<std::string>{"preview.png"});
+
+  DecodedPng png;
+  ASSERT_TRUE(decode_png(file, &png));
+  EXPECT_EQ(png.width, 5u);
+  EXPECT_EQ(png.height, 3u);
+  EXPECT_TRUE(png.has_alpha);
+  const unsigned char* a = png.rgba.data() + (1 * width + 2) * 4;
+  EXPECT_EQ(a[0], 188);  // sRGB(0.5) = 0.7354
+  EXPECT_EQ(a[1], 118);  // sRGB(0.18) = 0.4613
+  EXPECT_EQ(a[2], 7);    // linear segment: 12.92 * 0.002
+  EXPECT_EQ(a[3], 128);  // alpha stays linear
+  EXPECT_EQ(a[0], srgb8(0.5));
+  EXPECT_EQ(a[1], srgb8(0.18));
+  const unsigned char* b = png.rgba.data() + (2 * width + 4) * 4;
+  EXPECT_EQ(b[0], 255);
+  EXPECT_EQ(b[1], 0);
+  EXPECT_EQ(b[2], 0);  // NaN → 0
+  EXPECT_EQ(b[3], 255);
+  const unsigned char* origin = png.rgba.data();
+  EXPECT_EQ(origin[0], 0);
+  EXPECT_EQ(origin[3], 0);
+}
+
+TEST_F(ImageFilesPng, RgbPreviewHasNoAlphaAndMatchesReference) {
+  const int width = 3;
+  const int height = 2;
+  std::vector<float> rgba(static_cast<size_t>(width * height) * 4);
+  for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = static_cast<float>(i) / 24.0f;
+  const std::string file = path("preview.png");
+  ASSERT_TRUE(write_png(file, width, height, rgba.data(), PngChannels::kRgb).ok());
+
+  DecodedPng png;
+  ASSERT_TRUE(decode_png(file, &png));
+  EXPECT_FALSE(png.has_alpha);
+  for (size_t i = 0; i < static_cast<size_t>(width * height); ++i) {
+    for (size_t c = 0; c < 3; ++c) {
+      EXPECT_EQ(png.rgba[i * 4 + c], srgb8(rgba[i * 4 + c])) << i << " " << c;
+    }
+    EXPECT_EQ(png.rgba[i * 4 + 3], 255);  // decoder fills the missing alpha
+  }
+}
+
+TEST_F(ImageFilesPng, ErrorsNameThePathAndLeaveNoFile) {
+  std::vector<float> rgba(16, 0.25f);
+  const std::string missing = path("missing") + "/preview.png";
+  Status s = write_png(missing, 2, 2, rgba.data());
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(missing), std::string::npos) << s.message();
+  s = write_png(path("preview.png"), 0, 2, rgba.data());
+  EXPECT_FALSE(s.ok());
+  s = write_png(path("preview.png"), 2, 2, nullptr);
+  EXPECT_FALSE(s.ok());
+  std::vector<unsigned char> bytes;
+  EXPECT_TRUE(encode_png(2, 2, rgba.data(), PngChannels::kRgba, &bytes).ok());
+  EXPECT_GT(bytes.size(), 8u);
+  EXPECT_EQ(bytes[1], 'P');  // PNG signature \x89PNG
+  EXPECT_TRUE(list_dir(dir_).empty());
+}
+
+TEST_F(ImageFilesPng, LibpngErrorIsReportedWithoutLeaking) {
+  // libpng refuses widths above its default user limit (1,000,000): exercises the longjmp path.
+  const int width = 1000001;
+  std::vector<float> rgba(static_cast<size_t>(width) * 4, 0.5f);
+  const std::string file = path("wide.png");
+  const Status s = write_png(file, width, 1, rgba.data());
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(file), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("width"), std::string::npos) << s.message();
+  EXPECT_TRUE(list_dir(dir_).empty());
+}
+
+}  // namespace
+}  // namespace siviflow
