@@ -1,0 +1,130 @@
+// SiViFlow renderer: the embedding interface.
+//
+// The host owns the instance, the device, the queue and the command buffers. It fills one
+// CreateInfo (zero-initialised fields take the documented defaults), enables
+// required_device_features() when it creates its device, and per frame:
+//   1. waits on its own fence for the frame slot it is about to reuse, then begin_frame(slot);
+//   2. update(camera, time)   — CPU only: simulation and packing into the slot's staging block;
+//   3. record(cmd, inputs)    — records upload and render passes into the host's command buffer,
+//                               outside any host render pass, and leaves every host image in the
+//                               state the host asked for.
+// The renderer never submits, never waits idle and never owns a swapchain. It calls Vulkan only
+// through a private function table loaded from the host's vkGet*ProcAddr.
+// Destroy it only when the GPU has finished every frame it recorded.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <vulkan/vulkan.h>
+
+#include "sim/status.h"
+
+namespace siviflow {
+
+enum class LogLevel { kInfo, kWarning, kError };
+using LogCallback = void (*)(LogLevel level, const char* message, void* user);
+
+struct CreateInfo {
+  VkInstance instance = VK_NULL_HANDLE;                    // host's instance (Vulkan >= 1.3)
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;       // the device's physical device
+  VkDevice device = VK_NULL_HANDLE;                        // created with required_device_features()
+  PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;  // required: loads our private table
+  PFN_vkGetDeviceProcAddr get_device_proc_addr = nullptr;  // optional: else from the instance
+  uint32_t queue_family_index = 0;     // family of the queue that will run what we record
+  uint32_t frames_in_flight = 0;       // ring slots; 0 means 2
+  VkFormat color_format = VK_FORMAT_UNDEFINED;  // output image format; 0 means RGBA16F
+  VkExtent2D extent = {0, 0};          // output size in pixels; required
+  bool enable_readback = false;        // record a copy of colour and depth into host buffers
+  VkDeviceSize staging_bytes_per_slot = 0;  // per-slot staging block; 0 means 8 MiB
+  bool debug_utils = false;            // the host enabled VK_EXT_debug_utils: label passes, name objects
+  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;         // optional
+  const VkAllocationCallbacks* allocation_callbacks = nullptr;  // optional
+  LogCallback log = nullptr;           // optional; warnings and errors with context
+  void* log_user = nullptr;
+};
+
+// Features the host must enable on its device (Vulkan 1.3 core). Fill the host's chain with
+// them; create() reports each one that is missing by name.
+struct RequiredDeviceFeatures {
+  VkPhysicalDeviceFeatures2 features2{};
+  VkPhysicalDeviceVulkan13Features vulkan13{};
+  // Links vulkan13 into features2.pNext; call after copying the struct.
+  void link() { features2.pNext = &vulkan13; }
+};
+RequiredDeviceFeatures required_device_features();
+
+struct Camera {
+  glm::vec3 position{0.0f, 10.0f, -30.0f};
+  glm::vec3 target{0.0f, 0.0f, 0.0f};
+  float fov_y_deg = 50.0f;
+  float near_plane = 0.1f;
+  float far_plane = 1000.0f;
+};
+
+// An image's synchronisation state: what last touched it and its layout.
+struct ImageState {
+  VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 access = VK_ACCESS_2_NONE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+};
+
+// A host image we render into. `current` is its state when our commands start; `final` the
+// state the host wants when they end.
+struct ExternalImage {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  ImageState current;
+  ImageState final;
+};
+
+// Host-visible buffers that receive the frame when CreateInfo::enable_readback is set:
+// colour as the output format's texels, depth as 32-bit floats (window depth, 0 near .. 1 far).
+struct ReadbackTargets {
+  VkBuffer color = VK_NULL_HANDLE;
+  VkBuffer depth = VK_NULL_HANDLE;
+};
+
+struct FrameInputs {
+  ExternalImage output;
+  ReadbackTargets readback;
+};
+
+// "siviflow 0.1.0", as recorded in EXR metadata.
+const char* version_string();
+
+class Renderer {
+ public:
+  static Status create(const CreateInfo& info, std::unique_ptr<Renderer>* out);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // The host has waited until the GPU finished the commands last recorded for this slot.
+  Status begin_frame(uint32_t slot);
+  // CPU only: camera and simulation time for the frame being prepared.
+  Status update(const Camera& camera, double time_seconds);
+  // Records the frame into `cmd` (in the recording state, outside any render pass).
+  Status record(VkCommandBuffer cmd, const FrameInputs& inputs);
+
+  // The camera of the scene's own camera path at that time (the default scene glides downstream).
+  Camera scene_camera(double time_seconds) const;
+
+  // Byte size of one readback buffer for colour / depth at the configured extent.
+  VkDeviceSize readback_color_bytes() const;
+  VkDeviceSize readback_depth_bytes() const;
+  // The frame graph of the current configuration, as text and as Graphviz.
+  std::string dump_frame_graph() const;
+  std::string dump_frame_graph_graphviz() const;
+
+  struct Impl;
+
+ private:
+  explicit Renderer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace siviflow

@@ -1,0 +1,92 @@
+// The passes of the SiViFlow frame graph. Each pass knows the frame graph and its own shaders,
+// not the other passes; the renderer wires their handles together.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "scene/default_scene.h"
+#include "shared.h"
+#include "sim/status.h"
+#include "vk/frame_graph.h"
+#include "vk/frame_ring.h"
+#include "vk/gpu_resources.h"
+
+namespace siviflow {
+
+// ---- upload: staging block -> device buffers and images (always a real copy) ----
+
+// One copy from the frame slot's staging block, recorded by the upload pass.
+struct BufferUpload {
+  VkDeviceSize staging_offset = 0;
+  VkBuffer destination = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+};
+struct ImageUpload {
+  VkDeviceSize staging_offset = 0;
+  ImageHandle destination;
+  VkExtent2D extent{};
+};
+
+// What the upload pass copies this frame; filled on the CPU during update().
+struct UploadList {
+  std::vector<BufferUpload> buffers;
+  std::vector<ImageUpload> images;
+  void clear() {
+    buffers.clear();
+    images.clear();
+  }
+};
+
+struct UploadPassHandles {
+  BufferHandle staging;                    // imported: the slot's staging block
+  std::vector<BufferHandle> buffers;       // written by the pass (new versions returned here)
+  std::vector<ImageHandle> images;
+};
+// Declares the pass; `list` is read when the pass records, so it may change every frame.
+void add_upload_pass(FrameGraph& graph, const UploadList& list, UploadPassHandles* handles);
+
+// ---- scene: sky, terrain, riverbed and objects ----
+
+class ScenePass {
+ public:
+  Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
+                VkFormat depth_format);
+  void destroy(const GpuContext& gpu);
+  // Points the pass's descriptor at the ground-detail texture (once, after it is created).
+  void set_detail_texture(const GpuContext& gpu, VkImageView view);
+
+  struct Handles {
+    ImageHandle color;
+    ImageHandle depth;
+    BufferHandle vertices;
+    BufferHandle indices;
+    ImageHandle detail;
+  };
+  // Declares the pass; the new versions of colour and depth are written back into `handles`.
+  void declare(FrameGraph& graph, const gpu::SceneConstants* constants, uint32_t index_count,
+               Handles* handles);
+
+ private:
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  VkSampler sampler_ = VK_NULL_HANDLE;
+  VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline scene_pipeline_ = VK_NULL_HANDLE;
+};
+
+// ---- readback: output colour and depth -> host buffers (tools and tests only) ----
+
+struct ReadbackHandles {
+  ImageHandle color;
+  ImageHandle depth;
+  BufferHandle color_buffer;  // imported, handed back in the HostRead state
+  BufferHandle depth_buffer;
+};
+void add_readback_pass(FrameGraph& graph, ReadbackHandles* handles);
+
+}  // namespace siviflow

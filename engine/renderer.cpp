@@ -1,0 +1,352 @@
+#include "siviflow/renderer.h"
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "passes/passes.h"
+#include "scene/default_scene.h"
+#include "scene/detail_texture.h"
+#include "siviflow/headless_context.h"
+#include "vk/device_table.h"
+#include "vk/frame_graph.h"
+#include "vk/frame_ring.h"
+#include "vk/gpu_resources.h"
+
+namespace siviflow {
+namespace {
+
+constexpr uint32_t kDefaultFramesInFlight = 2;
+constexpr uint32_t kMaxFramesInFlight = 8;
+constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkDeviceSize kDefaultStagingBytes = 8ull << 20;
+constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we copy
+
+uint32_t texel_bytes(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_R8G8B8A8_SRGB:
+    case VK_FORMAT_B8G8R8A8_UNORM:
+    case VK_FORMAT_B8G8R8A8_SRGB:
+      return 4;
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+      return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+      return 16;
+    default:
+      return 0;
+  }
+}
+
+Status invalid(const std::string& message) {
+  return Status::error("siviflow::Renderer: " + message, VK_ERROR_INITIALIZATION_FAILED);
+}
+
+}  // namespace
+
+const char* version_string() { return "siviflow 0.1.0"; }
+
+struct Renderer::Impl {
+  CreateInfo info;
+  DeviceTable table;
+  GpuContext gpu;
+  FrameRing ring;
+  ProceduralRiver river{default_river_params()};
+  SceneLook look = default_scene_look();
+
+  SceneGeometry geometry;  // kept until the first frame has copied it to the GPU
+  uint32_t index_count = 0;
+  Buffer vertex_buffer;
+  Buffer index_buffer;
+  DetailTexture detail_pixels;
+  Image detail_image;
+  Image depth_image;
+  ScenePass scene_pass;
+
+  FrameGraph graph;
+  UploadPassHandles upload;
+  ScenePass::Handles scene;
+  ImageHandle output;
+  ReadbackHandles readback;
+  UploadList uploads;
+  FrameBindings bindings;
+  gpu::SceneConstants constants{};
+
+  bool static_data_uploaded = false;
+  bool detail_initialised = false;
+  bool frame_begun = false;
+  bool frame_updated = false;
+
+  Status validate_info(const CreateInfo& create);
+  Status create_static_resources();
+  Status declare_graph();
+  Status stage_static_data();
+  void destroy();
+};
+
+Status Renderer::Impl::validate_info(const CreateInfo& create) {
+  info = create;
+  if (info.instance == VK_NULL_HANDLE || info.physical_device == VK_NULL_HANDLE ||
+      info.device == VK_NULL_HANDLE || info.get_instance_proc_addr == nullptr) {
+    return invalid("CreateInfo needs instance, physical_device, device and get_instance_proc_addr");
+  }
+  if (info.extent.width == 0 || info.extent.height == 0) {
+    return invalid("CreateInfo::extent must be at least 1x1");
+  }
+  if (info.frames_in_flight == 0) info.frames_in_flight = kDefaultFramesInFlight;
+  if (info.frames_in_flight > kMaxFramesInFlight) {
+    return invalid("CreateInfo::frames_in_flight " + std::to_string(info.frames_in_flight) +
+                   " exceeds " + std::to_string(kMaxFramesInFlight));
+  }
+  if (info.color_format == VK_FORMAT_UNDEFINED) info.color_format = kDefaultColorFormat;
+  if (texel_bytes(info.color_format) == 0) {
+    return invalid("CreateInfo::color_format " + std::to_string(info.color_format) +
+                   " is not an RGBA8, RGBA16F or RGBA32F format");
+  }
+  if (info.staging_bytes_per_slot == 0) info.staging_bytes_per_slot = kDefaultStagingBytes;
+
+  const char* missing_function = nullptr;
+  const VkResult loaded = load_device_table(info.instance, info.physical_device, info.device,
+                                            info.get_instance_proc_addr, info.get_device_proc_addr,
+                                            info.debug_utils, &table, &missing_function);
+  if (loaded != VK_SUCCESS) {
+    return Status::error(std::string("siviflow::Renderer: cannot load ") + missing_function, loaded);
+  }
+  const std::vector<std::string> missing =
+      missing_required_features(info.get_instance_proc_addr, info.instance, info.physical_device);
+  if (!missing.empty()) {
+    std::string names;
+    for (const std::string& name : missing) names += (names.empty() ? "" : ", ") + name;
+    return Status::error("siviflow::Renderer: the device lacks required features: " + names,
+                         VK_ERROR_FEATURE_NOT_PRESENT);
+  }
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  table.vkGetPhysicalDeviceProperties2(info.physical_device, &props);
+  const uint32_t limit = props.properties.limits.maxImageDimension2D;
+  if (info.extent.width > limit || info.extent.height > limit) {
+    return invalid("extent " + std::to_string(info.extent.width) + "x" +
+                   std::to_string(info.extent.height) + " exceeds the device limit of " +
+                   std::to_string(limit));
+  }
+  VkFormatProperties format_props;
+  table.vkGetPhysicalDeviceFormatProperties(info.physical_device, info.color_format, &format_props);
+  if ((format_props.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT) == 0) {
+    return Status::error("siviflow::Renderer: color_format cannot be rendered to on this device",
+                         VK_ERROR_FORMAT_NOT_SUPPORTED);
+  }
+  gpu = make_gpu_context(table, info.allocation_callbacks);
+  return Status::success();
+}
+
+Status Renderer::Impl::create_static_resources() {
+  geometry = build_default_scene_geometry(river);
+  index_count = static_cast<uint32_t>(geometry.indices.size());
+  detail_pixels = make_detail_texture();
+  const VkDeviceSize vertex_bytes = geometry.vertices.size() * sizeof(SceneVertex);
+  const VkDeviceSize index_bytes = geometry.indices.size() * sizeof(uint32_t);
+  // The first frame's slot must hold every static upload at once.
+  const VkDeviceSize static_bytes =
+      vertex_bytes + index_bytes + detail_pixels.texels.size() + 4 * kStagingAlignment;
+  if (info.staging_bytes_per_slot < static_bytes) info.staging_bytes_per_slot = static_bytes;
+  SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
+  SIVIFLOW_TRY(create_buffer(gpu, vertex_bytes,
+                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                             false, "scene vertices", &vertex_buffer));
+  SIVIFLOW_TRY(create_buffer(gpu, index_bytes,
+                             VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                             false, "scene indices", &index_buffer));
+  return Status::success();
+}
+
+Status Renderer::Impl::declare_graph() {
+  const VkExtent2D extent = info.extent;
+  upload.staging = graph.import_buffer({"staging", 0}, state_of(Access::HostWrite));
+  const BufferHandle vertices = graph.import_buffer({"scene vertices", vertex_buffer.size},
+                                                    ResourceState{}, state_of(Access::VertexBufferRead));
+  const BufferHandle indices = graph.import_buffer({"scene indices", index_buffer.size},
+                                                   ResourceState{}, state_of(Access::IndexBufferRead));
+  const ImageHandle detail = graph.create_persistent_image(
+      {"ground detail", VK_FORMAT_R8G8B8A8_UNORM, {detail_pixels.size, detail_pixels.size}, {}});
+  upload.buffers = {vertices, indices};
+  upload.images = {detail};
+  add_upload_pass(graph, uploads, &upload);
+
+  VkClearValue sky_clear{};
+  VkClearValue far_depth{};
+  far_depth.depthStencil = {1.0f, 0};
+  // The host states the output's real states per frame; these are overridden in record().
+  output = graph.import_image({"output", info.color_format, extent, sky_clear}, ResourceState{},
+                              state_of(Access::SampledFragment));
+  scene.color = output;
+  scene.depth = graph.create_image({"depth", kDepthFormat, extent, far_depth});
+  scene.vertices = upload.buffers[0];
+  scene.indices = upload.buffers[1];
+  scene.detail = upload.images[0];
+  scene_pass.declare(graph, &constants, index_count, &scene);
+
+  if (info.enable_readback) {
+    readback.color = scene.color;
+    readback.depth = scene.depth;
+    readback.color_buffer = graph.import_buffer({"readback colour", 0}, ResourceState{},
+                                                state_of(Access::HostRead));
+    readback.depth_buffer = graph.import_buffer({"readback depth", 0}, ResourceState{},
+                                                state_of(Access::HostRead));
+    add_readback_pass(graph, &readback);
+  }
+  SIVIFLOW_TRY(graph.compile());
+
+  SIVIFLOW_TRY(create_image(gpu, kDepthFormat, extent, graph.image_usage(scene.depth), "depth",
+                            &depth_image));
+  SIVIFLOW_TRY(create_image(gpu, VK_FORMAT_R8G8B8A8_UNORM,
+                            {detail_pixels.size, detail_pixels.size},
+                            graph.image_usage(upload.images[0]), "ground detail", &detail_image));
+  SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
+  scene_pass.set_detail_texture(gpu, detail_image.view);
+  return Status::success();
+}
+
+Status Renderer::Impl::stage_static_data() {
+  const auto stage = [this](const void* data, VkDeviceSize size, VkDeviceSize* offset) {
+    StagingAllocation allocation;
+    SIVIFLOW_TRY(ring.allocate_staging(size, kStagingAlignment, &allocation));
+    std::memcpy(allocation.data, data, size);
+    *offset = allocation.offset;
+    return Status::success();
+  };
+  BufferUpload vertices{0, vertex_buffer.buffer, vertex_buffer.size};
+  SIVIFLOW_TRY(stage(geometry.vertices.data(), vertex_buffer.size, &vertices.staging_offset));
+  BufferUpload indices{0, index_buffer.buffer, index_buffer.size};
+  SIVIFLOW_TRY(stage(geometry.indices.data(), index_buffer.size, &indices.staging_offset));
+  ImageUpload detail{0, upload.images[0], {detail_pixels.size, detail_pixels.size}};
+  SIVIFLOW_TRY(stage(detail_pixels.texels.data(), detail_pixels.texels.size(), &detail.staging_offset));
+  uploads.buffers = {vertices, indices};
+  uploads.images = {detail};
+  return Status::success();
+}
+
+void Renderer::Impl::destroy() {
+  if (table.device == VK_NULL_HANDLE) return;
+  scene_pass.destroy(gpu);
+  destroy_image(gpu, &depth_image);
+  destroy_image(gpu, &detail_image);
+  destroy_buffer(gpu, &vertex_buffer);
+  destroy_buffer(gpu, &index_buffer);
+  ring.destroy();
+}
+
+Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) {
+  auto impl = std::make_unique<Impl>();
+  Status status = impl->validate_info(info);
+  if (status.ok()) status = impl->create_static_resources();
+  if (status.ok()) status = impl->declare_graph();
+  if (!status.ok()) {
+    if (info.log != nullptr) info.log(LogLevel::kError, status.message().c_str(), info.log_user);
+    impl->destroy();
+    return status;
+  }
+  out->reset(new Renderer(std::move(impl)));
+  return Status::success();
+}
+
+Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Renderer::~Renderer() { impl_->destroy(); }
+
+Status Renderer::begin_frame(uint32_t slot) {
+  Impl& r = *impl_;
+  SIVIFLOW_TRY(r.ring.begin_slot(slot));
+  r.uploads.clear();
+  r.frame_begun = true;
+  r.frame_updated = false;
+  return Status::success();
+}
+
+Status Renderer::update(const Camera& camera, double time_seconds) {
+  Impl& r = *impl_;
+  if (!r.frame_begun) return Status::error("Renderer::update called before begin_frame");
+  if (!std::isfinite(time_seconds) || camera.near_plane <= 0.0f ||
+      camera.far_plane <= camera.near_plane || camera.fov_y_deg <= 0.0f ||
+      camera.fov_y_deg >= 180.0f || camera.position == camera.target) {
+    return Status::error("Renderer::update: invalid camera or time");
+  }
+  const float aspect = static_cast<float>(r.info.extent.width) / static_cast<float>(r.info.extent.height);
+  glm::mat4 projection = glm::perspectiveRH_ZO(glm::radians(camera.fov_y_deg), aspect,
+                                               camera.near_plane, camera.far_plane);
+  projection[1][1] *= -1.0f;  // Vulkan's clip space has +Y down
+  const glm::mat4 view = glm::lookAtRH(camera.position, camera.target, glm::vec3(0.0f, 1.0f, 0.0f));
+  r.constants.view_proj = projection * view;
+  r.constants.camera_position = glm::vec4(camera.position, 1.0f);
+  r.constants.sun_direction = glm::vec4(glm::normalize(r.look.sun_direction), r.look.sun_disc_intensity);
+  r.constants.clip_plane = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // main view: nothing clipped
+  r.constants.fog = glm::vec4(r.look.fog_density, r.look.fog_height_falloff, 0.0f, 0.0f);
+  if (!r.static_data_uploaded) SIVIFLOW_TRY(r.stage_static_data());
+  r.frame_updated = true;
+  return Status::success();
+}
+
+Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
+  Impl& r = *impl_;
+  if (!r.frame_updated) return Status::error("Renderer::record called before begin_frame and update");
+  if (inputs.output.image == VK_NULL_HANDLE || inputs.output.view == VK_NULL_HANDLE) {
+    return Status::error("Renderer::record: FrameInputs::output needs an image and a view");
+  }
+  if (r.info.enable_readback &&
+      (inputs.readback.color == VK_NULL_HANDLE || inputs.readback.depth == VK_NULL_HANDLE)) {
+    return Status::error("Renderer::record: readback is enabled but FrameInputs::readback is empty");
+  }
+  FrameBindings& b = r.bindings;
+  b.reset();
+  b.bind_buffer(r.upload.staging, r.ring.staging_buffer());
+  b.bind_buffer(r.scene.vertices, r.vertex_buffer.buffer);
+  b.bind_buffer(r.scene.indices, r.index_buffer.buffer);
+  b.bind_image(r.scene.detail, r.detail_image.image, r.detail_image.view);
+  b.bind_image(r.output, inputs.output.image, inputs.output.view);
+  b.bind_image(r.scene.depth, r.depth_image.image, r.depth_image.view);
+  b.set_incoming(r.output, {inputs.output.current.stage, inputs.output.current.access,
+                            inputs.output.current.layout});
+  b.set_outgoing(r.output, {inputs.output.final.stage, inputs.output.final.access,
+                            inputs.output.final.layout});
+  if (r.static_data_uploaded) {
+    // Last frame left the static buffers being read; this frame's upload barrier waits on that.
+    b.set_incoming(r.scene.vertices, state_of(Access::VertexBufferRead));
+    b.set_incoming(r.scene.indices, state_of(Access::IndexBufferRead));
+  }
+  if (!r.detail_initialised) b.set_incoming(r.scene.detail, ResourceState{});
+  if (r.info.enable_readback) {
+    b.bind_buffer(r.readback.color_buffer, inputs.readback.color);
+    b.bind_buffer(r.readback.depth_buffer, inputs.readback.depth);
+  }
+  const Status status = r.graph.execute(r.table, cmd, b);
+  if (!status.ok()) {
+    if (r.info.log != nullptr) r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
+    return status;
+  }
+  if (!r.uploads.buffers.empty()) {
+    r.static_data_uploaded = true;
+    r.geometry = SceneGeometry{};  // the GPU copy is the only one needed from now on
+  }
+  r.detail_initialised = true;
+  r.frame_begun = false;
+  r.frame_updated = false;
+  return Status::success();
+}
+
+Camera Renderer::scene_camera(double time_seconds) const {
+  return default_camera(impl_->river, time_seconds);
+}
+
+VkDeviceSize Renderer::readback_color_bytes() const {
+  return VkDeviceSize{impl_->info.extent.width} * impl_->info.extent.height *
+         texel_bytes(impl_->info.color_format);
+}
+
+VkDeviceSize Renderer::readback_depth_bytes() const {
+  return VkDeviceSize{impl_->info.extent.width} * impl_->info.extent.height * sizeof(float);
+}
+
+std::string Renderer::dump_frame_graph() const { return impl_->graph.dump_text(); }
+std::string Renderer::dump_frame_graph_graphviz() const { return impl_->graph.dump_graphviz(); }
+
+}  // namespace siviflow

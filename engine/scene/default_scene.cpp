@@ -1,0 +1,161 @@
+#include "scene/default_scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
+
+namespace siviflow {
+namespace {
+
+constexpr int kTerrainColumns = 180;   // quads across the valley
+constexpr int kTerrainRows = 240;      // quads along the valley
+constexpr float kTerrainHalfWidth = 90.0f;
+
+glm::vec3 terrain_normal(const ProceduralRiver& river, float x, float z) {
+  const float e = 0.5f;
+  const float dx = river.terrain_height(x + e, z) - river.terrain_height(x - e, z);
+  const float dz = river.terrain_height(x, z + e) - river.terrain_height(x, z - e);
+  return glm::normalize(glm::vec3(-dx, 2.0f * e, -dz));
+}
+
+glm::vec3 terrain_albedo(float height, float slope_y) {
+  const glm::vec3 riverbed(0.30f, 0.27f, 0.21f);
+  const glm::vec3 sand(0.62f, 0.55f, 0.42f);
+  const glm::vec3 grass(0.13f, 0.24f, 0.07f);
+  const glm::vec3 rock(0.42f, 0.40f, 0.38f);
+  // Wide, smooth transitions: colour is interpolated per vertex on a 1 m grid, so a narrow band
+  // would show the grid as a saw-tooth edge.
+  glm::vec3 c = glm::mix(riverbed, sand, glm::smoothstep(-0.8f, 0.1f, height));
+  c = glm::mix(c, grass, glm::smoothstep(0.35f, 0.9f, height));
+  c = glm::mix(c, rock, glm::clamp((0.85f - slope_y) * 4.0f, 0.0f, 1.0f));
+  return glm::mix(c, rock * 1.1f, glm::clamp((height - 14.0f) / 6.0f, 0.0f, 1.0f));
+}
+
+void add_terrain(const ProceduralRiver& river, SceneGeometry* geometry) {
+  const float half_length = 0.5f * river.params().length;
+  const uint32_t base = static_cast<uint32_t>(geometry->vertices.size());
+  for (int row = 0; row <= kTerrainRows; ++row) {
+    const float z = -half_length + river.params().length * static_cast<float>(row) / kTerrainRows;
+    for (int col = 0; col <= kTerrainColumns; ++col) {
+      const float x = -kTerrainHalfWidth + 2.0f * kTerrainHalfWidth * static_cast<float>(col) /
+                                               kTerrainColumns;
+      const float y = river.terrain_height(x, z);
+      const glm::vec3 n = terrain_normal(river, x, z);
+      const glm::vec3 albedo = terrain_albedo(y, n.y);
+      geometry->vertices.push_back({{x, y, z}, n, glm::vec4(albedo, 1.0f)});
+    }
+  }
+  const uint32_t stride = kTerrainColumns + 1;
+  for (uint32_t row = 0; row < kTerrainRows; ++row) {
+    for (uint32_t col = 0; col < kTerrainColumns; ++col) {
+      const uint32_t a = base + row * stride + col;
+      const uint32_t b = a + 1;
+      const uint32_t c = a + stride;
+      const uint32_t d = c + 1;
+      // Counter-clockwise seen from above (+Y) with x right and z towards the viewer.
+      geometry->indices.insert(geometry->indices.end(), {a, c, b, b, c, d});
+    }
+  }
+}
+
+// A latitude-longitude ellipsoid, squashed and bumped so it reads as a boulder.
+void add_boulder(glm::vec3 centre, glm::vec3 radii, glm::vec3 albedo, float seed,
+                 SceneGeometry* geometry) {
+  constexpr int kRings = 10;
+  constexpr int kSegments = 16;
+  const uint32_t base = static_cast<uint32_t>(geometry->vertices.size());
+  for (int ring = 0; ring <= kRings; ++ring) {
+    const float theta = glm::pi<float>() * static_cast<float>(ring) / kRings;
+    for (int seg = 0; seg <= kSegments; ++seg) {
+      const float phi = glm::two_pi<float>() * static_cast<float>(seg) / kSegments;
+      const glm::vec3 unit(std::sin(theta) * std::cos(phi), std::cos(theta),
+                           std::sin(theta) * std::sin(phi));
+      const float bump = 1.0f + 0.12f * std::sin(3.0f * phi + seed) * std::sin(2.0f * theta + seed);
+      const glm::vec3 p = centre + unit * radii * bump;
+      const glm::vec3 n = glm::normalize(unit / radii);
+      const float occlusion = 0.55f + 0.45f * (unit.y * 0.5f + 0.5f);
+      geometry->vertices.push_back({p, n, glm::vec4(albedo, occlusion)});
+    }
+  }
+  for (uint32_t ring = 0; ring < kRings; ++ring) {
+    for (uint32_t seg = 0; seg < kSegments; ++seg) {
+      const uint32_t a = base + ring * (kSegments + 1) + seg;
+      const uint32_t b = a + 1;
+      const uint32_t c = a + kSegments + 1;
+      const uint32_t d = c + 1;
+      geometry->indices.insert(geometry->indices.end(), {a, b, c, b, d, c});
+    }
+  }
+}
+
+// A cone on a cylinder: a conifer, tall enough to show in the water's reflection later.
+void add_tree(glm::vec3 foot, float height, SceneGeometry* geometry) {
+  constexpr int kSegments = 12;
+  const glm::vec3 trunk_colour(0.25f, 0.16f, 0.09f);
+  const glm::vec3 crown_colour(0.07f, 0.20f, 0.08f);
+  const float trunk_radius = 0.04f * height;
+  const float trunk_height = 0.25f * height;
+  const float crown_radius = 0.22f * height;
+  const auto add_ring_pair = [&](float r0, float y0, float r1, float y1, glm::vec3 colour) {
+    const uint32_t base = static_cast<uint32_t>(geometry->vertices.size());
+    const float slope = (r0 - r1) / (y1 - y0);
+    for (int seg = 0; seg <= kSegments; ++seg) {
+      const float phi = glm::two_pi<float>() * static_cast<float>(seg) / kSegments;
+      const glm::vec3 radial(std::cos(phi), 0.0f, std::sin(phi));
+      const glm::vec3 n = glm::normalize(radial + glm::vec3(0.0f, slope, 0.0f));
+      geometry->vertices.push_back({foot + radial * r0 + glm::vec3(0, y0, 0), n, glm::vec4(colour, 0.6f)});
+      geometry->vertices.push_back({foot + radial * r1 + glm::vec3(0, y1, 0), n, glm::vec4(colour, 1.0f)});
+    }
+    for (uint32_t seg = 0; seg < kSegments; ++seg) {
+      const uint32_t a = base + 2 * seg;
+      geometry->indices.insert(geometry->indices.end(), {a, a + 1, a + 2, a + 2, a + 1, a + 3});
+    }
+  };
+  add_ring_pair(trunk_radius, -0.5f, trunk_radius, trunk_height, trunk_colour);
+  add_ring_pair(crown_radius, trunk_height, 0.0f, height, crown_colour);
+}
+
+glm::vec3 on_ground(const ProceduralRiver& river, float lateral_offset, float z) {
+  const float x = river.centreline_x(z) + lateral_offset;
+  return {x, river.terrain_height(x, z), z};
+}
+
+}  // namespace
+
+SceneLook default_scene_look() { return SceneLook{}; }
+
+ProceduralRiverParams default_river_params() { return ProceduralRiverParams{}; }
+
+SceneGeometry build_default_scene_geometry(const ProceduralRiver& river) {
+  SceneGeometry geometry;
+  add_terrain(river, &geometry);
+  const glm::vec3 granite(0.46f, 0.44f, 0.42f);
+  const glm::vec3 sandstone(0.55f, 0.45f, 0.35f);
+  // Boulders on both banks, and one in the water that the flow will go around.
+  add_boulder(on_ground(river, -10.0f, -20.0f) + glm::vec3(0, 0.6f, 0), {2.2f, 1.6f, 1.9f}, granite, 1.0f, &geometry);
+  add_boulder(on_ground(river, 11.0f, 12.0f) + glm::vec3(0, 0.5f, 0), {1.6f, 1.2f, 1.5f}, sandstone, 2.0f, &geometry);
+  add_boulder(on_ground(river, 1.5f, 2.0f) + glm::vec3(0, 0.3f, 0), {1.3f, 1.3f, 1.2f}, granite, 3.0f, &geometry);
+  for (int i = 0; i < 6; ++i) {
+    const float z = -60.0f + 22.0f * static_cast<float>(i);
+    const float side = (i % 2 == 0) ? -1.0f : 1.0f;
+    add_tree(on_ground(river, side * (13.0f + 3.0f * static_cast<float>(i % 3)), z), 7.0f + static_cast<float>(i % 3), &geometry);
+  }
+  return geometry;
+}
+
+Camera default_camera(const ProceduralRiver& river, double time_seconds) {
+  // Glide downstream (+Z) above the water, looking ahead along the river.
+  const float z = -55.0f + 2.0f * static_cast<float>(time_seconds);
+  const float look_ahead = 30.0f;
+  Camera camera;
+  camera.position = {river.centreline_x(z) - 4.0f, 6.5f, z};
+  camera.target = {river.centreline_x(z + look_ahead), 0.5f, z + look_ahead};
+  camera.fov_y_deg = 55.0f;
+  camera.near_plane = 0.1f;
+  camera.far_plane = 600.0f;
+  return camera;
+}
+
+}  // namespace siviflow

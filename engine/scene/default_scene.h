@@ -1,0 +1,44 @@
+// The built-in default scene: the procedural river's valley (terrain and riverbed), a few
+// objects on the banks and in the water, the sun, and a camera that moves along the river.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "siviflow/renderer.h"
+#include "sim/procedural_river.h"
+
+namespace siviflow {
+
+// Vertex of the scene pipeline; attribute locations are in shaders/shared.h.
+struct SceneVertex {
+  glm::vec3 position;
+  glm::vec3 normal;
+  glm::vec4 color;  // rgb linear albedo, a ambient occlusion
+};
+static_assert(sizeof(SceneVertex) == 40);
+
+struct SceneGeometry {
+  std::vector<SceneVertex> vertices;
+  std::vector<uint32_t> indices;  // triangle list, counter-clockwise seen from outside
+};
+
+// Tunables of the look of the default scene, in one place.
+struct SceneLook {
+  glm::vec3 sun_direction{0.45f, 0.62f, 0.35f};  // towards the sun; normalised on use
+  float sun_disc_intensity = 20.0f;
+  float fog_density = 0.0022f;  // per metre at the water level
+  float fog_height_falloff = 0.05f;  // per metre of height
+};
+
+SceneLook default_scene_look();
+ProceduralRiverParams default_river_params();
+// Terrain of the river's valley plus the objects, in world space.
+SceneGeometry build_default_scene_geometry(const ProceduralRiver& river);
+// The camera of the default scene at time t (seconds): it glides down the valley.
+Camera default_camera(const ProceduralRiver& river, double time_seconds);
+
+}  // namespace siviflow

@@ -1,0 +1,47 @@
+// Buffers and images with their own memory. The renderer has a handful of long-lived resources,
+// so one dedicated allocation each is simpler than a sub-allocator and costs nothing measurable.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include "sim/status.h"
+#include "vk/device_table.h"
+
+namespace siviflow {
+
+struct GpuContext {
+  const DeviceTable* table = nullptr;
+  const VkAllocationCallbacks* allocation_callbacks = nullptr;
+  VkPhysicalDeviceMemoryProperties memory_properties{};
+};
+
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+  void* mapped = nullptr;  // persistently mapped when created host-visible
+};
+
+struct Image {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent{0, 0};
+};
+
+GpuContext make_gpu_context(const DeviceTable& table, const VkAllocationCallbacks* callbacks);
+
+// host_visible: the memory is HOST_VISIBLE|HOST_COHERENT and mapped for the buffer's lifetime.
+Status create_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags usage,
+                     bool host_visible, const char* debug_name, Buffer* out);
+void destroy_buffer(const GpuContext& gpu, Buffer* buffer);
+
+Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,
+                    VkImageUsageFlags usage, const char* debug_name, Image* out);
+void destroy_image(const GpuContext& gpu, Image* image);
+
+// The aspect a view or barrier of this format covers (depth formats vs colour).
+VkImageAspectFlags aspect_of(VkFormat format);
+
+}  // namespace siviflow

@@ -1,0 +1,151 @@
+#include "vk/pipeline.h"
+
+#include <string>
+
+#include "shader_registry.h"
+
+namespace siviflow {
+namespace {
+
+Status create_module(const GpuContext& gpu, std::string_view name, VkShaderModule* out) {
+  const ShaderBlob* blob = find_shader(name);
+  if (blob == nullptr) {
+    return Status::error("no embedded shader named '" + std::string(name) + "'");
+  }
+  VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  info.codeSize = blob->word_count * sizeof(uint32_t);
+  info.pCode = blob->words;
+  const VkResult result =
+      gpu.table->vkCreateShaderModule(gpu.table->device, &info, gpu.allocation_callbacks, out);
+  if (result != VK_SUCCESS) {
+    return Status::error("vkCreateShaderModule for '" + std::string(name) +
+                             "' failed: " + result_name(result),
+                         result);
+  }
+  return Status::success();
+}
+
+}  // namespace
+
+Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
+                                const GraphicsPipelineDesc& desc, VkPipeline* out) {
+  const DeviceTable& vk = *gpu.table;
+  VkShaderModule vertex = VK_NULL_HANDLE;
+  VkShaderModule fragment = VK_NULL_HANDLE;
+  Status status = create_module(gpu, desc.vertex_shader, &vertex);
+  if (status.ok()) status = create_module(gpu, desc.fragment_shader, &fragment);
+
+  if (status.ok()) {
+    VkPipelineShaderStageCreateInfo stages[2] = {
+        {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
+        {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
+    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].module = vertex;
+    stages[0].pName = "main";
+    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[1].module = fragment;
+    stages[1].pName = "main";
+
+    VkPipelineVertexInputStateCreateInfo vertex_input{
+        VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    vertex_input.vertexBindingDescriptionCount = static_cast<uint32_t>(desc.bindings.size());
+    vertex_input.pVertexBindingDescriptions = desc.bindings.data();
+    vertex_input.vertexAttributeDescriptionCount = static_cast<uint32_t>(desc.attributes.size());
+    vertex_input.pVertexAttributeDescriptions = desc.attributes.data();
+
+    VkPipelineInputAssemblyStateCreateInfo assembly{
+        VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+
+    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    viewport.viewportCount = 1;
+    viewport.scissorCount = 1;
+
+    VkPipelineRasterizationStateCreateInfo raster{
+        VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    raster.polygonMode = VK_POLYGON_MODE_FILL;
+    raster.cullMode = desc.cull_mode;
+    raster.frontFace = desc.front_face;
+    raster.lineWidth = 1.0f;
+
+    VkPipelineMultisampleStateCreateInfo multisample{
+        VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+
+    VkPipelineDepthStencilStateCreateInfo depth{
+        VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    depth.depthTestEnable = desc.depth_test ? VK_TRUE : VK_FALSE;
+    depth.depthWriteEnable = desc.depth_write ? VK_TRUE : VK_FALSE;
+    depth.depthCompareOp = desc.depth_compare;
+
+    VkPipelineColorBlendAttachmentState blend_attachment{};
+    blend_attachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                      VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    if (desc.alpha_blend) {
+      blend_attachment.blendEnable = VK_TRUE;
+      blend_attachment.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+      blend_attachment.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+      blend_attachment.colorBlendOp = VK_BLEND_OP_ADD;
+      blend_attachment.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+      blend_attachment.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+      blend_attachment.alphaBlendOp = VK_BLEND_OP_ADD;
+    }
+    VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    blend.attachmentCount = 1;
+    blend.pAttachments = &blend_attachment;
+
+    const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dynamic.dynamicStateCount = 2;
+    dynamic.pDynamicStates = dynamic_states;
+
+    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+    rendering.colorAttachmentCount = 1;
+    rendering.pColorAttachmentFormats = &desc.color_format;
+    rendering.depthAttachmentFormat = desc.depth_format;
+
+    VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    info.pNext = &rendering;
+    info.stageCount = 2;
+    info.pStages = stages;
+    info.pVertexInputState = &vertex_input;
+    info.pInputAssemblyState = &assembly;
+    info.pViewportState = &viewport;
+    info.pRasterizationState = &raster;
+    info.pMultisampleState = &multisample;
+    info.pDepthStencilState = desc.depth_format != VK_FORMAT_UNDEFINED ? &depth : nullptr;
+    info.pColorBlendState = &blend;
+    info.pDynamicState = &dynamic;
+    info.layout = desc.layout;
+    const VkResult result = vk.vkCreateGraphicsPipelines(vk.device, cache, 1, &info,
+                                                         gpu.allocation_callbacks, out);
+    if (result != VK_SUCCESS) {
+      status = Status::error("vkCreateGraphicsPipelines (" + std::string(desc.vertex_shader) + ", " +
+                                 std::string(desc.fragment_shader) + ") failed: " + result_name(result),
+                             result);
+    }
+  }
+  if (vertex != VK_NULL_HANDLE) vk.vkDestroyShaderModule(vk.device, vertex, gpu.allocation_callbacks);
+  if (fragment != VK_NULL_HANDLE) {
+    vk.vkDestroyShaderModule(vk.device, fragment, gpu.allocation_callbacks);
+  }
+  return status;
+}
+
+Status create_push_constant_layout(const GpuContext& gpu, uint32_t push_constant_bytes,
+                                   VkPipelineLayout* out) {
+  VkPushConstantRange range{};
+  range.stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+  range.size = push_constant_bytes;
+  VkPipelineLayoutCreateInfo info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  info.pushConstantRangeCount = 1;
+  info.pPushConstantRanges = &range;
+  const VkResult result =
+      gpu.table->vkCreatePipelineLayout(gpu.table->device, &info, gpu.allocation_callbacks, out);
+  if (result != VK_SUCCESS) {
+    return Status::error(std::string("vkCreatePipelineLayout failed: ") + result_name(result), result);
+  }
+  return Status::success();
+}
+
+}  // namespace siviflow

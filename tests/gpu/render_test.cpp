@@ -1,0 +1,162 @@
+// The default scene through the embedding path: validation-clean, plausible pixels,
+// deterministic, and host image states honoured.
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include <glm/gtc/packing.hpp>
+#include <gtest/gtest.h>
+
+#include "gpu_test.h"
+
+namespace siviflow::testing {
+namespace {
+
+constexpr uint32_t kWidth = 320;
+constexpr uint32_t kHeight = 180;
+
+struct Frame {
+  std::vector<float> rgba;   // linear, 4 floats per pixel
+  std::vector<float> depth;  // window depth, 0 near .. 1 far
+
+  const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * kWidth + x) * 4]; }
+};
+
+class RenderTest : public GpuTest {
+ protected:
+  // Renders frames [first, end) with two frames in flight and returns them in order.
+  std::vector<Frame> render(uint32_t first, uint32_t end) {
+    std::vector<Frame> frames;
+    if (renderer_ == nullptr) {
+      const Status status = Renderer::create(make_create_info(kWidth, kHeight), &renderer_);
+      EXPECT_TRUE(status.ok()) << status.message();
+      if (!status.ok()) return frames;
+    }
+    HostImage target;
+    HostBuffer color;
+    HostBuffer depth;
+    EXPECT_TRUE(context_->create_target_image(VK_FORMAT_R16G16B16A16_SFLOAT, {kWidth, kHeight}, &target).ok());
+    EXPECT_TRUE(context_->create_readback_buffer(renderer_->readback_color_bytes(), &color).ok());
+    EXPECT_TRUE(context_->create_readback_buffer(renderer_->readback_depth_bytes(), &depth).ok());
+    ImageState state;  // undefined until the first frame
+    for (uint32_t frame = first; frame < end; ++frame) {
+      VkCommandBuffer cmd = VK_NULL_HANDLE;
+      EXPECT_TRUE(context_->begin_slot(0, &cmd).ok());
+      EXPECT_TRUE(renderer_->begin_frame(frame % 2).ok());
+      const double time = frame / 30.0;
+      EXPECT_TRUE(renderer_->update(renderer_->scene_camera(time), time).ok());
+      FrameInputs inputs;
+      inputs.output = {target.image, target.view, state,
+                       {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                        VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+      inputs.readback = {color.buffer, depth.buffer};
+      const Status status = renderer_->record(cmd, inputs);
+      EXPECT_TRUE(status.ok()) << status.message();
+      state = inputs.output.final;  // the host's image now is where it asked us to leave it
+      EXPECT_TRUE(context_->end_slot_and_submit(0).ok());
+      EXPECT_TRUE(context_->wait_slot(0).ok());
+      Frame out;
+      const auto* halves = static_cast<const uint16_t*>(color.data);
+      out.rgba.resize(size_t{kWidth} * kHeight * 4);
+      for (size_t i = 0; i < out.rgba.size(); ++i) out.rgba[i] = glm::unpackHalf1x16(halves[i]);
+      const auto* depths = static_cast<const float*>(depth.data);
+      out.depth.assign(depths, depths + size_t{kWidth} * kHeight);
+      frames.push_back(std::move(out));
+    }
+    return frames;
+  }
+};
+
+TEST_F(RenderTest, DeviceIsLavapipeWithValidation) {
+  EXPECT_TRUE(context_->report().validation_enabled);
+  if (std::getenv("SIVIFLOW_EXPECT_LAVAPIPE") != nullptr) {
+    EXPECT_EQ(context_->report().driver_id, VK_DRIVER_ID_MESA_LLVMPIPE) << context_->report().device_name;
+    EXPECT_NE(context_->report().device_name.find("llvmpipe"), std::string::npos);
+  }
+}
+
+TEST_F(RenderTest, DefaultSceneShowsSkyAboveTerrainBelow) {
+  const std::vector<Frame> frames = render(0, 1);
+  ASSERT_EQ(frames.size(), 1u);
+  const Frame& f = frames[0];
+  // Sky at the top centre: blue dominates, moderately bright, nothing drawn there (far depth).
+  const float* sky = f.pixel(kWidth / 2, 4);
+  EXPECT_GT(sky[2], sky[0]);
+  EXPECT_GT(sky[2], 0.5f);
+  EXPECT_LT(sky[2], 1.5f);
+  EXPECT_EQ(f.depth[4 * kWidth + kWidth / 2], 1.0f);
+  // Terrain at the bottom centre: the (dry) riverbed, warmer than the sky and near the camera.
+  const float* ground = f.pixel(kWidth / 2, kHeight - 4);
+  EXPECT_GE(ground[0], ground[2]);
+  EXPECT_GT(ground[0] + ground[1] + ground[2], 0.05f);
+  EXPECT_LT(ground[0] + ground[1] + ground[2], 3.0f);
+  EXPECT_LT(f.depth[(kHeight - 4) * kWidth + kWidth / 2], 0.999f);
+  // Opaque everywhere, and the frame is not constant.
+  double sum = 0.0;
+  double sum_sq = 0.0;
+  for (size_t i = 0; i < size_t{kWidth} * kHeight; ++i) {
+    EXPECT_EQ(f.rgba[i * 4 + 3], 1.0f) << "pixel " << i;
+    const double luma = f.rgba[i * 4] + f.rgba[i * 4 + 1] + f.rgba[i * 4 + 2];
+    sum += luma;
+    sum_sq += luma * luma;
+    if (HasFailure()) break;
+  }
+  const double n = double{kWidth} * kHeight;
+  EXPECT_GT(sum_sq / n - (sum / n) * (sum / n), 0.01) << "the frame is (nearly) constant";
+}
+
+TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {
+  const std::vector<Frame> run = render(0, 4);
+  const std::vector<Frame> shard = render(3, 4);
+  ASSERT_EQ(run.size(), 4u);
+  ASSERT_EQ(shard.size(), 1u);
+  EXPECT_EQ(std::memcmp(run[3].rgba.data(), shard[0].rgba.data(), run[3].rgba.size() * sizeof(float)), 0);
+  EXPECT_EQ(run[3].depth, shard[0].depth);
+  EXPECT_NE(run[0].rgba, run[3].rgba) << "the camera moves: frames must differ";
+}
+
+TEST_F(RenderTest, FrameGraphHasUploadSceneReadback) {
+  ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
+  const std::string dump = renderer_->dump_frame_graph();
+  const size_t upload = dump.find("upload");
+  const size_t scene = dump.find("scene", upload);
+  const size_t readback = dump.find("readback", scene);
+  EXPECT_NE(upload, std::string::npos) << dump;
+  EXPECT_NE(scene, std::string::npos) << dump;
+  EXPECT_NE(readback, std::string::npos) << dump;
+  EXPECT_NE(renderer_->dump_frame_graph_graphviz().find("digraph"), std::string::npos);
+}
+
+TEST_F(RenderTest, BadCreateInfoIsReportedNotCrashed) {
+  CreateInfo info = make_create_info(0, kHeight);
+  Status status = Renderer::create(info, &renderer_);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("extent"), std::string::npos) << status.message();
+
+  info = make_create_info(context_->report().max_image_dimension_2d + 1, 16);
+  status = Renderer::create(info, &renderer_);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("device limit"), std::string::npos) << status.message();
+
+  info = make_create_info(kWidth, kHeight);
+  info.get_instance_proc_addr = nullptr;
+  EXPECT_FALSE(Renderer::create(info, &renderer_).ok());
+
+  setenv("SIVIFLOW_HIDE_DEVICE_FEATURES", "shaderClipDistance", 1);
+  status = Renderer::create(make_create_info(kWidth, kHeight), &renderer_);
+  unsetenv("SIVIFLOW_HIDE_DEVICE_FEATURES");
+  EXPECT_FALSE(status.ok());
+  EXPECT_EQ(status.code(), VK_ERROR_FEATURE_NOT_PRESENT);
+  EXPECT_NE(status.message().find("shaderClipDistance"), std::string::npos) << status.message();
+  EXPECT_EQ(renderer_, nullptr);
+}
+
+TEST_F(RenderTest, RecordOutOfOrderIsAnError) {
+  ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
+  EXPECT_FALSE(renderer_->update(renderer_->scene_camera(0.0), 0.0).ok());  // before begin_frame
+  EXPECT_FALSE(renderer_->begin_frame(5).ok());                              // slot out of range
+}
+
+}  // namespace
+}  // namespace siviflow::testing

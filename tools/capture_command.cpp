@@ -1,0 +1,322 @@
+// `siviflow capture`: the offline frame-capture host. It plays the part of an embedding engine
+// (own device, own command buffers and fences, own target images) and writes each frame to EXR.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/packing.hpp>
+
+#include "cli.h"
+#include "commands.h"
+#include "siviflow/headless_context.h"
+#include "siviflow/image_files.h"
+#include "siviflow/renderer.h"
+
+namespace siviflow {
+namespace {
+
+constexpr const char* kCommand = "capture";
+constexpr uint32_t kFramesInFlight = 2;
+constexpr VkFormat kOutputFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+// Colour (RGBA16F) + depth (D32) images and their readback copies, per frame in flight.
+constexpr uint64_t kBytesPerPixel = 2 * (8 + 4);
+// Lavapipe does not enforce its 2 GiB heap (reliability notes), so the capture enforces a budget.
+constexpr uint64_t kMaxCaptureBytes = 2ull << 30;
+
+struct CaptureOptions {
+  uint32_t first_frame = 0;
+  uint32_t end_frame = 1;
+  cli::Size size{1280, 720};
+  std::string out_dir;
+  uint32_t seed = 1;
+  float fps = 30.0f;
+  bool preview = false;
+  bool validation = false;
+  bool depth_aov = false;
+};
+
+void print_help() {
+  std::printf(
+      "usage: siviflow capture [--frames N | --range A:B] [--size WxH] --out DIR [--seed S]\n"
+      "                        [--fps F] [--aov LIST] [--preview] [--validation]\n"
+      "  Renders the built-in default scene into DIR/frame_NNNNN.exr.\n"
+      "  --frames N     frames 0..N-1 (same as --range 0:N; default 1)\n"
+      "  --range A:B    frames A..B-1; a frame is the same whatever range it is rendered in\n"
+      "  --size WxH     output size in pixels (default 1280x720)\n"
+      "  --out DIR      existing folder to write into (required)\n"
+      "  --seed S       simulation seed, recorded in the EXR metadata (default 1)\n"
+      "  --fps F        frames per second of scene time (default 30)\n"
+      "  --aov LIST     comma list of extra EXR layers; available: depth (depth.Z, view-axis\n"
+      "                 distance in metres, +inf where only sky is seen)\n"
+      "  --preview      also write DIR/frame_NNNNN.png (sRGB, clamped)\n"
+      "  --validation   run with the Khronos validation layer; any error fails the capture\n");
+}
+
+Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help) {
+  cli::ArgReader args(argc, argv, 2);
+  std::string_view value;
+  while (!args.done()) {
+    const std::string_view arg = args.next();
+    if (arg == "--help" || arg == "-h") {
+      *help = true;
+      return Status::success();
+    } else if (arg == "--frames") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      uint32_t count = 0;
+      SIVIFLOW_TRY(cli::parse_uint(arg, value, &count));
+      if (count == 0) return Status::error("--frames: must be at least 1");
+      options->first_frame = 0;
+      options->end_frame = count;
+    } else if (arg == "--range") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(cli::parse_range(arg, value, &options->first_frame, &options->end_frame));
+    } else if (arg == "--size") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(cli::parse_size(arg, value, &options->size));
+    } else if (arg == "--out") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      options->out_dir = std::string(value);
+    } else if (arg == "--seed") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->seed));
+    } else if (arg == "--fps") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(cli::parse_positive_float(arg, value, &options->fps));
+    } else if (arg == "--aov") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      for (const std::string& aov : cli::split_list(value)) {
+        if (aov == "depth") {
+          options->depth_aov = true;
+        } else {
+          return Status::error("--aov: unknown AOV '" + aov + "' (available: depth)");
+        }
+      }
+    } else if (arg == "--preview") {
+      options->preview = true;
+    } else if (arg == "--validation") {
+      options->validation = true;
+    } else if (!arg.empty() && arg[0] == '-') {
+      return Status::error("unknown option '" + std::string(arg) + "' (see --help)");
+    } else {
+      return Status::error("unexpected argument '" + std::string(arg) +
+                           "': scene files are not supported yet, only the built-in default scene");
+    }
+  }
+  if (options->out_dir.empty()) return Status::error("--out DIR is required");
+  return Status::success();
+}
+
+Status check_output_dir(const std::string& dir) {
+  struct stat info {};
+  if (stat(dir.c_str(), &info) != 0) {
+    return Status::error("output folder '" + dir + "': " + std::strerror(errno));
+  }
+  if (!S_ISDIR(info.st_mode)) return Status::error("output folder '" + dir + "' is not a folder");
+  if (access(dir.c_str(), W_OK | X_OK) != 0) {
+    return Status::error("output folder '" + dir + "' is not writable: " + std::strerror(errno));
+  }
+  return Status::success();
+}
+
+// Window depth (0 near .. 1 far, glm::perspectiveRH_ZO) to distance along the view axis.
+float linear_depth(float window_depth, float near_plane, float far_plane) {
+  if (window_depth >= 1.0f) return std::numeric_limits<float>::infinity();
+  const float a = far_plane / (near_plane - far_plane);
+  const float b = far_plane * near_plane / (near_plane - far_plane);
+  return b / (window_depth + a);
+}
+
+struct SlotTargets {
+  HostImage output;
+  HostBuffer color;
+  HostBuffer depth;
+  bool pending = false;  // a submitted frame whose readback has not been written yet
+  uint32_t frame = 0;
+  Camera camera;
+};
+
+class Capture {
+ public:
+  explicit Capture(const CaptureOptions& options) : options_(options) {}
+  // The GPU may still run a frame after an error: let it finish before the renderer goes.
+  ~Capture() {
+    if (context_ != nullptr) (void)context_->wait_idle();
+  }
+
+  Status run();
+
+ private:
+  Status write_frame(const SlotTargets& slot);
+  void report_progress(uint32_t done_count);
+
+  CaptureOptions options_;
+  std::unique_ptr<HeadlessContext> context_;
+  std::unique_ptr<Renderer> renderer_;
+  std::vector<float> rgba_;
+  std::vector<float> depth_;
+};
+
+Status Capture::run() {
+  HeadlessContextOptions context_options;
+  context_options.enable_validation = options_.validation;
+  context_options.require_validation = options_.validation;
+  SIVIFLOW_TRY(HeadlessContext::create(context_options, &context_));
+  const uint32_t max_dimension = context_->report().max_image_dimension_2d;
+  if (options_.size.width > max_dimension || options_.size.height > max_dimension) {
+    return Status::error("--size " + std::to_string(options_.size.width) + "x" +
+                         std::to_string(options_.size.height) + " exceeds the device limit of " +
+                         std::to_string(max_dimension) + " pixels per side");
+  }
+  const uint64_t pixels = uint64_t{options_.size.width} * options_.size.height;
+  if (pixels * kBytesPerPixel * kFramesInFlight > kMaxCaptureBytes) {
+    return Status::error("--size " + std::to_string(options_.size.width) + "x" +
+                         std::to_string(options_.size.height) + " needs more than the " +
+                         std::to_string(kMaxCaptureBytes >> 20) + " MiB memory budget");
+  }
+
+  CreateInfo info;
+  info.instance = context_->instance();
+  info.physical_device = context_->physical_device();
+  info.device = context_->device();
+  info.get_instance_proc_addr = context_->get_instance_proc_addr();
+  info.get_device_proc_addr = context_->get_device_proc_addr();
+  info.queue_family_index = context_->queue_family_index();
+  info.frames_in_flight = kFramesInFlight;
+  info.color_format = kOutputFormat;
+  info.extent = {options_.size.width, options_.size.height};
+  info.enable_readback = true;
+  info.debug_utils = context_->report().validation_enabled;
+  SIVIFLOW_TRY(Renderer::create(info, &renderer_));
+
+  std::vector<SlotTargets> slots(kFramesInFlight);
+  const VkExtent2D extent{options_.size.width, options_.size.height};
+  for (SlotTargets& slot : slots) {
+    SIVIFLOW_TRY(context_->create_target_image(kOutputFormat, extent, &slot.output));
+    SIVIFLOW_TRY(context_->create_readback_buffer(renderer_->readback_color_bytes(), &slot.color));
+    SIVIFLOW_TRY(context_->create_readback_buffer(renderer_->readback_depth_bytes(), &slot.depth));
+  }
+
+  uint32_t written = 0;
+  for (uint32_t frame = options_.first_frame; frame < options_.end_frame; ++frame) {
+    const uint32_t index = (frame - options_.first_frame) % kFramesInFlight;
+    SlotTargets& slot = slots[index];
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    SIVIFLOW_TRY(context_->begin_slot(index, &cmd));  // waits for this slot's previous frame
+    // Pipelined readback: the slot's previous frame is written while the other slot renders.
+    if (slot.pending) {
+      SIVIFLOW_TRY(write_frame(slot));
+      report_progress(++written);
+    }
+    const double time = static_cast<double>(frame) / options_.fps;
+    SIVIFLOW_TRY(renderer_->begin_frame(index));
+    slot.camera = renderer_->scene_camera(time);
+    SIVIFLOW_TRY(renderer_->update(slot.camera, time));
+    FrameInputs inputs;
+    inputs.output.image = slot.output.image;
+    inputs.output.view = slot.output.view;
+    inputs.output.current = ImageState{};  // contents discarded: we overwrite every pixel
+    inputs.output.final = {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+    inputs.readback.color = slot.color.buffer;
+    inputs.readback.depth = slot.depth.buffer;
+    SIVIFLOW_TRY(renderer_->record(cmd, inputs));
+    SIVIFLOW_TRY(context_->end_slot_and_submit(index));
+    slot.pending = true;
+    slot.frame = frame;
+  }
+  // Drain: the last frames, at most one per slot, in submission order.
+  const uint32_t count = options_.end_frame - options_.first_frame;
+  for (uint32_t i = count > kFramesInFlight ? count - kFramesInFlight : 0; i < count; ++i) {
+    SlotTargets& slot = slots[i % kFramesInFlight];
+    SIVIFLOW_TRY(context_->wait_slot(i % kFramesInFlight));
+    SIVIFLOW_TRY(write_frame(slot));
+    slot.pending = false;
+    report_progress(++written);
+  }
+  if (context_->report().validation_enabled && context_->validation_error_count() > 0) {
+    return Status::error(std::to_string(context_->validation_error_count()) +
+                         " Vulkan validation error(s); the first: " +
+                         context_->validation_errors().front());
+  }
+  return Status::success();
+}
+
+Status Capture::write_frame(const SlotTargets& slot) {
+  const uint32_t width = options_.size.width;
+  const uint32_t height = options_.size.height;
+  const size_t pixels = size_t{width} * height;
+  rgba_.resize(pixels * 4);
+  const auto* halves = static_cast<const uint16_t*>(slot.color.data);
+  for (size_t i = 0; i < pixels * 4; ++i) rgba_[i] = glm::unpackHalf1x16(halves[i]);
+
+  ExrFrame frame;
+  frame.width = static_cast<int>(width);
+  frame.height = static_cast<int>(height);
+  frame.rgba = rgba_.data();
+  if (options_.depth_aov) {
+    depth_.resize(pixels);
+    const auto* window_depth = static_cast<const float*>(slot.depth.data);
+    for (size_t i = 0; i < pixels; ++i) {
+      depth_[i] = linear_depth(window_depth[i], slot.camera.near_plane, slot.camera.far_plane);
+    }
+    frame.channels.push_back({"depth.Z", depth_.data()});
+  }
+  frame.metadata.scene = "default";
+  frame.metadata.frame = static_cast<int>(slot.frame);
+  frame.metadata.time_seconds = static_cast<float>(slot.frame / options_.fps);
+  frame.metadata.seed = static_cast<int>(options_.seed);
+  frame.metadata.software_version = version_string();
+
+  char name[32];
+  std::snprintf(name, sizeof(name), "frame_%05u", slot.frame);
+  const std::string base = options_.out_dir + "/" + name;
+  SIVIFLOW_TRY(write_exr(base + ".exr", frame));
+  if (options_.preview) {
+    SIVIFLOW_TRY(write_png(base + ".png", frame.width, frame.height, rgba_.data(), PngChannels::kRgb));
+  }
+  return Status::success();
+}
+
+void Capture::report_progress(uint32_t done_count) {
+  const uint32_t total = options_.end_frame - options_.first_frame;
+  if (isatty(STDOUT_FILENO)) {
+    constexpr int kBarWidth = 40;
+    const int filled = static_cast<int>(kBarWidth * done_count / total);
+    std::printf("\r[%s%s] %u/%u", std::string(filled, '#').c_str(),
+                std::string(kBarWidth - filled, ' ').c_str(), done_count, total);
+    if (done_count == total) std::printf("\n");
+    std::fflush(stdout);
+  } else if (done_count % 10 == 0 || done_count == total) {
+    std::printf("captured %u/%u frames\n", done_count, total);
+  }
+}
+
+}  // namespace
+
+int run_capture(int argc, char** argv) {
+  CaptureOptions options;
+  bool help = false;
+  Status status = parse_options(argc, argv, &options, &help);
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  if (help) {
+    print_help();
+    return cli::kExitOk;
+  }
+  status = check_output_dir(options.out_dir);
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  Capture capture(options);
+  status = capture.run();
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  std::printf("wrote frames %u..%u to %s/frame_NNNNN.exr%s\n", options.first_frame,
+              options.end_frame - 1, options.out_dir.c_str(), options.preview ? " (+ .png)" : "");
+  return cli::kExitOk;
+}
+
+}  // namespace siviflow

@@ -1,0 +1,9 @@
+// The subcommands of the siviflow tool; each returns the process exit status.
+#pragma once
+
+namespace siviflow {
+
+int run_info(int argc, char** argv);
+int run_capture(int argc, char** argv);
+
+}  // namespace siviflow

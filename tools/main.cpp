@@ -1,0 +1,36 @@
+// siviflow: command-line front end of the SiViFlow library.
+#include <cstdio>
+#include <string_view>
+
+#include "cli.h"
+#include "commands.h"
+
+namespace {
+
+void print_usage() {
+  std::printf(
+      "usage: siviflow <command> [options]\n"
+      "commands:\n"
+      "  capture   render frames of the default scene into EXR files (and PNG previews)\n"
+      "  info      print the Vulkan device, driver, required features and validation layer\n"
+      "Run 'siviflow <command> --help' for the options of a command.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    print_usage();
+    return siviflow::cli::kExitError;
+  }
+  const std::string_view command = argv[1];
+  if (command == "--help" || command == "-h" || command == "help") {
+    print_usage();
+    return siviflow::cli::kExitOk;
+  }
+  if (command == "capture") return siviflow::run_capture(argc, argv);
+  if (command == "info") return siviflow::run_info(argc, argv);
+  std::fprintf(stderr, "siviflow: unknown command '%.*s' (try 'siviflow --help')\n",
+               static_cast<int>(command.size()), command.data());
+  return siviflow::cli::kExitError;
+}
