@@ -163,7 +163,8 @@ Status Renderer::Impl::create_static_resources() {
 
 Status Renderer::Impl::declare_graph() {
   const VkExtent2D extent = info.extent;
-  upload.staging = graph.import_buffer({"staging", 0}, state_of(Access::HostWrite));
+  // No incoming state: the host's writes to the mapped block are made visible by the submit.
+  upload.staging = graph.import_buffer({"staging", 0}, ResourceState{});
   const BufferHandle vertices = graph.import_buffer({"scene vertices", vertex_buffer.size},
                                                     ResourceState{}, state_of(Access::VertexBufferRead));
   const BufferHandle indices = graph.import_buffer({"scene indices", index_buffer.size},

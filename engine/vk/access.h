@@ -66,6 +66,9 @@ VkAccessFlags2 write_bits(VkAccessFlags2 access);
 inline bool has_write_access(VkAccessFlags2 access) { return write_bits(access) != 0; }
 inline bool is_write(Access access) { return has_write_access(access_info(access).access); }
 
+// The aspects an image view or barrier of this format covers (depth, stencil or colour).
+VkImageAspectFlags aspect_of(VkFormat format);
+
 // Stable names for dumps: "EARLY_FRAGMENT_TESTS|LATE_FRAGMENT_TESTS", "TRANSFER_WRITE",
 // "NONE" for zero, unknown bits as hex. Layout names drop the VK_IMAGE_LAYOUT_ prefix.
 std::string stage_flags_name(VkPipelineStageFlags2 stages);

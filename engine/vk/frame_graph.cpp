@@ -92,19 +92,6 @@ bool kind_allows(PassKind kind, Access access) {
   }
 }
 
-VkImageAspectFlags aspect_of(VkFormat format) {
-  switch (format) {
-    case VK_FORMAT_D16_UNORM:
-    case VK_FORMAT_X8_D24_UNORM_PACK32:
-    case VK_FORMAT_D32_SFLOAT: return VK_IMAGE_ASPECT_DEPTH_BIT;
-    case VK_FORMAT_D16_UNORM_S8_UINT:
-    case VK_FORMAT_D24_UNORM_S8_UINT:
-    case VK_FORMAT_D32_SFLOAT_S8_UINT: return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
-    case VK_FORMAT_S8_UINT: return VK_IMAGE_ASPECT_STENCIL_BIT;
-    default: return VK_IMAGE_ASPECT_COLOR_BIT;
-  }
-}
-
 const char* load_name(VkAttachmentLoadOp op) {
   switch (op) {
     case VK_ATTACHMENT_LOAD_OP_CLEAR: return "CLEAR";

@@ -100,20 +100,6 @@ void destroy_buffer(const GpuContext& gpu, Buffer* buffer) {
   *buffer = Buffer{};
 }
 
-VkImageAspectFlags aspect_of(VkFormat format) {
-  switch (format) {
-    case VK_FORMAT_D16_UNORM:
-    case VK_FORMAT_D32_SFLOAT:
-    case VK_FORMAT_X8_D24_UNORM_PACK32:
-      return VK_IMAGE_ASPECT_DEPTH_BIT;
-    case VK_FORMAT_D24_UNORM_S8_UINT:
-    case VK_FORMAT_D32_SFLOAT_S8_UINT:
-      return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
-    default:
-      return VK_IMAGE_ASPECT_COLOR_BIT;
-  }
-}
-
 Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,
                     VkImageUsageFlags usage, const char* debug_name, Image* out) {
   const DeviceTable& vk = *gpu.table;

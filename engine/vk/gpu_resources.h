@@ -5,6 +5,7 @@
 #include <vulkan/vulkan.h>
 
 #include "sim/status.h"
+#include "vk/access.h"
 #include "vk/device_table.h"
 
 namespace siviflow {
@@ -40,8 +41,5 @@ void destroy_buffer(const GpuContext& gpu, Buffer* buffer);
 Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,
                     VkImageUsageFlags usage, const char* debug_name, Image* out);
 void destroy_image(const GpuContext& gpu, Image* image);
-
-// The aspect a view or barrier of this format covers (depth formats vs colour).
-VkImageAspectFlags aspect_of(VkFormat format);
 
 }  // namespace siviflow

@@ -1,0 +1,343 @@
+// River Surface Generator (Algorithm 1): sections and banks from the topology, per-vertex data,
+// and every bad river mesh of reliability.md §5 that reaches the sim.
+#include "sim/river_surface.h"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "sim/river_tuning.h"
+#include "unit/river_test_meshes.h"
+
+namespace siviflow {
+namespace {
+
+using test::TestMesh;
+
+Status build(const TestMesh& m, RiverSurface* s, RiverSurfaceOptions options = {}) {
+  return RiverSurface::build(m.positions, m.indices, options, s);
+}
+
+// Fails the test unless building gives an error containing every one of `parts`.
+void expect_error(const TestMesh& m, std::initializer_list<const char*> parts) {
+  RiverSurface s;
+  const Status status = build(m, &s);
+  ASSERT_FALSE(status.ok()) << "expected an error containing " << *parts.begin();
+  for (const char* part : parts) {
+    EXPECT_NE(status.message().find(part), std::string::npos)
+        << "message: \"" << status.message() << "\" lacks \"" << part << "\"";
+  }
+}
+
+TEST(RiverSurface, StraightChannelSectionsBanksAndDistances) {
+  const TestMesh m = test::straight_channel(10.0f, 40.0f, 21, 6);
+  RiverSurface s;
+  ASSERT_TRUE(build(m, &s).ok());
+  ASSERT_EQ(s.sections().size(), 21u);
+  EXPECT_EQ(s.vertex_count(), m.positions.size());
+  EXPECT_FLOAT_EQ(s.widest_section(), 10.0f);
+  for (size_t v = 0; v < m.positions.size(); ++v) {
+    const RiverVertex rv = s.vertex(v);
+    const uint32_t k = uint32_t(v / 6), j = uint32_t(v % 6);
+    EXPECT_EQ(rv.section, k) << "vertex " << v;
+    EXPECT_EQ(rv.bank, j == 0 ? Bank::kLeft : j == 5 ? Bank::kRight : Bank::kNone) << "vertex " << v;
+    EXPECT_FLOAT_EQ(rv.width, 10.0f);
+    EXPECT_NEAR(rv.d_left, 5.0f - m.positions[v].x, 1e-5f);
+    EXPECT_NEAR(rv.d_right, 5.0f + m.positions[v].x, 1e-5f);
+    EXPECT_NEAR(rv.flow_direction.z, 1.0f, 1e-6f);
+    EXPECT_NEAR(std::abs(rv.flow_direction.x) + std::abs(rv.flow_direction.y), 0.0f, 1e-6f);
+  }
+  for (size_t k = 0; k < s.sections().size(); ++k) {
+    EXPECT_NEAR(s.sections()[k].along, 2.0f * float(k), 1e-4f);
+    const auto nodes = s.section_nodes(k);
+    ASSERT_EQ(nodes.size(), 6u);
+    EXPECT_GT(s.node_positions()[nodes.front()].x, s.node_positions()[nodes.back()].x);
+  }
+}
+
+TEST(RiverSurface, UpstreamEndFollowsVertexZero) {
+  // Vertex 0 at the z = 40 end: the river now flows along -Z, and the left bank is at -X.
+  TestMesh m = test::straight_channel(10.0f, 40.0f, 11, 4);
+  for (glm::vec3& p : m.positions) p = glm::vec3(-p.x, p.y, 40.0f - p.z);
+  RiverSurface s;
+  ASSERT_TRUE(build(m, &s).ok());
+  EXPECT_NEAR(s.vertex(0).flow_direction.z, -1.0f, 1e-6f);
+  EXPECT_EQ(s.vertex(0).section, 0u);
+  EXPECT_EQ(s.vertex(0).bank, Bank::kLeft);
+  EXPECT_LT(s.node_positions()[s.section_nodes(0).front()].x, 0.0f);
+
+  // The upstream marker may also be any vertex of an end section.
+  RiverSurface t;
+  const TestMesh straight = test::straight_channel(10.0f, 40.0f, 11, 4);
+  RiverSurfaceOptions options;
+  options.upstream_vertex = uint32_t(straight.positions.size() - 2);  // on the z = 40 end
+  ASSERT_TRUE(build(straight, &t, options).ok());
+  EXPECT_NEAR(t.vertex(0).flow_direction.z, -1.0f, 1e-6f);
+  EXPECT_EQ(t.vertex(0).section, 10u);
+}
+
+TEST(RiverSurface, VertexOrderDoesNotMatter) {
+  const TestMesh m = test::straight_channel(8.0f, 30.0f, 16, 5);
+  std::vector<uint32_t> new_of_old;
+  const TestMesh shuffled = test::shuffled(m, 1234, &new_of_old);
+  RiverSurface a, b;
+  ASSERT_TRUE(build(m, &a).ok());
+  ASSERT_TRUE(build(shuffled, &b).ok());
+  for (size_t v = 0; v < m.positions.size(); ++v) {
+    const RiverVertex x = a.vertex(v), y = b.vertex(new_of_old[v]);
+    EXPECT_EQ(x.section, y.section);
+    EXPECT_EQ(x.bank, y.bank);
+    EXPECT_EQ(x.d_left, y.d_left);
+    EXPECT_EQ(x.d_right, y.d_right);
+    EXPECT_EQ(x.flow_direction, y.flow_direction);
+  }
+}
+
+TEST(RiverSurface, SectionsMayDifferInWidthAndVertexCount) {
+  std::vector<std::vector<glm::vec3>> sections;
+  const uint32_t counts[] = {3, 4, 6, 2, 5, 5, 3};
+  for (uint32_t k = 0; k < 7; ++k) {
+    const float half = 2.0f + float(k);
+    const float z = 3.0f * float(k);
+    sections.push_back(test::section_line({half, 0, z}, {-half, 0, z}, counts[k]));
+  }
+  const TestMesh m = test::mesh_from_sections(sections);
+  RiverSurface s;
+  const Status status = build(m, &s);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(s.sections().size(), 7u);
+  for (uint32_t k = 0; k < 7; ++k) {
+    EXPECT_EQ(s.sections()[k].node_count, counts[k]);
+    EXPECT_FLOAT_EQ(s.sections()[k].width, 4.0f + 2.0f * float(k));
+  }
+}
+
+TEST(RiverSurface, NonIndexedAndSplitVerticesAreWelded) {
+  const TestMesh m = test::straight_channel(6.0f, 12.0f, 7, 4);
+  TestMesh soup;
+  for (const uint32_t i : m.indices) soup.positions.push_back(m.positions[i]);
+  RiverSurface indexed, welded;
+  ASSERT_TRUE(build(m, &indexed).ok());
+  ASSERT_TRUE(build(soup, &welded).ok());
+  EXPECT_EQ(welded.node_count(), m.positions.size());
+  EXPECT_EQ(welded.vertex_count(), soup.positions.size());
+  for (size_t v = 0; v < soup.positions.size(); ++v) {
+    const RiverVertex x = welded.vertex(v);
+    const RiverVertex y = indexed.vertex(m.indices[v]);
+    EXPECT_EQ(x.section, y.section);
+    EXPECT_EQ(x.bank, y.bank);
+    EXPECT_EQ(x.d_left, y.d_left);
+  }
+}
+
+TEST(RiverSurface, BendFlowDirectionIsPerpendicularToRadialSections) {
+  const TestMesh m = test::bend(20.0f, 30.0f, 1.5707963f, 31, 5);
+  RiverSurface s;
+  ASSERT_TRUE(build(m, &s).ok());
+  for (const RiverSection& sec : s.sections()) {
+    const glm::vec3 radial = glm::normalize(glm::vec3(sec.midpoint.x, 0.0f, sec.midpoint.z));
+    EXPECT_NEAR(glm::dot(radial, sec.flow_direction), 0.0f, 1e-5f);
+    // Counter-clockwise seen from +Y: from +X towards +Z means flowing along +theta.
+    const glm::vec3 theta(-radial.z, 0.0f, radial.x);
+    EXPECT_NEAR(glm::dot(theta, sec.flow_direction), 1.0f, 1e-5f);
+    EXPECT_NEAR(sec.width, 10.0f, 1e-4f);
+  }
+  // Flowing along +theta with +Y up, the left bank is the outer one.
+  EXPECT_EQ(s.vertex(0).bank, Bank::kRight);
+}
+
+TEST(RiverSurface, TrianglesAreWoundUpwards) {
+  TestMesh m = test::straight_channel(6.0f, 12.0f, 7, 4);
+  for (size_t t = 0; t < m.indices.size(); t += 6) std::swap(m.indices[t + 1], m.indices[t + 2]);
+  RiverSurface s;
+  ASSERT_TRUE(build(m, &s).ok());
+  const auto pos = s.node_positions();
+  const auto tri = s.triangles();
+  for (size_t t = 0; t < s.triangle_count(); ++t) {
+    const glm::vec3 n = glm::cross(pos[tri[3 * t + 1]] - pos[tri[3 * t]], pos[tri[3 * t + 2]] - pos[tri[3 * t]]);
+    EXPECT_GT(n.y, 0.0f) << "triangle " << t;
+  }
+}
+
+TEST(RiverSurface, Deterministic) {
+  const TestMesh m = test::bend(5.0f, 9.0f, 2.0f, 40, 7);
+  RiverSurface a, b;
+  ASSERT_TRUE(build(m, &a).ok());
+  ASSERT_TRUE(build(m, &b).ok());
+  ASSERT_EQ(a.node_count(), b.node_count());
+  for (uint32_t n = 0; n < a.node_count(); ++n) {
+    EXPECT_EQ(a.node_d_left()[n], b.node_d_left()[n]);
+    EXPECT_EQ(a.node_section()[n], b.node_section()[n]);
+  }
+  EXPECT_TRUE(std::equal(a.triangles().begin(), a.triangles().end(), b.triangles().begin()));
+}
+
+// --- Bad meshes (reliability.md §5 rows 6-16) --------------------------------------------------
+
+TEST(RiverSurfaceBad, Empty) { expect_error({}, {"no vertices"}); }
+
+TEST(RiverSurfaceBad, HugeCountIsRefusedBeforeReading) {
+  const glm::vec3 one(0.0f);
+  // A span that claims far more vertices than exist: the size check must come before any read.
+  const std::span<const glm::vec3> huge(&one, kMaxRiverVertices + 1);
+  RiverSurface s;
+  const Status status = RiverSurface::build(huge, {}, {}, &s);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("limit"), std::string::npos) << status.message();
+}
+
+TEST(RiverSurfaceBad, IndicesNotAMultipleOfThree) {
+  TestMesh m = test::straight_channel(4, 4, 3, 3);
+  m.indices.pop_back();
+  expect_error(m, {"not a multiple of 3"});
+}
+
+TEST(RiverSurfaceBad, IndexOutOfRange) {
+  TestMesh m = test::straight_channel(4, 4, 3, 3);
+  m.indices[7] = 99;
+  expect_error(m, {"triangle 2", "vertex 99"});
+}
+
+TEST(RiverSurfaceBad, NonFinitePosition) {
+  TestMesh m = test::straight_channel(4, 4, 3, 3);
+  m.positions[4].y = std::numeric_limits<float>::quiet_NaN();
+  expect_error(m, {"vertex 4", "non-finite"});
+  m.positions[4].y = std::numeric_limits<float>::infinity();
+  expect_error(m, {"vertex 4", "non-finite"});
+}
+
+TEST(RiverSurfaceBad, DegenerateTriangles) {
+  TestMesh m = test::straight_channel(4, 4, 3, 3);
+  m.indices[4] = m.indices[3];
+  expect_error(m, {"triangle 1", "degenerate", "twice"});
+  TestMesh line;  // a single "section" given as one triangle of collinear points
+  line.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  expect_error(line, {"triangle 0", "zero area"});
+}
+
+TEST(RiverSurfaceBad, OneSection) {
+  TestMesh tri;
+  tri.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}};
+  tri.indices = {0, 1, 2};
+  expect_error(tri, {"at least two sections"});
+}
+
+TEST(RiverSurfaceBad, ZeroWidth) {
+  // Every section's shores coincide.
+  TestMesh m = test::straight_channel(0.0f, 10.0f, 6, 2);
+  expect_error(m, {"degenerate", "same position", "zero-width"});
+  // One section pinched to a point in an otherwise fine river.
+  TestMesh pinched = test::straight_channel(4.0f, 10.0f, 6, 3);
+  for (int j = 0; j < 3; ++j) pinched.positions[3 * 3 + j].x = 0.0f;
+  expect_error(pinched, {"same position"});
+}
+
+TEST(RiverSurfaceBad, TinyWidthSection) {
+  TestMesh m = test::straight_channel(4.0f, 10.0f, 6, 2);
+  m.positions[2 * 2 + 0].x = 1e-6f;  // section 2 squeezed to 2e-6 m
+  m.positions[2 * 2 + 1].x = -1e-6f;
+  expect_error(m, {"section 2", "zero width"});
+}
+
+TEST(RiverSurfaceBad, Disconnected) {
+  TestMesh a = test::straight_channel(4, 8, 5, 3);
+  const TestMesh b = test::straight_channel(4, 8, 5, 3);
+  const uint32_t offset = uint32_t(a.positions.size());
+  for (glm::vec3 p : b.positions) a.positions.push_back(p + glm::vec3(20, 0, 0));
+  for (uint32_t i : b.indices) a.indices.push_back(i + offset);
+  expect_error(a, {"disconnected"});
+}
+
+TEST(RiverSurfaceBad, UnusedVertex) {
+  TestMesh m = test::straight_channel(4, 8, 5, 3);
+  m.positions.push_back({50, 0, 50});
+  expect_error(m, {"vertex 15", "not used"});
+}
+
+TEST(RiverSurfaceBad, HoleIsNotAStrip) {
+  // A 5x5 grid of vertices missing its middle quad.
+  TestMesh m = test::straight_channel(8, 8, 5, 5);
+  std::vector<uint32_t> kept;
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    bool middle = true;
+    for (int i = 0; i < 3; ++i) {
+      const uint32_t v = m.indices[t + i];
+      const uint32_t k = v / 5, j = v % 5;
+      middle = middle && (k == 2 || k == 3) && (j == 2 || j == 3);
+    }
+    if (!middle) kept.insert(kept.end(), m.indices.begin() + long(t), m.indices.begin() + long(t) + 3);
+  }
+  m.indices = kept;
+  expect_error(m, {"border loops"});
+}
+
+TEST(RiverSurfaceBad, NonManifoldEdge) {
+  TestMesh m = test::straight_channel(4, 8, 5, 3);
+  m.positions.push_back({0.5f, 3.0f, 3.0f});
+  // Triangle 0's second edge runs across the first band: two triangles share it already.
+  m.indices.insert(m.indices.end(), {m.indices[1], m.indices[2], uint32_t(m.positions.size() - 1)});
+  expect_error(m, {"non-manifold"});
+}
+
+TEST(RiverSurfaceBad, ClosedMesh) {
+  TestMesh tetra;
+  tetra.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}};
+  tetra.indices = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
+  expect_error(tetra, {"closed"});
+}
+
+TEST(RiverSurfaceBad, FanIsNotAStrip) {
+  TestMesh fan;
+  fan.positions.push_back({0, 0, 0});
+  for (int i = 0; i < 6; ++i) {
+    const float a = float(i) * 1.0471976f;
+    fan.positions.push_back({std::cos(a), 0, std::sin(a)});
+  }
+  for (uint32_t i = 0; i < 6; ++i) fan.indices.insert(fan.indices.end(), {0, 1 + i, 1 + (i + 1) % 6});
+  // Vertex 0 is the hub, inside the mesh: it cannot mark an end.
+  expect_error(fan, {"vertex 0", "not on the border"});
+  RiverSurface s;
+  RiverSurfaceOptions options;
+  options.upstream_vertex = 1;
+  const Status status = RiverSurface::build(fan.positions, fan.indices, options, &s);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("not a strip"), std::string::npos) << status.message();
+}
+
+TEST(RiverSurfaceBad, TShapeIsNotAStrip) {
+  // A T of quads: a confluence (three ends), which no single strip of sections describes.
+  std::vector<glm::vec3> pos;
+  std::vector<uint32_t> idx;
+  auto vertex = [&](float x, float z) {
+    for (uint32_t i = 0; i < pos.size(); ++i) {
+      if (pos[i] == glm::vec3(x, 0, z)) return i;
+    }
+    pos.push_back({x, 0, z});
+    return uint32_t(pos.size() - 1);
+  };
+  for (int cz = 0; cz < 5; ++cz) {
+    for (int cx = 0; cx < 6; ++cx) {
+      if (cz >= 2 && (cx < 2 || cx >= 4)) continue;
+      const uint32_t a = vertex(float(cx), float(cz)), b = vertex(float(cx + 1), float(cz));
+      const uint32_t c = vertex(float(cx), float(cz + 1)), d = vertex(float(cx + 1), float(cz + 1));
+      idx.insert(idx.end(), {a, c, b, b, c, d});
+    }
+  }
+  TestMesh m{pos, idx};
+  expect_error(m, {"not a strip"});
+}
+
+TEST(RiverSurfaceBad, UpstreamVertexOutOfRange) {
+  const TestMesh m = test::straight_channel(4, 8, 5, 3);
+  RiverSurface s;
+  RiverSurfaceOptions options;
+  options.upstream_vertex = 1000;
+  const Status status = RiverSurface::build(m.positions, m.indices, options, &s);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("1000"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace siviflow
