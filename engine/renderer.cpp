@@ -9,7 +9,6 @@
 #include "passes/passes.h"
 #include "scene/default_scene.h"
 #include "scene/detail_texture.h"
-#include "siviflow/headless_context.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
@@ -23,7 +22,6 @@ constexpr uint32_t kMaxFramesInFlight = 8;
 constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkDeviceSize kDefaultStagingBytes = 8ull << 20;
-constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we copy
 
 uint32_t texel_bytes(VkFormat format) {
   switch (format) {
@@ -66,24 +64,30 @@ struct Renderer::Impl {
   Image depth_image;
   ScenePass scene_pass;
 
+  // One-off graph that copies the static scene data on the first frame; the frame graph then
+  // only reads it, so later frames carry no upload barriers for it.
+  FrameGraph static_graph;
+  BufferHandle static_staging;
+  UploadList static_uploads;
+  Buffer static_staging_buffer;  // sized for the static data; freed when its slot comes round
+
   FrameGraph graph;
-  UploadPassHandles upload;
   ScenePass::Handles scene;
   ImageHandle output;
   ReadbackHandles readback;
-  UploadList uploads;
   FrameBindings bindings;
   gpu::SceneConstants constants{};
 
   bool static_data_uploaded = false;
-  bool detail_initialised = false;
   bool frame_begun = false;
   bool frame_updated = false;
 
   Status validate_info(const CreateInfo& create);
   Status create_static_resources();
+  Status declare_static_graph();
   Status declare_graph();
   Status stage_static_data();
+  Status record_static_upload(VkCommandBuffer cmd);
   void destroy();
 };
 
@@ -115,13 +119,27 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
   if (loaded != VK_SUCCESS) {
     return Status::error(std::string("siviflow::Renderer: cannot load ") + missing_function, loaded);
   }
-  const std::vector<std::string> missing =
-      missing_required_features(info.get_instance_proc_addr, info.instance, info.physical_device);
+  gpu = make_gpu_context(table, info.allocation_callbacks);
+  if (info.enabled_features == nullptr) {
+    return invalid("CreateInfo::enabled_features must point to the feature chain the device was "
+                   "created with");
+  }
+  const std::vector<std::string> missing = missing_device_features(info.enabled_features);
   if (!missing.empty()) {
     std::string names;
     for (const std::string& name : missing) names += (names.empty() ? "" : ", ") + name;
-    return Status::error("siviflow::Renderer: the device lacks required features: " + names,
+    return Status::error("siviflow::Renderer: the device was created without required features: " +
+                             names + " (enable required_device_features())",
                          VK_ERROR_FEATURE_NOT_PRESENT);
+  }
+  uint32_t family_count = 0;
+  table.vkGetPhysicalDeviceQueueFamilyProperties(info.physical_device, &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  table.vkGetPhysicalDeviceQueueFamilyProperties(info.physical_device, &family_count, families.data());
+  if (info.queue_family_index >= family_count ||
+      (families[info.queue_family_index].queueFlags & VK_QUEUE_GRAPHICS_BIT) == 0) {
+    return invalid("CreateInfo::queue_family_index " + std::to_string(info.queue_family_index) +
+                   " is not a graphics queue family of this device");
   }
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   table.vkGetPhysicalDeviceProperties2(info.physical_device, &props);
@@ -137,7 +155,6 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
     return Status::error("siviflow::Renderer: color_format cannot be rendered to on this device",
                          VK_ERROR_FORMAT_NOT_SUPPORTED);
   }
-  gpu = make_gpu_context(table, info.allocation_callbacks);
   return Status::success();
 }
 
@@ -147,10 +164,6 @@ Status Renderer::Impl::create_static_resources() {
   detail_pixels = make_detail_texture();
   const VkDeviceSize vertex_bytes = geometry.vertices.size() * sizeof(SceneVertex);
   const VkDeviceSize index_bytes = geometry.indices.size() * sizeof(uint32_t);
-  // The first frame's slot must hold every static upload at once.
-  const VkDeviceSize static_bytes =
-      vertex_bytes + index_bytes + detail_pixels.texels.size() + 4 * kStagingAlignment;
-  if (info.staging_bytes_per_slot < static_bytes) info.staging_bytes_per_slot = static_bytes;
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
   SIVIFLOW_TRY(create_buffer(gpu, vertex_bytes,
                              VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -161,20 +174,35 @@ Status Renderer::Impl::create_static_resources() {
   return Status::success();
 }
 
+Status Renderer::Impl::declare_static_graph() {
+  const VkExtent2D detail_extent{detail_pixels.size, detail_pixels.size};
+  static_staging = static_graph.import_buffer({"static staging", 0}, ResourceState{});
+  const BufferHandle vertices = static_graph.import_buffer(
+      {"scene vertices", vertex_buffer.size}, ResourceState{}, state_of(Access::VertexBufferRead));
+  const BufferHandle indices = static_graph.import_buffer(
+      {"scene indices", index_buffer.size}, ResourceState{}, state_of(Access::IndexBufferRead));
+  const ImageHandle detail =
+      static_graph.import_image({"ground detail", VK_FORMAT_R8G8B8A8_UNORM, detail_extent, {}},
+                                ResourceState{}, state_of(Access::SampledFragment));
+  static_uploads.buffers = {{0, vertices, vertex_buffer.size}, {0, indices, index_buffer.size}};
+  static_uploads.images = {{0, detail, detail_extent}};
+  add_upload_pass(static_graph, static_staging, &static_uploads);
+  return static_graph.compile();
+}
+
 Status Renderer::Impl::declare_graph() {
   const VkExtent2D extent = info.extent;
-  // No incoming state: the host's writes to the mapped block are made visible by the submit.
-  upload.staging = graph.import_buffer({"staging", 0}, ResourceState{});
-  const BufferHandle vertices = graph.import_buffer({"scene vertices", vertex_buffer.size},
-                                                    ResourceState{}, state_of(Access::VertexBufferRead));
-  const BufferHandle indices = graph.import_buffer({"scene indices", index_buffer.size},
-                                                   ResourceState{}, state_of(Access::IndexBufferRead));
-  const ImageHandle detail = graph.create_persistent_image(
-      {"ground detail", VK_FORMAT_R8G8B8A8_UNORM, {detail_pixels.size, detail_pixels.size}, {}});
-  upload.buffers = {vertices, indices};
-  upload.images = {detail};
-  add_upload_pass(graph, uploads, &upload);
-
+  const VkExtent2D detail_extent{detail_pixels.size, detail_pixels.size};
+  // Static data arrives through the static graph and is only read from then on.
+  scene.vertices = graph.import_buffer({"scene vertices", vertex_buffer.size},
+                                       state_of(Access::VertexBufferRead),
+                                       state_of(Access::VertexBufferRead));
+  scene.indices = graph.import_buffer({"scene indices", index_buffer.size},
+                                      state_of(Access::IndexBufferRead),
+                                      state_of(Access::IndexBufferRead));
+  scene.detail = graph.import_image({"ground detail", VK_FORMAT_R8G8B8A8_UNORM, detail_extent, {}},
+                                    state_of(Access::SampledFragment),
+                                    state_of(Access::SampledFragment));
   VkClearValue sky_clear{};
   VkClearValue far_depth{};
   far_depth.depthStencil = {1.0f, 0};
@@ -183,9 +211,6 @@ Status Renderer::Impl::declare_graph() {
                               state_of(Access::SampledFragment));
   scene.color = output;
   scene.depth = graph.create_image({"depth", kDepthFormat, extent, far_depth});
-  scene.vertices = upload.buffers[0];
-  scene.indices = upload.buffers[1];
-  scene.detail = upload.images[0];
   scene_pass.declare(graph, &constants, index_count, &scene);
 
   if (info.enable_readback) {
@@ -198,43 +223,60 @@ Status Renderer::Impl::declare_graph() {
     add_readback_pass(graph, &readback);
   }
   SIVIFLOW_TRY(graph.compile());
+  SIVIFLOW_TRY(declare_static_graph());
 
   SIVIFLOW_TRY(create_image(gpu, kDepthFormat, extent, graph.image_usage(scene.depth), "depth",
                             &depth_image));
-  SIVIFLOW_TRY(create_image(gpu, VK_FORMAT_R8G8B8A8_UNORM,
-                            {detail_pixels.size, detail_pixels.size},
-                            graph.image_usage(upload.images[0]), "ground detail", &detail_image));
+  SIVIFLOW_TRY(create_image(gpu, VK_FORMAT_R8G8B8A8_UNORM, detail_extent,
+                            graph.image_usage(scene.detail) |
+                                static_graph.image_usage(static_uploads.images[0].destination),
+                            "ground detail", &detail_image));
   SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
   scene_pass.set_detail_texture(gpu, detail_image.view);
   return Status::success();
 }
 
 Status Renderer::Impl::stage_static_data() {
-  const auto stage = [this](const void* data, VkDeviceSize size, VkDeviceSize* offset) {
-    StagingAllocation allocation;
-    SIVIFLOW_TRY(ring.allocate_staging(size, kStagingAlignment, &allocation));
-    std::memcpy(allocation.data, data, size);
-    *offset = allocation.offset;
-    return Status::success();
-  };
-  BufferUpload vertices{0, vertex_buffer.buffer, vertex_buffer.size};
-  SIVIFLOW_TRY(stage(geometry.vertices.data(), vertex_buffer.size, &vertices.staging_offset));
-  BufferUpload indices{0, index_buffer.buffer, index_buffer.size};
-  SIVIFLOW_TRY(stage(geometry.indices.data(), index_buffer.size, &indices.staging_offset));
-  ImageUpload detail{0, upload.images[0], {detail_pixels.size, detail_pixels.size}};
-  SIVIFLOW_TRY(stage(detail_pixels.texels.data(), detail_pixels.texels.size(), &detail.staging_offset));
-  uploads.buffers = {vertices, indices};
-  uploads.images = {detail};
+  const VkDeviceSize vertex_bytes = vertex_buffer.size;
+  const VkDeviceSize index_bytes = index_buffer.size;
+  const VkDeviceSize detail_bytes = detail_pixels.texels.size();
+  SIVIFLOW_TRY(create_buffer(gpu, vertex_bytes + index_bytes + detail_bytes,
+                             VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true,
+                             "static staging", &static_staging_buffer));
+  auto* bytes = static_cast<uint8_t*>(static_staging_buffer.mapped);
+  std::memcpy(bytes, geometry.vertices.data(), vertex_bytes);
+  std::memcpy(bytes + vertex_bytes, geometry.indices.data(), index_bytes);
+  std::memcpy(bytes + vertex_bytes + index_bytes, detail_pixels.texels.data(), detail_bytes);
+  static_uploads.buffers[0].staging_offset = 0;
+  static_uploads.buffers[1].staging_offset = vertex_bytes;
+  static_uploads.images[0].staging_offset = vertex_bytes + index_bytes;
+  geometry = SceneGeometry{};  // the staging copy is the only one needed from now on
+  return Status::success();
+}
+
+Status Renderer::Impl::record_static_upload(VkCommandBuffer cmd) {
+  FrameBindings static_bindings;
+  static_bindings.bind_buffer(static_staging, static_staging_buffer.buffer);
+  static_bindings.bind_buffer(static_uploads.buffers[0].destination, vertex_buffer.buffer);
+  static_bindings.bind_buffer(static_uploads.buffers[1].destination, index_buffer.buffer);
+  static_bindings.bind_image(static_uploads.images[0].destination, detail_image.image,
+                             detail_image.view);
+  SIVIFLOW_TRY(static_graph.execute(table, cmd, static_bindings));
+  // The GPU reads the staging buffer until this slot's frame completes; free it after that.
+  Buffer retired = static_staging_buffer;
+  static_staging_buffer = Buffer{};
+  ring.defer_deletion([gpu_context = gpu, retired]() mutable { destroy_buffer(gpu_context, &retired); });
   return Status::success();
 }
 
 void Renderer::Impl::destroy() {
-  if (table.device == VK_NULL_HANDLE) return;
+  if (gpu.table == nullptr) return;  // failed before any Vulkan object existed
   scene_pass.destroy(gpu);
   destroy_image(gpu, &depth_image);
   destroy_image(gpu, &detail_image);
   destroy_buffer(gpu, &vertex_buffer);
   destroy_buffer(gpu, &index_buffer);
+  destroy_buffer(gpu, &static_staging_buffer);
   ring.destroy();
 }
 
@@ -258,7 +300,6 @@ Renderer::~Renderer() { impl_->destroy(); }
 Status Renderer::begin_frame(uint32_t slot) {
   Impl& r = *impl_;
   SIVIFLOW_TRY(r.ring.begin_slot(slot));
-  r.uploads.clear();
   r.frame_begun = true;
   r.frame_updated = false;
   return Status::success();
@@ -282,7 +323,9 @@ Status Renderer::update(const Camera& camera, double time_seconds) {
   r.constants.sun_direction = glm::vec4(glm::normalize(r.look.sun_direction), r.look.sun_disc_intensity);
   r.constants.clip_plane = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // main view: nothing clipped
   r.constants.fog = glm::vec4(r.look.fog_density, r.look.fog_height_falloff, 0.0f, 0.0f);
-  if (!r.static_data_uploaded) SIVIFLOW_TRY(r.stage_static_data());
+  if (!r.static_data_uploaded && r.static_staging_buffer.buffer == VK_NULL_HANDLE) {
+    SIVIFLOW_TRY(r.stage_static_data());
+  }
   r.frame_updated = true;
   return Status::success();
 }
@@ -293,13 +336,16 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   if (inputs.output.image == VK_NULL_HANDLE || inputs.output.view == VK_NULL_HANDLE) {
     return Status::error("Renderer::record: FrameInputs::output needs an image and a view");
   }
+  if (inputs.output.final.layout == VK_IMAGE_LAYOUT_UNDEFINED) {
+    return Status::error("Renderer::record: FrameInputs::output.final.layout must not be UNDEFINED");
+  }
   if (r.info.enable_readback &&
       (inputs.readback.color == VK_NULL_HANDLE || inputs.readback.depth == VK_NULL_HANDLE)) {
     return Status::error("Renderer::record: readback is enabled but FrameInputs::readback is empty");
   }
+  if (!r.static_data_uploaded) SIVIFLOW_TRY(r.record_static_upload(cmd));
   FrameBindings& b = r.bindings;
   b.reset();
-  b.bind_buffer(r.upload.staging, r.ring.staging_buffer());
   b.bind_buffer(r.scene.vertices, r.vertex_buffer.buffer);
   b.bind_buffer(r.scene.indices, r.index_buffer.buffer);
   b.bind_image(r.scene.detail, r.detail_image.image, r.detail_image.view);
@@ -309,12 +355,6 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
                             inputs.output.current.layout});
   b.set_outgoing(r.output, {inputs.output.final.stage, inputs.output.final.access,
                             inputs.output.final.layout});
-  if (r.static_data_uploaded) {
-    // Last frame left the static buffers being read; this frame's upload barrier waits on that.
-    b.set_incoming(r.scene.vertices, state_of(Access::VertexBufferRead));
-    b.set_incoming(r.scene.indices, state_of(Access::IndexBufferRead));
-  }
-  if (!r.detail_initialised) b.set_incoming(r.scene.detail, ResourceState{});
   if (r.info.enable_readback) {
     b.bind_buffer(r.readback.color_buffer, inputs.readback.color);
     b.bind_buffer(r.readback.depth_buffer, inputs.readback.depth);
@@ -324,11 +364,7 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
     if (r.info.log != nullptr) r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
     return status;
   }
-  if (!r.uploads.buffers.empty()) {
-    r.static_data_uploaded = true;
-    r.geometry = SceneGeometry{};  // the GPU copy is the only one needed from now on
-  }
-  r.detail_initialised = true;
+  r.static_data_uploaded = true;
   r.frame_begun = false;
   r.frame_updated = false;
   return Status::success();

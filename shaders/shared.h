@@ -8,9 +8,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 namespace siviflow::gpu {
 using mat4 = glm::mat4;
+using vec3 = glm::vec3;
 using vec4 = glm::vec4;
 using uint = uint32_t;
 #endif
@@ -19,6 +21,19 @@ using uint = uint32_t;
 #define SIVIFLOW_ATTR_POSITION 0
 #define SIVIFLOW_ATTR_NORMAL 1
 #define SIVIFLOW_ATTR_COLOR 2
+
+#ifdef __cplusplus
+// One vertex of the scene pipeline's vertex buffer (GLSL reads it through the attributes above).
+struct SceneVertex {
+  vec3 position;
+  vec3 normal;
+  vec4 color;  // rgb linear albedo, a ambient occlusion
+};
+static_assert(sizeof(SceneVertex) == 40);
+static_assert(offsetof(SceneVertex, position) == 0);
+static_assert(offsetof(SceneVertex, normal) == 12);
+static_assert(offsetof(SceneVertex, color) == 24);
+#endif
 
 // Push constants of the sky and scene pipelines: one block for both, 128 bytes (the guaranteed
 // minimum of maxPushConstantsSize).
@@ -29,6 +44,50 @@ struct SceneConstants {
   vec4 clip_plane;          // world-space plane (n, d): gl_ClipDistance = dot(n, p) + d
   vec4 fog;                 // x density per metre, y height falloff, zw unused
 };
+
+// River particles: flow texture and auxiliary data (paper §3.2; packed by sim/flow_textures.h
+// into the frame slot's staging block, flow texels first, aux texels at an aligned offset).
+// Flow texture: VK_FORMAT_R16G16B16A16_UINT, ceil(W / n) x ceil(H / n) texels for a W x H output
+// (n = SIVIFLOW_FLOW_TEXEL_PX unless configured). Texel (x, y) stands for the pixels
+// [x n, x n + n) x [y n, y n + n), origin top-left, and holds the particle nearest to its centre
+// ((x + 0.5) n, (y + 0.5) n) among the active and fading ones within the cover radius:
+//   .r  particle id: SIVIFLOW_PARTICLE_NONE (0) when none covers the texel, else 1..65535, the
+//       particle's slot, i.e. its texel in the aux texture (stable over the particle's life)
+//   .g  flow.x  IEEE 754 binary16 bits  (the flow vector of the particle's nearest river
+//   .b  flow.y  IEEE 754 binary16 bits   vertex, world space, as the river gives it)
+//   .a  flow.z  IEEE 754 binary16 bits
+//   GLSL: uvec4 t = texelFetch(flow_tex, p, 0);
+//         vec3 flow = vec3(unpackHalf2x16(t.g | (t.b << 16)), unpackHalf2x16(t.a).x);
+// Aux texture: VK_FORMAT_R32G32B32A32_SFLOAT, SIVIFLOW_AUX_WIDTH texels wide, as many rows as
+// the slots need; id s is texel (s % SIVIFLOW_AUX_WIDTH, s / SIVIFLOW_AUX_WIDTH); texel 0 and
+// unused slots are all zero:
+//   .r speed (m/s)   .g depth (m)   .b riverbed slope (as the river gives it)   .a fade (0..1)
+#define SIVIFLOW_FLOW_TEXEL_PX 4
+#define SIVIFLOW_PARTICLE_NONE 0u
+#define SIVIFLOW_AUX_WIDTH 256u
+
+#ifdef __cplusplus
+struct FlowTexel {
+  uint16_t id;       // slot, 0 = no particle
+  uint16_t flow_x;   // binary16 bits
+  uint16_t flow_y;
+  uint16_t flow_z;
+};
+static_assert(sizeof(FlowTexel) == 8);
+static_assert(offsetof(FlowTexel, flow_x) == 2);
+static_assert(offsetof(FlowTexel, flow_y) == 4);
+static_assert(offsetof(FlowTexel, flow_z) == 6);
+struct ParticleAux {
+  float speed;
+  float depth;
+  float slope;
+  float fade;
+};
+static_assert(sizeof(ParticleAux) == 16);
+static_assert(offsetof(ParticleAux, depth) == 4);
+static_assert(offsetof(ParticleAux, slope) == 8);
+static_assert(offsetof(ParticleAux, fade) == 12);
+#endif
 
 #ifdef __cplusplus
 static_assert(sizeof(SceneConstants) == 128);

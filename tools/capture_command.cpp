@@ -137,9 +137,18 @@ struct SlotTargets {
   HostImage output;
   HostBuffer color;
   HostBuffer depth;
-  bool pending = false;  // a submitted frame whose readback has not been written yet
+  bool pending = false;  // a submitted frame whose readback has not been copied out yet
   uint32_t frame = 0;
   Camera camera;
+};
+
+// A finished frame copied out of its readback buffers, so that the buffers can take the next
+// frame while this one is encoded and written.
+struct FinishedFrame {
+  uint32_t frame = 0;
+  Camera camera;
+  std::vector<uint16_t> color_halves;
+  std::vector<float> window_depth;
 };
 
 class Capture {
@@ -153,12 +162,14 @@ class Capture {
   Status run();
 
  private:
-  Status write_frame(const SlotTargets& slot);
+  void copy_out(const SlotTargets& slot);
+  Status write_frame();
   void report_progress(uint32_t done_count);
 
   CaptureOptions options_;
   std::unique_ptr<HeadlessContext> context_;
   std::unique_ptr<Renderer> renderer_;
+  FinishedFrame finished_;
   std::vector<float> rgba_;
   std::vector<float> depth_;
 };
@@ -181,18 +192,10 @@ Status Capture::run() {
                          std::to_string(kMaxCaptureBytes >> 20) + " MiB memory budget");
   }
 
-  CreateInfo info;
-  info.instance = context_->instance();
-  info.physical_device = context_->physical_device();
-  info.device = context_->device();
-  info.get_instance_proc_addr = context_->get_instance_proc_addr();
-  info.get_device_proc_addr = context_->get_device_proc_addr();
-  info.queue_family_index = context_->queue_family_index();
+  CreateInfo info = context_->renderer_create_info(
+      {options_.size.width, options_.size.height}, kOutputFormat);
   info.frames_in_flight = kFramesInFlight;
-  info.color_format = kOutputFormat;
-  info.extent = {options_.size.width, options_.size.height};
   info.enable_readback = true;
-  info.debug_utils = context_->report().validation_enabled;
   SIVIFLOW_TRY(Renderer::create(info, &renderer_));
 
   std::vector<SlotTargets> slots(kFramesInFlight);
@@ -209,11 +212,10 @@ Status Capture::run() {
     SlotTargets& slot = slots[index];
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     SIVIFLOW_TRY(context_->begin_slot(index, &cmd));  // waits for this slot's previous frame
-    // Pipelined readback: the slot's previous frame is written while the other slot renders.
-    if (slot.pending) {
-      SIVIFLOW_TRY(write_frame(slot));
-      report_progress(++written);
-    }
+    // Pipelined readback: the slot's previous frame is copied out, this frame is submitted, and
+    // only then is the previous frame encoded and written, while the GPU renders.
+    const bool have_finished = slot.pending;
+    if (have_finished) copy_out(slot);
     const double time = static_cast<double>(frame) / options_.fps;
     SIVIFLOW_TRY(renderer_->begin_frame(index));
     slot.camera = renderer_->scene_camera(time);
@@ -230,14 +232,19 @@ Status Capture::run() {
     SIVIFLOW_TRY(context_->end_slot_and_submit(index));
     slot.pending = true;
     slot.frame = frame;
+    if (have_finished) {
+      SIVIFLOW_TRY(write_frame());
+      report_progress(++written);
+    }
   }
   // Drain: the last frames, at most one per slot, in submission order.
   const uint32_t count = options_.end_frame - options_.first_frame;
   for (uint32_t i = count > kFramesInFlight ? count - kFramesInFlight : 0; i < count; ++i) {
     SlotTargets& slot = slots[i % kFramesInFlight];
     SIVIFLOW_TRY(context_->wait_slot(i % kFramesInFlight));
-    SIVIFLOW_TRY(write_frame(slot));
+    copy_out(slot);
     slot.pending = false;
+    SIVIFLOW_TRY(write_frame());
     report_progress(++written);
   }
   if (context_->report().validation_enabled && context_->validation_error_count() > 0) {
@@ -248,13 +255,22 @@ Status Capture::run() {
   return Status::success();
 }
 
-Status Capture::write_frame(const SlotTargets& slot) {
+void Capture::copy_out(const SlotTargets& slot) {
+  const size_t pixels = size_t{options_.size.width} * options_.size.height;
+  finished_.frame = slot.frame;
+  finished_.camera = slot.camera;
+  const auto* halves = static_cast<const uint16_t*>(slot.color.data);
+  finished_.color_halves.assign(halves, halves + pixels * 4);
+  const auto* depth = static_cast<const float*>(slot.depth.data);
+  finished_.window_depth.assign(depth, depth + pixels);
+}
+
+Status Capture::write_frame() {
   const uint32_t width = options_.size.width;
   const uint32_t height = options_.size.height;
   const size_t pixels = size_t{width} * height;
   rgba_.resize(pixels * 4);
-  const auto* halves = static_cast<const uint16_t*>(slot.color.data);
-  for (size_t i = 0; i < pixels * 4; ++i) rgba_[i] = glm::unpackHalf1x16(halves[i]);
+  for (size_t i = 0; i < pixels * 4; ++i) rgba_[i] = glm::unpackHalf1x16(finished_.color_halves[i]);
 
   ExrFrame frame;
   frame.width = static_cast<int>(width);
@@ -262,20 +278,20 @@ Status Capture::write_frame(const SlotTargets& slot) {
   frame.rgba = rgba_.data();
   if (options_.depth_aov) {
     depth_.resize(pixels);
-    const auto* window_depth = static_cast<const float*>(slot.depth.data);
+    const Camera& camera = finished_.camera;
     for (size_t i = 0; i < pixels; ++i) {
-      depth_[i] = linear_depth(window_depth[i], slot.camera.near_plane, slot.camera.far_plane);
+      depth_[i] = linear_depth(finished_.window_depth[i], camera.near_plane, camera.far_plane);
     }
     frame.channels.push_back({"depth.Z", depth_.data()});
   }
   frame.metadata.scene = "default";
-  frame.metadata.frame = static_cast<int>(slot.frame);
-  frame.metadata.time_seconds = static_cast<float>(slot.frame / options_.fps);
+  frame.metadata.frame = static_cast<int>(finished_.frame);
+  frame.metadata.time_seconds = static_cast<float>(finished_.frame / options_.fps);
   frame.metadata.seed = static_cast<int>(options_.seed);
   frame.metadata.software_version = version_string();
 
   char name[32];
-  std::snprintf(name, sizeof(name), "frame_%05u", slot.frame);
+  std::snprintf(name, sizeof(name), "frame_%05u", finished_.frame);
   const std::string base = options_.out_dir + "/" + name;
   SIVIFLOW_TRY(write_exr(base + ".exr", frame));
   if (options_.preview) {

@@ -18,10 +18,11 @@ namespace siviflow {
 
 // ---- upload: staging block -> device buffers and images (always a real copy) ----
 
-// One copy from the frame slot's staging block, recorded by the upload pass.
+// One copy from the frame slot's staging block, recorded by the upload pass. Destinations are
+// graph handles, so the copy and the graph's barriers always name the same resource.
 struct BufferUpload {
   VkDeviceSize staging_offset = 0;
-  VkBuffer destination = VK_NULL_HANDLE;
+  BufferHandle destination;
   VkDeviceSize size = 0;
 };
 struct ImageUpload {
@@ -30,7 +31,7 @@ struct ImageUpload {
   VkExtent2D extent{};
 };
 
-// What the upload pass copies this frame; filled on the CPU during update().
+// What the upload pass copies; filled on the CPU before the pass records.
 struct UploadList {
   std::vector<BufferUpload> buffers;
   std::vector<ImageUpload> images;
@@ -40,13 +41,9 @@ struct UploadList {
   }
 };
 
-struct UploadPassHandles {
-  BufferHandle staging;                    // imported: the slot's staging block
-  std::vector<BufferHandle> buffers;       // written by the pass (new versions returned here)
-  std::vector<ImageHandle> images;
-};
-// Declares the pass; `list` is read when the pass records, so it may change every frame.
-void add_upload_pass(FrameGraph& graph, const UploadList& list, UploadPassHandles* handles);
+// Declares the pass: it writes every destination of `list` (their handles are replaced by the
+// written versions) from the imported staging buffer. `list` is read again when the pass records.
+void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list);
 
 // ---- scene: sky, terrain, riverbed and objects ----
 

@@ -4,28 +4,28 @@
 
 namespace siviflow {
 
-void add_upload_pass(FrameGraph& graph, const UploadList& list, UploadPassHandles* handles) {
+void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list) {
   PassBuilder pass = graph.add_pass("upload", PassKind::Transfer);
-  pass.transfer_read(handles->staging);
-  for (BufferHandle& buffer : handles->buffers) buffer = pass.transfer_write(buffer);
-  for (ImageHandle& image : handles->images) image = pass.transfer_write(image);
-  const BufferHandle staging = handles->staging;
-  // Declared every frame, copying only what `list` holds: data that changes per frame is in it
-  // every frame, static data only on the first; the barriers of an idle frame cost nothing.
-  pass.record([&list, staging](const PassContext& ctx) {
+  pass.transfer_read(staging);
+  for (BufferUpload& upload : list->buffers) upload.destination = pass.transfer_write(upload.destination);
+  for (ImageUpload& upload : list->images) upload.destination = pass.transfer_write(upload.destination);
+  // Lookups in the pass context go by resource, so the written versions name the same images.
+  pass.record([list, staging](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
     const VkBuffer source = ctx.buffer(staging);
-    for (const BufferUpload& upload : list.buffers) {
-      VkBufferCopy region{upload.staging_offset, 0, upload.size};
-      vk.vkCmdCopyBuffer(ctx.cmd(), source, upload.destination, 1, &region);
+    const VkDeviceSize source_base = ctx.offset(staging);
+    for (const BufferUpload& upload : list->buffers) {
+      const BufferHandle target = upload.destination;
+      VkBufferCopy region{source_base + upload.staging_offset, ctx.offset(target), upload.size};
+      vk.vkCmdCopyBuffer(ctx.cmd(), source, ctx.buffer(target), 1, &region);
     }
-    for (const ImageUpload& upload : list.images) {
+    for (const ImageUpload& upload : list->images) {
+      const ImageHandle target = upload.destination;
       VkBufferImageCopy region{};
-      region.bufferOffset = upload.staging_offset;
+      region.bufferOffset = source_base + upload.staging_offset;
       region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
       region.imageExtent = {upload.extent.width, upload.extent.height, 1};
-      vk.vkCmdCopyBufferToImage(ctx.cmd(), source, ctx.image(upload.destination),
-                                ctx.layout(upload.destination), 1, &region);
+      vk.vkCmdCopyBufferToImage(ctx.cmd(), source, ctx.image(target), ctx.layout(target), 1, &region);
     }
     return Status::success();
   });

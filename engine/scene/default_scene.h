@@ -8,18 +8,13 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "shared.h"
 #include "siviflow/renderer.h"
 #include "sim/procedural_river.h"
 
 namespace siviflow {
 
-// Vertex of the scene pipeline; attribute locations are in shaders/shared.h.
-struct SceneVertex {
-  glm::vec3 position;
-  glm::vec3 normal;
-  glm::vec4 color;  // rgb linear albedo, a ambient occlusion
-};
-static_assert(sizeof(SceneVertex) == 40);
+using gpu::SceneVertex;
 
 struct SceneGeometry {
   std::vector<SceneVertex> vertices;

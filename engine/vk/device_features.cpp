@@ -1,26 +1,47 @@
-// The device features SiViFlow needs, and the check that names each one a device lacks.
-#include <cstdlib>
-#include <sstream>
+// The device features SiViFlow needs, and the check that names each one a feature chain lacks.
+#include <array>
 #include <string>
 #include <vector>
 
-#include "siviflow/headless_context.h"
 #include "siviflow/renderer.h"
 
 namespace siviflow {
 namespace {
 
-// Testing hook: a comma list of feature names to report as missing, so the "missing feature"
-// path can be exercised on lavapipe, which has them all.
-bool hidden_by_environment(const char* feature) {
-  const char* hidden = std::getenv("SIVIFLOW_HIDE_DEVICE_FEATURES");
-  if (hidden == nullptr) return false;
-  std::stringstream list(hidden);
-  std::string item;
-  while (std::getline(list, item, ',')) {
-    if (item == feature) return true;
+struct FeatureSet {
+  bool shader_clip_distance = false;
+  bool dynamic_rendering = false;
+  bool synchronization2 = false;
+};
+
+// Reads the features we need from a chain, whether the host used the Vulkan 1.3 struct or the
+// per-feature structs that were promoted into it.
+FeatureSet read_chain(const VkPhysicalDeviceFeatures2* features) {
+  FeatureSet set;
+  if (features == nullptr) return set;
+  set.shader_clip_distance = features->features.shaderClipDistance == VK_TRUE;
+  for (auto* node = static_cast<const VkBaseInStructure*>(features->pNext); node != nullptr;
+       node = node->pNext) {
+    switch (node->sType) {
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES: {
+        const auto* v13 = reinterpret_cast<const VkPhysicalDeviceVulkan13Features*>(node);
+        set.dynamic_rendering |= v13->dynamicRendering == VK_TRUE;
+        set.synchronization2 |= v13->synchronization2 == VK_TRUE;
+        break;
+      }
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES:
+        set.dynamic_rendering |=
+            reinterpret_cast<const VkPhysicalDeviceDynamicRenderingFeatures*>(node)->dynamicRendering == VK_TRUE;
+        break;
+      case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES:
+        set.synchronization2 |=
+            reinterpret_cast<const VkPhysicalDeviceSynchronization2Features*>(node)->synchronization2 == VK_TRUE;
+        break;
+      default:
+        break;
+    }
   }
-  return false;
+  return set;
 }
 
 }  // namespace
@@ -30,30 +51,25 @@ RequiredDeviceFeatures required_device_features() {
   required.features2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
   required.features2.features.shaderClipDistance = VK_TRUE;  // reflection clip plane
   required.vulkan13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
-  required.vulkan13.dynamicRendering = VK_TRUE;
-  required.vulkan13.synchronization2 = VK_TRUE;
-  required.vulkan13.maintenance4 = VK_TRUE;  // glslang's vulkan1.3 compute output needs it
+  required.vulkan13.dynamicRendering = VK_TRUE;   // every pass renders without render passes
+  required.vulkan13.synchronization2 = VK_TRUE;   // every barrier is a VkDependencyInfo
   required.link();
   return required;
 }
 
-std::vector<std::string> missing_required_features(PFN_vkGetInstanceProcAddr get_instance_proc_addr,
-                                                   VkInstance instance, VkPhysicalDevice device) {
-  auto get_features = reinterpret_cast<PFN_vkGetPhysicalDeviceFeatures2>(
-      get_instance_proc_addr(instance, "vkGetPhysicalDeviceFeatures2"));
-  VkPhysicalDeviceVulkan13Features vulkan13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
-  VkPhysicalDeviceFeatures2 features2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
-  features2.pNext = &vulkan13;
-  get_features(device, &features2);
+std::vector<std::string> required_device_feature_names() {
+  return {"shaderClipDistance", "dynamicRendering", "synchronization2"};
+}
 
+std::vector<std::string> missing_device_features(const VkPhysicalDeviceFeatures2* features) {
+  const FeatureSet set = read_chain(features);
+  const std::array<bool, 3> present = {set.shader_clip_distance, set.dynamic_rendering,
+                                       set.synchronization2};
+  const std::vector<std::string> names = required_device_feature_names();
   std::vector<std::string> missing;
-  const auto check = [&](bool present, const char* name) {
-    if (!present || hidden_by_environment(name)) missing.emplace_back(name);
-  };
-  check(features2.features.shaderClipDistance, "shaderClipDistance");
-  check(vulkan13.dynamicRendering, "dynamicRendering");
-  check(vulkan13.synchronization2, "synchronization2");
-  check(vulkan13.maintenance4, "maintenance4");
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (!present[i]) missing.push_back(names[i]);
+  }
   return missing;
 }
 

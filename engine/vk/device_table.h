@@ -13,7 +13,7 @@ namespace siviflow {
   X(vkGetPhysicalDeviceFeatures2)              \
   X(vkGetPhysicalDeviceMemoryProperties)       \
   X(vkGetPhysicalDeviceFormatProperties)       \
-  X(vkGetPhysicalDeviceImageFormatProperties)  \
+  X(vkGetPhysicalDeviceQueueFamilyProperties)  \
   X(vkGetDeviceProcAddr)
 
 // Device-level functions.
@@ -21,7 +21,6 @@ namespace siviflow {
   X(vkAllocateMemory)                  \
   X(vkFreeMemory)                      \
   X(vkMapMemory)                       \
-  X(vkUnmapMemory)                     \
   X(vkCreateBuffer)                    \
   X(vkDestroyBuffer)                   \
   X(vkGetBufferMemoryRequirements)     \
@@ -39,13 +38,11 @@ namespace siviflow {
   X(vkCreatePipelineLayout)            \
   X(vkDestroyPipelineLayout)           \
   X(vkCreateGraphicsPipelines)         \
-  X(vkCreateComputePipelines)          \
   X(vkDestroyPipeline)                 \
   X(vkCreateDescriptorSetLayout)       \
   X(vkDestroyDescriptorSetLayout)      \
   X(vkCreateDescriptorPool)            \
   X(vkDestroyDescriptorPool)           \
-  X(vkResetDescriptorPool)             \
   X(vkAllocateDescriptorSets)          \
   X(vkUpdateDescriptorSets)            \
   X(vkCmdPipelineBarrier2)             \
@@ -60,12 +57,9 @@ namespace siviflow {
   X(vkCmdSetScissor)                   \
   X(vkCmdDraw)                         \
   X(vkCmdDrawIndexed)                  \
-  X(vkCmdDispatch)                     \
   X(vkCmdCopyBuffer)                   \
   X(vkCmdCopyBufferToImage)            \
-  X(vkCmdCopyImageToBuffer)            \
-  X(vkCmdFillBuffer)                   \
-  X(vkCmdClearColorImage)
+  X(vkCmdCopyImageToBuffer)
 
 // VK_EXT_debug_utils labels: loaded only when the host says it enabled the extension (a loader
 // may hand out entry points of extensions that are not enabled, and calling them crashes).

@@ -94,6 +94,26 @@ bool has_layer(const HostTable& host, const char* name) {
   return false;
 }
 
+// Test seam of this standalone host only (the renderer checks the real enabled features): a comma
+// list of required feature names to treat as unsupported, so the tool's "missing feature" path
+// can be exercised on lavapipe, which has them all.
+std::vector<std::string> hidden_features() {
+  std::vector<std::string> names;
+  const char* hidden = std::getenv("SIVIFLOW_HIDE_DEVICE_FEATURES");
+  if (hidden == nullptr) return names;
+  std::string item;
+  for (const char* c = hidden;; ++c) {
+    if (*c == ',' || *c == '\0') {
+      if (!item.empty()) names.push_back(item);
+      item.clear();
+      if (*c == '\0') break;
+    } else {
+      item += *c;
+    }
+  }
+  return names;
+}
+
 std::string driver_files_hint() {
   const char* files = std::getenv("VK_DRIVER_FILES");
   if (files == nullptr) files = std::getenv("VK_ICD_FILENAMES");
@@ -116,6 +136,7 @@ struct HeadlessContext::Impl {
   std::vector<VkFence> slot_fences;
   DeviceReport report;
   bool print_messages = true;
+  RequiredDeviceFeatures enabled;  // the chain the device was created with
   DeviceTable table;  // for the host-owned images and buffers
   GpuContext gpu;
   std::vector<Image> host_images;
@@ -263,8 +284,12 @@ Status HeadlessContext::Impl::pick_device(const HeadlessContextOptions& options)
       rejected += "\n  " + name + ": not Mesa lavapipe (llvmpipe) as required";
       continue;
     }
-    const std::vector<std::string> missing =
-        missing_required_features(get_instance_proc_addr, instance, candidate);
+    VkPhysicalDeviceVulkan13Features supported13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+    VkPhysicalDeviceFeatures2 supported{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    supported.pNext = &supported13;
+    host.vkGetPhysicalDeviceFeatures2(candidate, &supported);
+    std::vector<std::string> missing = missing_device_features(&supported);
+    for (const std::string& hidden : hidden_features()) missing.push_back(hidden);
     if (!missing.empty()) {
       rejected += "\n  " + name + ": missing required feature";
       for (const std::string& feature : missing) rejected += " " + feature;
@@ -306,10 +331,10 @@ Status HeadlessContext::Impl::create_device() {
   queue_info.queueCount = 1;
   queue_info.pQueuePriorities = &priority;
 
-  RequiredDeviceFeatures required = required_device_features();
-  required.link();
+  enabled = required_device_features();
+  enabled.link();
   VkDeviceCreateInfo create{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  create.pNext = &required.features2;
+  create.pNext = &enabled.features2;
   create.queueCreateInfoCount = 1;
   create.pQueueCreateInfos = &queue_info;
   VkResult result = host.vkCreateDevice(physical_device, &create, nullptr, &device);
@@ -382,6 +407,24 @@ PFN_vkGetDeviceProcAddr HeadlessContext::get_device_proc_addr() const {
   return impl_->host.vkGetDeviceProcAddr;
 }
 const DeviceReport& HeadlessContext::report() const { return impl_->report; }
+const VkPhysicalDeviceFeatures2* HeadlessContext::enabled_features() const {
+  return &impl_->enabled.features2;
+}
+
+CreateInfo HeadlessContext::renderer_create_info(VkExtent2D extent, VkFormat color_format) const {
+  CreateInfo info;
+  info.instance = impl_->instance;
+  info.physical_device = impl_->physical_device;
+  info.device = impl_->device;
+  info.get_instance_proc_addr = impl_->get_instance_proc_addr;
+  info.get_device_proc_addr = impl_->host.vkGetDeviceProcAddr;
+  info.enabled_features = &impl_->enabled.features2;
+  info.queue_family_index = impl_->queue_family;
+  info.color_format = color_format;
+  info.extent = extent;
+  info.debug_utils = impl_->report.validation_enabled;
+  return info;
+}
 
 Status HeadlessContext::begin_slot(uint32_t slot, VkCommandBuffer* cmd) {
   Impl& s = *impl_;
@@ -402,9 +445,7 @@ Status HeadlessContext::begin_slot(uint32_t slot, VkCommandBuffer* cmd) {
     s.slot_fences.push_back(fence);
   }
   SIVIFLOW_TRY(wait_slot(slot));
-  VkResult result = s.host.vkResetFences(s.device, 1, &s.slot_fences[slot]);
-  if (result != VK_SUCCESS) return vk_error("vkResetFences", result);
-  result = s.host.vkResetCommandBuffer(s.slot_commands[slot], 0);
+  VkResult result = s.host.vkResetCommandBuffer(s.slot_commands[slot], 0);
   if (result != VK_SUCCESS) return vk_error("vkResetCommandBuffer", result);
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -419,6 +460,10 @@ Status HeadlessContext::end_slot_and_submit(uint32_t slot) {
   if (slot >= s.slot_commands.size()) return Status::error("end_slot_and_submit: slot not begun");
   VkResult result = s.host.vkEndCommandBuffer(s.slot_commands[slot]);
   if (result != VK_SUCCESS) return vk_error("vkEndCommandBuffer", result);
+  // Reset only now: a failure between begin_slot and here leaves the fence signalled, so the
+  // next wait on this slot does not block until the timeout.
+  result = s.host.vkResetFences(s.device, 1, &s.slot_fences[slot]);
+  if (result != VK_SUCCESS) return vk_error("vkResetFences", result);
   VkCommandBufferSubmitInfo command_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
   command_info.commandBuffer = s.slot_commands[slot];
   VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};

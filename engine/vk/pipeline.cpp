@@ -132,20 +132,4 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
   return status;
 }
 
-Status create_push_constant_layout(const GpuContext& gpu, uint32_t push_constant_bytes,
-                                   VkPipelineLayout* out) {
-  VkPushConstantRange range{};
-  range.stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-  range.size = push_constant_bytes;
-  VkPipelineLayoutCreateInfo info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  info.pushConstantRangeCount = 1;
-  info.pPushConstantRanges = &range;
-  const VkResult result =
-      gpu.table->vkCreatePipelineLayout(gpu.table->device, &info, gpu.allocation_callbacks, out);
-  if (result != VK_SUCCESS) {
-    return Status::error(std::string("vkCreatePipelineLayout failed: ") + result_name(result), result);
-  }
-  return Status::success();
-}
-
 }  // namespace siviflow

@@ -31,8 +31,4 @@ struct GraphicsPipelineDesc {
 Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
                                 const GraphicsPipelineDesc& desc, VkPipeline* out);
 
-// A layout with one push-constant range visible to the vertex and fragment stages.
-Status create_push_constant_layout(const GpuContext& gpu, uint32_t push_constant_bytes,
-                                   VkPipelineLayout* out);
-
 }  // namespace siviflow

@@ -35,18 +35,9 @@ class GpuTest : public ::testing::Test {
   }
 
   CreateInfo make_create_info(uint32_t width, uint32_t height) const {
-    CreateInfo info;
-    info.instance = context_->instance();
-    info.physical_device = context_->physical_device();
-    info.device = context_->device();
-    info.get_instance_proc_addr = context_->get_instance_proc_addr();
-    info.get_device_proc_addr = context_->get_device_proc_addr();
-    info.queue_family_index = context_->queue_family_index();
+    CreateInfo info = context_->renderer_create_info({width, height}, VK_FORMAT_R16G16B16A16_SFLOAT);
     info.frames_in_flight = 2;
-    info.color_format = VK_FORMAT_R16G16B16A16_SFLOAT;
-    info.extent = {width, height};
     info.enable_readback = true;
-    info.debug_utils = true;
     return info;
   }
 

@@ -10,6 +10,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include "siviflow/renderer.h"
 #include "sim/status.h"
 
 namespace siviflow {
@@ -66,6 +67,11 @@ class HeadlessContext {
   PFN_vkGetInstanceProcAddr get_instance_proc_addr() const;
   PFN_vkGetDeviceProcAddr get_device_proc_addr() const;
   const DeviceReport& report() const;
+  // The features the device was created with: what CreateInfo::enabled_features points to.
+  const VkPhysicalDeviceFeatures2* enabled_features() const;
+  // A renderer CreateInfo for this device, with every handle, the enabled features and debug
+  // labels (when validation is on) filled; the caller sets the rest.
+  CreateInfo renderer_create_info(VkExtent2D extent, VkFormat color_format) const;
 
   // One command buffer and fence per frame slot, as a host keeping frames in flight has.
   // begin_slot waits (bounded) for the slot's previous submission, then begins recording.
@@ -94,10 +100,5 @@ class HeadlessContext {
 // Whether the Khronos validation layer is installed, without creating an instance.
 // Returns false when the Vulkan loader itself cannot be loaded.
 bool validation_layer_present();
-
-// Names of the required device features the physical device lacks (empty when all present).
-// The required set is what renderer.h's required_device_features() enables.
-std::vector<std::string> missing_required_features(PFN_vkGetInstanceProcAddr get_instance_proc_addr,
-                                                   VkInstance instance, VkPhysicalDevice device);
 
 }  // namespace siviflow

@@ -34,7 +34,10 @@ struct CreateInfo {
   VkDevice device = VK_NULL_HANDLE;                        // created with required_device_features()
   PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;  // required: loads our private table
   PFN_vkGetDeviceProcAddr get_device_proc_addr = nullptr;  // optional: else from the instance
-  uint32_t queue_family_index = 0;     // family of the queue that will run what we record
+  // The feature chain the device was created with (what VkDeviceCreateInfo::pNext held). Required:
+  // create() checks it enables every feature of required_device_features() and names any missing.
+  const VkPhysicalDeviceFeatures2* enabled_features = nullptr;
+  uint32_t queue_family_index = 0;     // family of the queue that will run what we record (graphics)
   uint32_t frames_in_flight = 0;       // ring slots; 0 means 2
   VkFormat color_format = VK_FORMAT_UNDEFINED;  // output image format; 0 means RGBA16F
   VkExtent2D extent = {0, 0};          // output size in pixels; required
@@ -56,6 +59,10 @@ struct RequiredDeviceFeatures {
   void link() { features2.pNext = &vulkan13; }
 };
 RequiredDeviceFeatures required_device_features();
+// Their names, as used in error messages: "shaderClipDistance", "dynamicRendering", ...
+std::vector<std::string> required_device_feature_names();
+// Names of required features a chain (enabled or supported features) does not hold.
+std::vector<std::string> missing_device_features(const VkPhysicalDeviceFeatures2* features);
 
 struct Camera {
   glm::vec3 position{0.0f, 10.0f, -30.0f};
@@ -72,8 +79,9 @@ struct ImageState {
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
 };
 
-// A host image we render into. `current` is its state when our commands start; `final` the
-// state the host wants when they end.
+// A host image we render into. `current` is its state when our commands start (UNDEFINED layout:
+// its contents may be discarded); `final` the state the host wants when they end, which must
+// name a real layout (not UNDEFINED).
 struct ExternalImage {
   VkImage image = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;
