@@ -173,6 +173,22 @@ glm::dvec3 closest_barycentric(std::span<const glm::dvec2, 3> t, glm::dvec2 p) {
   return best_bary;
 }
 
+bool footprint_overlaps_segment(const Obstacle& o, glm::dvec2 centre_xz, glm::dvec2 a,
+                                glm::dvec2 b) {
+  if (o.polygon.empty()) return segment_distance(centre_xz, a, b) < double{o.radius};
+  if (footprint_distance(o, centre_xz, a) < 0.0 || footprint_distance(o, centre_xz, b) < 0.0) {
+    return true;
+  }
+  const size_t n = o.polygon.size();
+  for (size_t i = 0; i < n; ++i) {
+    if (segments_cross(centre_xz + glm::dvec2(o.polygon[i]),
+                       centre_xz + glm::dvec2(o.polygon[(i + 1) % n]), a, b)) {
+      return true;
+    }
+  }
+  return false;
+}
+
 bool footprint_overlaps_triangle(const Obstacle& o, glm::dvec2 centre_xz,
                                  std::span<const glm::dvec2, 3> tri) {
   if (o.polygon.empty()) {

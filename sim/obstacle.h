@@ -48,6 +48,10 @@ void footprint_bounds(const Obstacle& obstacle, glm::dvec2 centre_xz, glm::dvec2
 bool footprint_overlaps_triangle(const Obstacle& obstacle, glm::dvec2 centre_xz,
                                  std::span<const glm::dvec2, 3> tri);
 
+// Whether the footprint placed at `centre_xz` overlaps the segment ab (XZ).
+bool footprint_overlaps_segment(const Obstacle& obstacle, glm::dvec2 centre_xz, glm::dvec2 a,
+                                glm::dvec2 b);
+
 // Closest point of triangle `tri` to `point`, as barycentric weights (all in the XZ plane).
 glm::dvec3 closest_barycentric(std::span<const glm::dvec2, 3> tri, glm::dvec2 point);
 

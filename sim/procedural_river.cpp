@@ -1,11 +1,16 @@
 #include "sim/procedural_river.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <glm/common.hpp>
 #include <glm/gtc/constants.hpp>
+
+#include "sim/river_tuning.h"
+#include "sim/text_format.h"
 
 namespace siviflow {
 
@@ -18,24 +23,33 @@ ProceduralRiver::ProceduralRiver(const ProceduralRiverParams& params) : params_(
   phase_w_ = static_cast<float>(rng() % 100000u) / 100000.0f * two_pi;
 }
 
-float ProceduralRiver::centreline_x(float z) const {
-  const float k = glm::two_pi<float>() / params_.meander_wavelength;
+double ProceduralRiver::centre_x(double z) const {
+  const double k = glm::two_pi<double>() / params_.meander_wavelength;
   // A second, shorter harmonic breaks the regularity of a pure sine.
   return params_.meander_amplitude *
-         (0.8f * std::sin(k * z + phase_a_) + 0.2f * std::sin(2.3f * k * z + phase_b_));
+         (0.8 * std::sin(k * z + phase_a_) + 0.2 * std::sin(2.3 * k * z + phase_b_));
 }
 
-float ProceduralRiver::width_at(float z) const {
-  const float k = glm::two_pi<float>() / (0.7f * params_.meander_wavelength);
-  return params_.width * (1.0f + params_.width_variation * std::sin(k * z + phase_w_));
+double ProceduralRiver::centre_slope(double z) const {
+  const double k = glm::two_pi<double>() / params_.meander_wavelength;
+  return params_.meander_amplitude * k *
+         (0.8 * std::cos(k * z + phase_a_) + 0.2 * 2.3 * std::cos(2.3 * k * z + phase_b_));
 }
+
+double ProceduralRiver::width(double z) const {
+  const double k = glm::two_pi<double>() / (0.7 * params_.meander_wavelength);
+  return params_.width * (1.0 + params_.width_variation * std::sin(k * z + phase_w_));
+}
+
+float ProceduralRiver::centreline_x(float z) const { return static_cast<float>(centre_x(z)); }
+
+float ProceduralRiver::width_at(float z) const { return static_cast<float>(width(z)); }
 
 float ProceduralRiver::lateral_distance(float x, float z) const {
   // Project the horizontal offset onto the local normal of the centreline; exact enough while
   // the meander radius is large against the valley width.
-  const float dz = 0.5f;
-  const float slope = (centreline_x(z + dz) - centreline_x(z - dz)) / (2.0f * dz);
-  return (x - centreline_x(z)) / std::sqrt(1.0f + slope * slope);
+  const double slope = centre_slope(z);
+  return static_cast<float>((x - centre_x(z)) / std::sqrt(1.0 + slope * slope));
 }
 
 float ProceduralRiver::terrain_height(float x, float z) const {
@@ -56,6 +70,142 @@ float ProceduralRiver::terrain_height(float x, float z) const {
   // Gentle undulation so the valley floor is not a perfect extrusion.
   const float undulation = 0.6f * std::sin(0.11f * x + phase_b_) * std::sin(0.07f * z + phase_a_);
   return bank + wall + undulation * wall_t;
+}
+
+float ProceduralRiver::depth_at(float x, float z) const {
+  return std::max(0.0f, water_level() - terrain_height(x, z));
+}
+
+Status ProceduralRiver::validate(const ProceduralRiverParams& p) {
+  const struct {
+    const char* name;
+    float value;
+    float min;
+    bool min_inclusive;
+  } ranges[] = {
+      {"length", p.length, 0.0f, false},
+      {"meander_amplitude", p.meander_amplitude, 0.0f, true},
+      {"meander_wavelength", p.meander_wavelength, 0.0f, false},
+      {"width", p.width, 0.0f, false},
+      {"width_variation", p.width_variation, 0.0f, true},
+      {"depth", p.depth, 0.0f, true},
+      {"bank_height", p.bank_height, 0.0f, true},
+      {"valley_half_width", p.valley_half_width, 0.0f, false},
+      {"valley_wall_height", p.valley_wall_height, 0.0f, true},
+      {"section_spacing", p.section_spacing, 0.0f, false},
+  };
+  for (const auto& r : ranges) {
+    if (!std::isfinite(r.value) || r.value < r.min || (!r.min_inclusive && r.value == r.min)) {
+      return Status::error(text_format("procedural river: %s = %g must be finite and %s %g",
+                                       r.name, r.value, r.min_inclusive ? ">=" : ">", r.min));
+    }
+  }
+  if (p.width_variation >= 1.0f) {
+    return Status::error(text_format(
+        "procedural river: width_variation = %g must be below 1 (the width would reach zero)",
+        p.width_variation));
+  }
+  const float widest_half = 0.5f * p.width * (1.0f + p.width_variation);
+  if (p.valley_half_width <= widest_half + 3.0f) {
+    return Status::error(text_format(
+        "procedural river: valley_half_width = %g must exceed half the widest water (%g) plus "
+        "the 3 m bank",
+        p.valley_half_width, widest_half));
+  }
+  if (p.vertices_across < 2) {
+    return Status::error(text_format(
+        "procedural river: vertices_across = %u must be at least 2 (one per bank)",
+        p.vertices_across));
+  }
+  // Bound the mesh size before allocating: the centreline's slope is at most 1.26 A k.
+  const double k = glm::two_pi<double>() / p.meander_wavelength;
+  const double max_slope = 1.26 * p.meander_amplitude * k;
+  const double arc_bound = p.length * std::sqrt(1.0 + max_slope * max_slope);
+  const double sections = arc_bound / p.section_spacing + 2.0;
+  if (sections * p.vertices_across > static_cast<double>(kMaxRiverVertices)) {
+    return Status::error(text_format(
+        "procedural river: %.0f sections of %u vertices exceed the limit of %zu vertices (raise "
+        "section_spacing or lower vertices_across)",
+        sections, p.vertices_across, kMaxRiverVertices));
+  }
+  return Status::success();
+}
+
+Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
+  SIVIFLOW_TRY(validate(params_));
+  const double half_length = 0.5 * params_.length;
+
+  // Arc length of the centreline, sampled finely enough for sub-centimetre section placement.
+  const size_t samples = std::clamp<size_t>(
+      static_cast<size_t>(params_.length / std::min(0.05f, 0.25f * params_.section_spacing)),
+      1024, size_t{1} << 22);
+  std::vector<double> arc(samples + 1, 0.0);
+  auto z_of = [&](size_t i) { return -half_length + params_.length * double(i) / double(samples); };
+  for (size_t i = 1; i <= samples; ++i) {
+    const double dz = z_of(i) - z_of(i - 1);
+    const double dx = centre_x(z_of(i)) - centre_x(z_of(i - 1));
+    arc[i] = arc[i - 1] + std::sqrt(dx * dx + dz * dz);
+  }
+  const double total = arc.back();
+  const uint32_t section_count =
+      std::max<uint32_t>(2, static_cast<uint32_t>(std::lround(total / params_.section_spacing)) + 1);
+  const uint32_t across = params_.vertices_across;
+
+  RiverMesh mesh;
+  mesh.section_count = section_count;
+  mesh.vertices_across = across;
+  const size_t vertex_count = size_t{section_count} * across;
+  mesh.positions.reserve(vertex_count);
+  mesh.uvs.reserve(vertex_count);
+  mesh.depth.reserve(vertex_count);
+  const float y = water_level();
+  size_t seg = 1;
+  for (uint32_t k = 0; k < section_count; ++k) {
+    // The z where the centreline has run k / (S - 1) of its length.
+    const double target = total * double(k) / double(section_count - 1);
+    while (seg < samples && arc[seg] < target) ++seg;
+    const double u = arc[seg] > arc[seg - 1]
+                         ? std::clamp((target - arc[seg - 1]) / (arc[seg] - arc[seg - 1]), 0.0, 1.0)
+                         : 0.0;
+    const double z = z_of(seg - 1) + u * (z_of(seg) - z_of(seg - 1));
+    const double x = centre_x(z);
+    // Sections are perpendicular to the centreline; left = +Y x downstream.
+    const double slope = centre_slope(z);
+    const double norm = std::sqrt(1.0 + slope * slope);
+    const glm::dvec2 left(1.0 / norm, -slope / norm);  // (x, z)
+    const double half_width = 0.5 * width(z);
+    for (uint32_t j = 0; j < across; ++j) {
+      const double t = double(j) / double(across - 1);
+      const double offset = half_width * (1.0 - 2.0 * t);
+      const glm::vec3 p(float(x + offset * left.x), y, float(z + offset * left.y));
+      mesh.positions.push_back(p);
+      mesh.uvs.emplace_back(float(t), float(target));
+      mesh.depth.push_back(depth_at(p.x, p.z));
+    }
+  }
+
+  // Two triangles per quad, counter-clockwise from +Y; a quad that turns over means two
+  // neighbouring sections cross, on the inside of a bend tighter than the half-width.
+  mesh.indices.reserve(size_t{section_count - 1} * (across - 1) * 6);
+  for (uint32_t k = 0; k + 1 < section_count; ++k) {
+    for (uint32_t j = 0; j + 1 < across; ++j) {
+      const uint32_t a = k * across + j, b = a + 1, c = a + across, d = c + 1;
+      for (const auto& [p, q, r] : {std::array{a, b, c}, std::array{b, d, c}}) {
+        const glm::vec3 e1 = mesh.positions[q] - mesh.positions[p];
+        const glm::vec3 e2 = mesh.positions[r] - mesh.positions[p];
+        if (!(e1.z * e2.x - e1.x * e2.z > 0.0f)) {
+          return Status::error(text_format(
+              "procedural river: sections %u and %u cross near z = %g (the meander is too tight "
+              "for the width: raise meander_wavelength or section_spacing, or lower "
+              "meander_amplitude or width)",
+              k, k + 1, mesh.positions[a].z));
+        }
+        mesh.indices.insert(mesh.indices.end(), {p, q, r});
+      }
+    }
+  }
+  *out = std::move(mesh);
+  return Status::success();
 }
 
 }  // namespace siviflow

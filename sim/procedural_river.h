@@ -66,6 +66,12 @@ class ProceduralRiver {
   Status generate_mesh(RiverMesh* out) const;
 
  private:
+  // Double-precision profiles: far from the origin float z loses the centimetres that section
+  // placement and the centreline's slope need.
+  double centre_x(double z) const;
+  double centre_slope(double z) const;  // dx/dz, analytic
+  double width(double z) const;
+
   ProceduralRiverParams params_;
   float phase_a_ = 0.0f;  // seeded phases of the two meander harmonics
   float phase_b_ = 0.0f;

@@ -78,8 +78,8 @@ class RiverSurface {
   // The first input vertex welded into node n (what error messages call "vertex").
   uint32_t vertex_of_node(uint32_t n) const { return node_vertex_[n]; }
 
-  // Triangles in node indices, wound counter-clockwise seen from the river's up side (the side
-  // that downstream x left-to-right... points to), whatever the input winding was.
+  // Triangles in node indices, wound counter-clockwise seen from the river's upper side
+  // (downstream x (left shore - right shore)), whatever the input winding was.
   std::span<const uint32_t> triangles() const { return triangles_; }  // 3 per triangle
   size_t triangle_count() const { return triangles_.size() / 3; }
   // Triangles around node n, ascending.

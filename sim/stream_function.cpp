@@ -103,9 +103,14 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
     bool wet = true;
     f.psi_free_[n] = f.evaluate(n, false, &wet);
   }
-  f.triangle_velocity_.assign(tris, glm::vec3(0.0f));
-  f.node_velocity_.assign(nodes, glm::vec3(0.0f));
-  f.solve_full();
+  // No obstacles yet: the field is the obstacle-free one, only the velocities remain.
+  f.psi_ = f.psi_free_;
+  f.wet_.assign(nodes, 1);
+  f.triangle_velocity_.resize(tris);
+  f.node_velocity_.resize(nodes);
+  for (uint32_t t = 0; t < tris; ++t) f.update_triangle(t);
+  for (uint32_t n = 0; n < nodes; ++n) f.update_node_velocity(n);
+  f.stats_ = {nodes, tris, nodes};
   *out = std::move(f);
   return Status::success();
 }
@@ -114,28 +119,44 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
   *wet = true;
   const double s = params_.search_radius;
   const double q = params_.discharge;
-  const double dl = surface_.node_d_left()[n];
-  const double dr = surface_.node_d_right()[n];
-  const bool obstacles = use_obstacles && !active_.empty();
+  double dl = surface_.node_d_left()[n];
+  double dr = surface_.node_d_right()[n];
 
-  // Pass 1: dry?, on a boundary?, and the nearest boundary distance (the weights' scale).
+  // Pass 1: dry?, on a boundary?, and the nearest boundary distance (the weights' scale). The
+  // obstacles in reach are remembered for pass 2 (recomputed past kKept of them).
+  constexpr size_t kKept = 16;
+  double kept_d[kKept];
+  double kept_psi[kKept];
+  size_t reached = 0;
   double nearest = std::numeric_limits<double>::max();
-  if (dl < s) nearest = dl;
-  if (dr < s) nearest = std::min(nearest, dr);
   const double* on_obstacle = nullptr;
-  if (obstacles) {
+  if (use_obstacles) {
+    const glm::dvec2 p = xz(surface_.node_positions()[n]);
     for (const uint32_t j : active_) {
       const ObstacleState& st = state_[j];
       if (!influences(st, j, n)) continue;
-      const double d = footprint_distance(obstacles_[j], xz(st.centre), xz(surface_.node_positions()[n]));
+      const double d = footprint_distance(obstacles_[j], xz(st.centre), p);
       if (d < 0.0) {
         *wet = false;
         return st.psi;
       }
-      if (d == 0.0 && on_obstacle == nullptr) on_obstacle = &st.psi;
-      nearest = std::min(nearest, d);
+      if (st.merged == Bank::kLeft) {
+        dl = std::min(dl, d);
+      } else if (st.merged == Bank::kRight) {
+        dr = std::min(dr, d);
+      } else {
+        if (d == 0.0 && on_obstacle == nullptr) on_obstacle = &st.psi;
+        nearest = std::min(nearest, d);
+        if (reached < kKept) {
+          kept_d[reached] = d;
+          kept_psi[reached] = st.psi;
+        }
+        ++reached;
+      }
     }
   }
+  if (dl < s) nearest = std::min(nearest, dl);
+  if (dr < s) nearest = std::min(nearest, dr);
   if (dl <= 0.0) return q;
   if (dr <= 0.0) return 0.0;
   if (on_obstacle != nullptr) return *on_obstacle;
@@ -151,12 +172,14 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
   };
   if (dl < s) add(dl, q);
   if (dr < s) add(dr, 0.0);
-  if (obstacles) {
+  if (reached <= kKept) {
+    for (size_t i = 0; i < reached; ++i) add(kept_d[i], kept_psi[i]);
+  } else {
+    const glm::dvec2 pn = xz(surface_.node_positions()[n]);
     for (const uint32_t j : active_) {
       const ObstacleState& st = state_[j];
-      if (!influences(st, j, n)) continue;
-      add(footprint_distance(obstacles_[j], xz(st.centre), xz(surface_.node_positions()[n])),
-          st.psi);
+      if (st.merged != Bank::kNone || !influences(st, j, n)) continue;
+      add(footprint_distance(obstacles_[j], xz(st.centre), pn), st.psi);
     }
   }
   return den > 0.0 ? num / den : psi_free_[n];
@@ -259,6 +282,8 @@ StreamFunction::ObstacleState StreamFunction::place(size_t obstacle, const glm::
   };
 
   // Wet footprint: the triangles it overlaps, and their span along the river.
+  const auto node_bank = surface_.node_bank();
+  bool crosses_left = false, crosses_right = false;
   float along_lo = std::numeric_limits<float>::max(), along_hi = -along_lo;
   uint32_t nearest_tri = std::numeric_limits<uint32_t>::max();
   double nearest_dist = std::numeric_limits<double>::max();
@@ -267,9 +292,16 @@ StreamFunction::ObstacleState StreamFunction::place(size_t obstacle, const glm::
     if (!footprint_overlaps_triangle(o, c, corner)) return;
     st.in_water = true;
     for (int i = 0; i < 3; ++i) {
-      const float along = sections[node_section[tri[3 * t + i]]].along;
+      const uint32_t a = tri[3 * t + i], b = tri[3 * t + (i + 1) % 3];
+      const float along = sections[node_section[a]].along;
       along_lo = std::min(along_lo, along);
       along_hi = std::max(along_hi, along);
+      // Two shore nodes of one bank in one triangle make a bank edge.
+      const Bank bank = node_bank[a];
+      if (bank != Bank::kNone && node_bank[b] == bank && node_section[a] != node_section[b] &&
+          footprint_overlaps_segment(o, c, xz(pos[a]), xz(pos[b]))) {
+        (bank == Bank::kLeft ? crosses_left : crosses_right) = true;
+      }
     }
     const glm::dvec3 b = closest_barycentric(corner, c);
     const double d = glm::length(b.x * corner[0] + b.y * corner[1] + b.z * corner[2] - c);
@@ -306,6 +338,12 @@ StreamFunction::ObstacleState StreamFunction::place(size_t obstacle, const glm::
     best_bary = closest_barycentric(corners(best), c);
   }
   st.psi = interpolate(best, best_bary);
+  // Touching one bank, the obstacle extends it: no water passes between them. Across both it
+  // dams the river; it stays a boundary of its own (the flow there is moot, but finite).
+  if (crosses_left != crosses_right) {
+    st.merged = crosses_left ? Bank::kLeft : Bank::kRight;
+    st.psi = crosses_left ? double{params_.discharge} : 0.0;
+  }
   return st;
 }
 
@@ -369,23 +407,30 @@ void StreamFunction::move_incremental(size_t j, const glm::vec3& centre) {
     return stamp_;
   };
 
-  // 1. The vertices within s of the old and of the new footprint.
+  // 1. The vertices within s of the old or of the new footprint, in one sweep of the grid over
+  // both boxes (a drifting object's old and new reach mostly overlap).
   uint32_t gen = next_stamp();
   scratch_nodes_.clear();
-  auto collect = [&](const ObstacleState& st) {
-    if (!st.in_water) return;
-    node_grid_.for_each_in(st.lo - s, st.hi + s, [&](uint32_t n) {
-      if (node_stamp_[n] != gen && influences(st, j, n)) {
+  const ObstacleState old_state = state_[j];
+  const ObstacleState new_state = place(j, centre);
+  const bool old_wet = old_state.in_water, new_wet = new_state.in_water;
+  if (old_wet || new_wet) {
+    glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (const ObstacleState* st : {&old_state, &new_state}) {
+      if (!st->in_water) continue;
+      lo = glm::min(lo, st->lo - s);
+      hi = glm::max(hi, st->hi + s);
+    }
+    node_grid_.for_each_in(lo, hi, [&](uint32_t n) {
+      if (node_stamp_[n] == gen) return;
+      if ((old_wet && influences(old_state, j, n)) || (new_wet && influences(new_state, j, n))) {
         node_stamp_[n] = gen;
         scratch_nodes_.push_back(n);
       }
     });
-  };
-  const ObstacleState old_state = state_[j];
-  collect(old_state);
-  state_[j] = place(j, centre);
-  if (state_[j].in_water != old_state.in_water) refresh_active();
-  collect(state_[j]);
+  }
+  state_[j] = new_state;
+  if (new_wet != old_wet) refresh_active();
   for (const uint32_t n : scratch_nodes_) {
     bool wet = true;
     psi_[n] = evaluate(n, true, &wet);

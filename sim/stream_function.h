@@ -6,7 +6,9 @@
 // Boundaries: the left bank (psi = Q), the right bank (psi = 0), with in-river distances measured
 // along each vertex's section, and the obstacles in the water, at the XZ distance to their
 // footprint, each with psi = the obstacle-free field at its centre (so the total discharge is
-// kept and an object entering the water does not make the flow pop).
+// kept). An obstacle whose footprint crosses one bank is part of that bank: it takes the bank's
+// psi (no water passes between them) and the bank's distance becomes the nearer of the two, so
+// an object entering the water from the shore does not make the flow pop.
 // Velocity: per triangle v = grad(psi) x n (P1, tangent to the surface, divergence-free, pointing
 // downstream); per vertex the area-weighted mean of its triangles, slid along the bank on a bank
 // vertex (a bank is a streamline), zero on a dry vertex (inside an obstacle).
@@ -79,6 +81,8 @@ class StreamFunction {
   // --- Per obstacle.
   glm::vec3 obstacle_centre(size_t i) const { return state_[i].centre; }
   bool obstacle_in_water(size_t i) const { return state_[i].in_water; }
+  // The bank an obstacle is merged into (it crosses that bank), or kNone.
+  Bank obstacle_bank(size_t i) const { return state_[i].merged; }
   double obstacle_psi(size_t i) const { return state_[i].psi; }
 
  private:
@@ -88,6 +92,9 @@ class StreamFunction {
     bool in_water = false;           // the footprint overlaps a river triangle
     double psi = 0.0;                // psi_free at the centre (or the nearest wet point)
     float along_lo = 0.0f, along_hi = 0.0f;  // along-river span of the wet footprint
+    // The bank the footprint crosses, if one (not both): the obstacle is then part of that bank,
+    // with its psi, and enters the interpolation as the nearer of the two.
+    Bank merged = Bank::kNone;
   };
 
   double evaluate(uint32_t node, bool use_obstacles, bool* wet) const;

@@ -1,0 +1,111 @@
+// The procedural default river: its profiles (used by the terrain) and its water-surface strip.
+#include "sim/procedural_river.h"
+
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "sim/river_surface.h"
+
+namespace siviflow {
+namespace {
+
+TEST(ProceduralRiver, ProfilesStayInTheirRanges) {
+  const ProceduralRiverParams params;
+  const ProceduralRiver river(params);
+  for (float z = -120.0f; z <= 120.0f; z += 0.5f) {
+    EXPECT_LE(std::abs(river.centreline_x(z)), params.meander_amplitude + 1e-4f);
+    const float w = river.width_at(z);
+    EXPECT_GE(w, params.width * (1.0f - params.width_variation) - 1e-4f);
+    EXPECT_LE(w, params.width * (1.0f + params.width_variation) + 1e-4f);
+    const float x = river.centreline_x(z);
+    EXPECT_NEAR(river.lateral_distance(x, z), 0.0f, 1e-4f);
+    EXPECT_NEAR(river.terrain_height(x, z), -params.depth, 1e-4f);  // deepest at the centre
+    EXPECT_NEAR(river.depth_at(x, z), params.depth, 1e-4f);
+    EXPECT_GT(river.terrain_height(x + params.valley_half_width, z), params.bank_height);
+    EXPECT_EQ(river.depth_at(x + w + 4.0f, z), 0.0f);  // well past the bank, even across a slope
+  }
+}
+
+TEST(ProceduralRiver, MeshFollowsCentrelineAndWidth) {
+  ProceduralRiverParams params;
+  params.vertices_across = 9;
+  const ProceduralRiver river(params);
+  RiverMesh mesh;
+  ASSERT_TRUE(river.generate_mesh(&mesh).ok());
+  ASSERT_EQ(mesh.positions.size(), size_t{mesh.section_count} * 9);
+  ASSERT_EQ(mesh.indices.size(), size_t{mesh.section_count - 1} * 8 * 6);
+  ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());
+  ASSERT_EQ(mesh.depth.size(), mesh.positions.size());
+  // The end sections are centred on the ends of the centreline.
+  const size_t last = mesh.positions.size() - 9;
+  EXPECT_NEAR(0.5f * (mesh.positions[0].z + mesh.positions[8].z), -0.5f * params.length, 1e-3f);
+  EXPECT_NEAR(0.5f * (mesh.positions[last].z + mesh.positions[last + 8].z), 0.5f * params.length, 1e-3f);
+
+  RiverSurface surface;
+  const Status status = RiverSurface::build(mesh.positions, mesh.indices, {}, &surface);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(surface.sections().size(), mesh.section_count);
+  for (uint32_t k = 0; k < mesh.section_count; ++k) {
+    const glm::vec3 mid = surface.sections()[k].midpoint;
+    EXPECT_NEAR(mid.x, river.centreline_x(mid.z), 1e-3f) << "section " << k;
+    EXPECT_NEAR(surface.sections()[k].width, river.width_at(mid.z), 0.01f * river.width_at(mid.z));
+    EXPECT_GT(surface.sections()[k].flow_direction.z, 0.0f);  // flows along +Z
+    EXPECT_EQ(surface.vertex(k * 9).bank, Bank::kLeft);
+    EXPECT_EQ(surface.vertex(k * 9 + 8).bank, Bank::kRight);
+    if (k > 0) {
+      const float gap = surface.sections()[k].along - surface.sections()[k - 1].along;
+      EXPECT_NEAR(gap, params.section_spacing, 0.05f * params.section_spacing);
+    }
+  }
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    EXPECT_EQ(mesh.positions[v].y, river.water_level());
+    EXPECT_GE(mesh.depth[v], 0.0f);
+  }
+  // Water is deeper mid-river than at the banks.
+  EXPECT_GT(mesh.depth[4], mesh.depth[0]);
+  EXPECT_GT(mesh.depth[4], mesh.depth[8]);
+}
+
+TEST(ProceduralRiver, SeedChangesTheRiverDeterministically) {
+  ProceduralRiverParams a;
+  ProceduralRiverParams b = a;
+  b.seed = a.seed + 1;
+  RiverMesh ma, ma2, mb;
+  ASSERT_TRUE(ProceduralRiver(a).generate_mesh(&ma).ok());
+  ASSERT_TRUE(ProceduralRiver(a).generate_mesh(&ma2).ok());
+  ASSERT_TRUE(ProceduralRiver(b).generate_mesh(&mb).ok());
+  EXPECT_EQ(ma.positions, ma2.positions);
+  EXPECT_EQ(ma.indices, ma2.indices);
+  EXPECT_NE(ma.positions, mb.positions);
+}
+
+TEST(ProceduralRiver, BadParametersNameTheParameter) {
+  const std::pair<void (*)(ProceduralRiverParams&), const char*> cases[] = {
+      {[](ProceduralRiverParams& p) { p.length = -1.0f; }, "length"},
+      {[](ProceduralRiverParams& p) { p.width = NAN; }, "width"},
+      {[](ProceduralRiverParams& p) { p.width_variation = 1.0f; }, "width_variation"},
+      {[](ProceduralRiverParams& p) { p.section_spacing = 0.0f; }, "section_spacing"},
+      {[](ProceduralRiverParams& p) { p.vertices_across = 1; }, "vertices_across"},
+      {[](ProceduralRiverParams& p) { p.valley_half_width = 5.0f; }, "valley_half_width"},
+      {[](ProceduralRiverParams& p) { p.section_spacing = 1e-6f; }, "limit"},
+      {[](ProceduralRiverParams& p) {
+         p.meander_amplitude = 40.0f;
+         p.meander_wavelength = 60.0f;
+         p.width = 20.0f;
+       },
+       "cross"},
+  };
+  for (const auto& [edit, part] : cases) {
+    ProceduralRiverParams params;
+    edit(params);
+    RiverMesh mesh;
+    const Status status = ProceduralRiver(params).generate_mesh(&mesh);
+    ASSERT_FALSE(status.ok()) << part;
+    EXPECT_NE(status.message().find(part), std::string::npos) << status.message();
+  }
+}
+
+}  // namespace
+}  // namespace siviflow
