@@ -1,0 +1,95 @@
+// Google Benchmark of the river simulation core: surface build, full solve and an obstacle move
+// on procedural rivers of 10k to 4M vertices (issue 3, "Speed").
+#include <cstdint>
+#include <map>
+#include <memory>
+
+#include <benchmark/benchmark.h>
+
+#include "sim/procedural_river.h"
+#include "sim/river_surface.h"
+#include "sim/stream_function.h"
+
+namespace siviflow {
+namespace {
+
+constexpr uint32_t kAcross = 41;
+
+// A procedural river of about `vertices` vertices: 41 across, sections 0.3 m apart.
+const RiverMesh& river_mesh(int64_t vertices) {
+  static std::map<int64_t, std::unique_ptr<RiverMesh>> cache;
+  auto& slot = cache[vertices];
+  if (!slot) {
+    ProceduralRiverParams params;
+    params.vertices_across = kAcross;
+    params.section_spacing = 0.3f;
+    // Length along Z such that the arc length gives the wanted section count.
+    const double sections = double(vertices) / kAcross;
+    params.length = float(sections * params.section_spacing / 1.07);
+    slot = std::make_unique<RiverMesh>();
+    if (!ProceduralRiver(params).generate_mesh(slot.get()).ok()) slot->positions.clear();
+  }
+  return *slot;
+}
+
+StreamFunction make_flow(const RiverMesh& mesh) {
+  RiverSurface surface;
+  StreamFunction flow;
+  if (!RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok() ||
+      !StreamFunction::create(std::move(surface), {20.0f, 1.5f, 0.0f}, &flow).ok()) {
+    std::abort();
+  }
+  return flow;
+}
+
+void BM_SurfaceBuild(benchmark::State& state) {
+  const RiverMesh& mesh = river_mesh(state.range(0));
+  for (auto _ : state) {
+    RiverSurface surface;
+    benchmark::DoNotOptimize(RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(mesh.positions.size()));
+}
+
+void BM_FullSolve(benchmark::State& state) {
+  const RiverMesh& mesh = river_mesh(state.range(0));
+  StreamFunction flow = make_flow(mesh);
+  Obstacle rock;
+  rock.centre = mesh.positions[mesh.positions.size() / 2];
+  rock.radius = 1.5f;
+  if (!flow.set_obstacles({rock}).ok()) std::abort();
+  for (auto _ : state) {
+    flow.solve_full();
+    benchmark::DoNotOptimize(flow.node_psi().data());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(mesh.positions.size()));
+}
+
+void BM_MoveObstacle(benchmark::State& state) {
+  const RiverMesh& mesh = river_mesh(state.range(0));
+  StreamFunction flow = make_flow(mesh);
+  Obstacle rock;
+  const glm::vec3 centre = mesh.positions[mesh.positions.size() / 2];
+  rock.centre = centre;
+  rock.radius = 1.5f;
+  if (!flow.set_obstacles({rock}).ok()) std::abort();
+  int step = 0;
+  for (auto _ : state) {
+    // A boat drifting 5 cm per frame, back and forth.
+    const float dz = 0.05f * float(step % 40 < 20 ? step % 40 : 40 - step % 40);
+    if (!flow.move_obstacle(0, centre + glm::vec3(0.0f, 0.0f, dz)).ok()) std::abort();
+    ++step;
+  }
+  state.counters["resolved"] = double(flow.last_update().nodes_resolved);
+}
+
+BENCHMARK(BM_SurfaceBuild)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FullSolve)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MoveObstacle)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace siviflow
+
+BENCHMARK_MAIN();
