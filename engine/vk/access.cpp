@@ -151,6 +151,16 @@ ResourceState state_of(Access access) {
   return {info.stage, info.access, info.layout};
 }
 
+VkImageLayout image_layout(Access access, VkFormat format) {
+  const bool sampled = access == Access::SampledVertex || access == Access::SampledFragment ||
+                       access == Access::SampledCompute;
+  // Valid for sampling and for read-only depth/stencil attachments (unlike SHADER_READ_ONLY).
+  if (sampled && (aspect_of(format) & VK_IMAGE_ASPECT_COLOR_BIT) == 0) {
+    return VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+  }
+  return access_info(access).layout;
+}
+
 VkAccessFlags2 write_bits(VkAccessFlags2 access) { return access & kWriteAccess; }
 
 std::string stage_flags_name(VkPipelineStageFlags2 stages) { return flags_name(stages, kStageNames); }

@@ -61,6 +61,10 @@ inline const char* access_name(Access access) { return access_info(access).name;
 // The row as a state, e.g. to state an import: state_of(Access::HostRead).
 ResourceState state_of(Access access);
 
+// The layout a row uses on an image of `format`. Sampled rows on depth/stencil formats use
+// DEPTH_STENCIL_READ_ONLY_OPTIMAL, so one pass can sample an image and depth-test against it.
+VkImageLayout image_layout(Access access, VkFormat format);
+
 // The write bits of a mask (a barrier after them must make memory available).
 VkAccessFlags2 write_bits(VkAccessFlags2 access);
 inline bool has_write_access(VkAccessFlags2 access) { return write_bits(access) != 0; }

@@ -9,69 +9,6 @@
 namespace siviflow {
 namespace {
 
-// What a resource has been through since its last barrier, so that the next use gets exactly
-// the barrier it needs (Granite's invalidate/flush bookkeeping, per resource).
-struct Track {
-  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
-  VkPipelineStageFlags2 write_stage = 0;  // last write or layout transition: later uses wait on it
-  VkAccessFlags2 write_access = 0;        // its writes, still to be made available
-  VkPipelineStageFlags2 read_stages = 0;  // reads since: a later write must wait on them (WAR)
-  VkPipelineStageFlags2 visible_stages = 0;  // where the last write is already visible
-  VkAccessFlags2 visible_access = 0;
-};
-
-Track start_track(const ResourceState& incoming) {
-  Track track;
-  track.layout = incoming.layout;
-  if (has_write_access(incoming.access)) {
-    track.write_stage = incoming.stage;
-    track.write_access = write_bits(incoming.access);
-  } else {
-    track.read_stages = incoming.stage;  // a read needs no barrier before another read
-  }
-  return track;
-}
-
-// Moves the track to `use`; returns true and fills *src when a barrier is needed first.
-bool advance(Track& track, const ResourceState& use, bool image, ResourceState* src) {
-  const bool write = has_write_access(use.access);
-  const bool relayout = image && use.layout != track.layout;
-  bool needed = relayout;
-  if (!relayout && write) needed = (track.write_stage | track.read_stages) != 0;
-  if (!relayout && !write) {
-    needed = track.write_stage != 0 && ((use.stage & ~track.visible_stages) != 0 ||
-                                        (use.access & ~track.visible_access) != 0);
-  }
-  if (needed) {
-    // Reads only need waiting on when the barrier writes (new data or a layout transition).
-    src->stage = track.write_stage | ((write || relayout) ? track.read_stages : 0);
-    src->access = track.write_access;
-    src->layout = image ? track.layout : VK_IMAGE_LAYOUT_UNDEFINED;
-  }
-  if (write) {
-    track.write_stage = use.stage;
-    track.write_access = write_bits(use.access);
-    track.read_stages = 0;
-    track.visible_stages = 0;
-    track.visible_access = 0;
-  } else if (relayout) {
-    // The transition is a write that later uses reach by chaining through this use's stage.
-    track.write_stage = use.stage;
-    track.write_access = 0;
-    track.read_stages = use.stage;
-    track.visible_stages = use.stage;
-    track.visible_access = use.access;
-  } else {
-    track.read_stages |= use.stage;
-    if (needed) {
-      track.visible_stages |= use.stage;
-      track.visible_access |= use.access;
-    }
-  }
-  if (image) track.layout = use.layout;
-  return needed;
-}
-
 bool kind_allows(PassKind kind, Access access) {
   switch (access) {
     case Access::ColorAttachmentWrite:
@@ -137,6 +74,76 @@ const char* pass_kind_name(PassKind kind) {
     case PassKind::Graphics: return "graphics";
     default: return "compute";
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Barrier bookkeeping
+
+FrameGraph::Track FrameGraph::start_track(const ResourceState& incoming) {
+  Track track;
+  track.layout = incoming.layout;
+  if (has_write_access(incoming.access)) {
+    track.write_stage = incoming.stage;
+    track.write_access = write_bits(incoming.access);
+  } else {
+    track.read_stages = incoming.stage;  // a read needs no barrier before another read
+  }
+  return track;
+}
+
+// Moves the track to `use`; returns true and fills *src when a barrier is needed first.
+bool FrameGraph::advance(Track& track, const ResourceState& use, bool image, ResourceState* src) {
+  const bool write = has_write_access(use.access);
+  const bool relayout = image && use.layout != track.layout;
+  bool needed = relayout;
+  if (!relayout && write) needed = (track.write_stage | track.read_stages) != 0;
+  if (!relayout && !write) {
+    needed = track.write_stage != 0 && ((use.stage & ~track.visible_stages) != 0 ||
+                                        (use.access & ~track.visible_access) != 0);
+  }
+  if (needed) {
+    // Reads only need waiting on when the barrier writes (new data or a layout transition).
+    src->stage = track.write_stage | ((write || relayout) ? track.read_stages : 0);
+    src->access = track.write_access;
+    src->layout = image ? track.layout : VK_IMAGE_LAYOUT_UNDEFINED;
+  }
+  if (write) {
+    track.write_stage = use.stage;
+    track.write_access = write_bits(use.access);
+    track.read_stages = 0;
+    track.visible_stages = 0;
+    track.visible_access = 0;
+  } else if (relayout) {
+    // The transition is a write that later uses reach by chaining through this use's stage.
+    track.write_stage = use.stage;
+    track.write_access = 0;
+    track.read_stages = use.stage;
+    track.visible_stages = use.stage;
+    track.visible_access = use.access;
+  } else {
+    track.read_stages |= use.stage;
+    if (needed) {
+      track.visible_stages |= use.stage;
+      track.visible_access |= use.access;
+    }
+  }
+  if (image) track.layout = use.layout;
+  return needed;
+}
+
+// The hand-over to an outgoing state: whoever comes next only waits on out.stage, so every
+// read not already in those stages must be chained into them, even when advance() needs no wait.
+bool FrameGraph::finish(const Track& track, const ResourceState& out, bool image,
+                        ResourceState* src) {
+  Track next = track;
+  bool needed = advance(next, out, image, src);
+  if (out.stage != 0 && (track.read_stages & ~out.stage) != 0) needed = true;
+  if (needed) {
+    src->stage = track.write_stage | track.read_stages;
+    src->access = track.write_access;
+    src->layout = image ? track.layout : VK_IMAGE_LAYOUT_UNDEFINED;
+  }
+  return needed;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -362,6 +369,8 @@ uint32_t FrameGraph::add_use(uint32_t p, uint32_t id, uint32_t version, bool ima
       return version;
     }
   }
+  const VkImageLayout layout =
+      image ? image_layout(access, r.image.format) : VK_IMAGE_LAYOUT_UNDEFINED;
   const bool writes = has_write_access(info.access);
   bool reads = !writes;  // plain writes (transfer, storage) overwrite what they touch
   if (role != Role::Plain && writes) {
@@ -380,7 +389,7 @@ uint32_t FrameGraph::add_use(uint32_t p, uint32_t id, uint32_t version, bool ima
       }
       continue;
     }
-    if (image && use.state.layout != info.layout) {
+    if (image && use.state.layout != layout) {
       fail(where + " uses '" + r.name + "' as " + use.verbs + " and " + info.name +
            ", which need different layouts");
       return version;
@@ -428,7 +437,7 @@ uint32_t FrameGraph::add_use(uint32_t p, uint32_t id, uint32_t version, bool ima
   use.writes = writes;
   use.role = role;
   use.load = load;
-  use.state = {info.stage, info.access, image ? info.layout : VK_IMAGE_LAYOUT_UNDEFINED};
+  use.state = {info.stage, info.access, layout};
   use.image_usage = info.image_usage;
   use.buffer_usage = info.buffer_usage;
   use.verbs = info.name;
@@ -443,11 +452,16 @@ uint32_t FrameGraph::add_use(uint32_t p, uint32_t id, uint32_t version, bool ima
 
 Status FrameGraph::compile() {
   compiled_ = false;
+  cached_valid_ = false;
   steps_.clear();
-  final_barriers_.clear();
+  starts_.clear();
+  barriers_ = Barriers{};
 
   // 1. Validate: declaration errors first (they name both passes), then whole-graph rules.
   if (!error_.empty()) return Status::error(error_);
+  for (uint32_t i = 0; i < resources_.size(); ++i) {
+    if (resources_[i].outgoing) SIVIFLOW_TRY(check_outgoing(i, *resources_[i].outgoing));
+  }
   for (const Pass& pass : passes_) {
     const std::string where = "frame graph: pass '" + pass.name + "'";
     for (const Use& use : pass.uses) {
@@ -494,7 +508,6 @@ Status FrameGraph::compile() {
 
   // 4. Usage flags and liveness, from the surviving passes only.
   std::vector<std::vector<bool>> read_later(resources_.size());
-  std::vector<std::optional<ResourceState>> last_use(resources_.size());
   for (size_t i = 0; i < resources_.size(); ++i) {
     resources_[i].image_usage = 0;
     resources_[i].buffer_usage = 0;
@@ -509,7 +522,6 @@ Status FrameGraph::compile() {
       r.buffer_usage |= use.buffer_usage;
       r.live = true;
       if (use.reads) read_later[use.resource][use.version] = true;
-      last_use[use.resource] = use.state;
     }
   }
 
@@ -541,49 +553,83 @@ Status FrameGraph::compile() {
     steps_.push_back(std::move(step));
   }
 
-  // 6. Barriers. Graph-owned resources start where their last use of the previous frame left
-  //    them (transient contents are discarded: undefined layout), imports where the host said.
-  std::vector<ResourceState> incoming(resources_.size());
-  std::vector<std::optional<ResourceState>> outgoing(resources_.size());
+  // 6. Barriers. Imports start where the host said; graph-owned resources where the previous
+  //    frame left them (transients in undefined layout), found by running frames until the
+  //    carried state repeats (within three runs: only the first use depends on the start).
+  starts_.resize(resources_.size());
   for (size_t i = 0; i < resources_.size(); ++i) {
-    Resource& r = resources_[i];
-    if (r.origin != Origin::Imported && last_use[i]) {
-      r.incoming = *last_use[i];
-      if (r.origin == Origin::Transient) r.incoming.layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    }
-    incoming[i] = r.incoming;
-    outgoing[i] = r.outgoing;
+    const Resource& r = resources_[i];
+    starts_[i] = r.origin == Origin::Imported ? start_track(r.incoming) : Track{};
   }
-  derive_barriers(incoming, outgoing, steps_, final_barriers_);
+  std::vector<Track> ends;
+  constexpr int kMaxRuns = 8;
+  for (int run = 0;; ++run) {
+    derive_barriers(starts_, {}, barriers_, &ends);
+    bool settled = true;
+    for (size_t i = 0; i < resources_.size(); ++i) {
+      const Resource& r = resources_[i];
+      if (r.origin == Origin::Imported) continue;
+      Track carried = ends[i];
+      if (r.origin == Origin::Transient) carried.layout = VK_IMAGE_LAYOUT_UNDEFINED;
+      if (carried == starts_[i]) continue;
+      starts_[i] = carried;
+      settled = false;
+    }
+    if (settled) break;
+    if (run + 1 == kMaxRuns) {
+      barriers_ = Barriers{};
+      return Status::error("frame graph: internal error: the state carried between frames does "
+                           "not settle");
+    }
+  }
   compiled_ = true;
   return Status();
 }
 
-void FrameGraph::derive_barriers(const std::vector<ResourceState>& incoming,
-                                 const std::vector<std::optional<ResourceState>>& outgoing,
-                                 std::vector<Step>& steps,
-                                 std::vector<Barrier>& final_barriers) const {
-  std::vector<Track> tracks;
-  tracks.reserve(resources_.size());
-  for (const ResourceState& state : incoming) tracks.push_back(start_track(state));
-  for (Step& step : steps) {
-    step.barriers.clear();
-    for (const Use& use : passes_[step.pass].uses) {
+Status FrameGraph::check_outgoing(uint32_t resource, const ResourceState& outgoing) const {
+  const Resource& r = resources_[resource];
+  if (!r.is_image || (outgoing.layout != VK_IMAGE_LAYOUT_UNDEFINED &&
+                      outgoing.layout != VK_IMAGE_LAYOUT_PREINITIALIZED)) {
+    return Status();
+  }
+  // VUID-VkImageMemoryBarrier2-newLayout-01198: a barrier cannot transition to these layouts.
+  return Status::error("frame graph: the outgoing state of '" + r.name + "' has layout " +
+                       layout_name(outgoing.layout) +
+                       ", which no barrier may transition to; state the layout its next user "
+                       "needs");
+}
+
+void FrameGraph::derive_barriers(const std::vector<Track>& starts,
+                                 const std::vector<Override>& overrides, Barriers& out,
+                                 std::vector<Track>* ends) const {
+  std::vector<Track> tracks = starts;
+  for (size_t i = 0; i < overrides.size(); ++i) {
+    if (overrides[i].incoming) tracks[i] = start_track(*overrides[i].incoming);
+  }
+  out.steps.resize(steps_.size());
+  for (size_t s = 0; s < steps_.size(); ++s) {
+    std::vector<Barrier>& barriers = out.steps[s];
+    barriers.clear();
+    for (const Use& use : passes_[steps_[s].pass].uses) {
       Barrier barrier{use.resource, {}, use.state};
       if (advance(tracks[use.resource], use.state, resources_[use.resource].is_image,
                   &barrier.src)) {
-        step.barriers.push_back(barrier);
+        barriers.push_back(barrier);
       }
     }
   }
-  final_barriers.clear();
+  out.final.clear();
   for (uint32_t i = 0; i < resources_.size(); ++i) {
-    if (!outgoing[i]) continue;
+    const std::optional<ResourceState>& outgoing =
+        i < overrides.size() && overrides[i].outgoing ? overrides[i].outgoing
+                                                      : resources_[i].outgoing;
+    if (!outgoing) continue;
     const bool image = resources_[i].is_image;
-    Barrier barrier{i, {}, *outgoing[i]};
+    Barrier barrier{i, {}, *outgoing};
     if (!image) barrier.dst.layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    if (advance(tracks[i], barrier.dst, image, &barrier.src)) final_barriers.push_back(barrier);
+    if (finish(tracks[i], barrier.dst, image, &barrier.src)) out.final.push_back(barrier);
   }
+  if (ends != nullptr) *ends = std::move(tracks);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -592,8 +638,10 @@ void FrameGraph::derive_barriers(const std::vector<ResourceState>& incoming,
 void FrameGraph::emit_barriers(const DeviceTable& table, VkCommandBuffer cmd,
                                const FrameBindings& bindings,
                                const std::vector<Barrier>& barriers) const {
-  std::vector<VkImageMemoryBarrier2> images;
-  std::vector<VkBufferMemoryBarrier2> buffers;
+  std::vector<VkImageMemoryBarrier2>& images = image_scratch_;
+  std::vector<VkBufferMemoryBarrier2>& buffers = buffer_scratch_;
+  images.clear();
+  buffers.clear();
   for (const Barrier& b : barriers) {
     const Resource& r = resources_[b.resource];
     const FrameBindings::Bound* bound = bindings.find(b.resource);  // checked by execute()
@@ -642,42 +690,12 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
     return Status::error("frame graph: execute() needs a command buffer and a loaded table");
   }
 
-  // Per-execute states replace the declared ones; the barriers are then derived again.
-  const std::vector<Step>* steps = &steps_;
-  const std::vector<Barrier>* final_barriers = &final_barriers_;
-  std::vector<Step> local_steps;
-  std::vector<Barrier> local_final;
-  std::vector<ResourceState> incoming;
-  std::vector<std::optional<ResourceState>> outgoing;
-  for (uint32_t i = 0; i < resources_.size(); ++i) {
-    const Resource& r = resources_[i];
-    const FrameBindings::Bound* bound = bindings.find(i);
-    const bool in = bound != nullptr && bound->incoming.has_value();
-    const bool out = bound != nullptr && bound->outgoing.has_value();
-    if ((in && r.origin == Origin::Transient) || (out && r.origin != Origin::Imported)) {
-      return Status::error("frame graph: '" + r.name +
-                           "' takes no per-execute state (only imports, and persistent images "
-                           "for their incoming state)");
-    }
-    if (!in && !out) continue;
-    if (incoming.empty()) {
-      for (const Resource& each : resources_) {
-        incoming.push_back(each.incoming);
-        outgoing.push_back(each.outgoing);
-      }
-    }
-    if (in) incoming[i] = *bound->incoming;
-    if (out) outgoing[i] = *bound->outgoing;
-  }
-  if (!incoming.empty()) {
-    local_steps = steps_;
-    derive_barriers(incoming, outgoing, local_steps, local_final);
-    steps = &local_steps;
-    final_barriers = &local_final;
-  }
+  Status state_status;
+  const Barriers* barriers = barriers_for(bindings, &state_status);
+  if (barriers == nullptr) return state_status;
 
   // Every handle is checked before the first command, so a binding error records nothing.
-  auto check_bound = [&](uint32_t id, bool need_view) -> Status {
+  auto check_bound = [&](uint32_t id, const Pass* pass, bool need_view) -> Status {
     const Resource& r = resources_[id];
     const FrameBindings::Bound* bound = bindings.find(id);
     const bool ok = bound != nullptr &&
@@ -685,25 +703,32 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
                                       (!need_view || bound->view != VK_NULL_HANDLE)
                                 : bound->buffer != VK_NULL_HANDLE);
     if (ok) return Status();
-    return Status::error("frame graph: '" + r.name + "' is not bound" +
+    const std::string what = pass != nullptr
+                                 ? "pass '" + pass->name + "' uses '" + r.name + "', which"
+                                 : "'" + r.name + "' (transitioned to its outgoing state)";
+    return Status::error("frame graph: " + what + " is not bound" +
                          (need_view ? " (an attachment needs a VkImageView)" : ""));
   };
-  for (const Step& step : *steps) {
-    for (const Use& use : passes_[step.pass].uses) {
-      SIVIFLOW_TRY(check_bound(use.resource, use.role != Role::Plain));
+  for (const Step& step : steps_) {
+    const Pass& pass = passes_[step.pass];
+    for (const Use& use : pass.uses) {
+      SIVIFLOW_TRY(check_bound(use.resource, &pass, use.role != Role::Plain));
     }
   }
-  for (const Barrier& barrier : *final_barriers) SIVIFLOW_TRY(check_bound(barrier.resource, false));
+  for (const Barrier& barrier : barriers->final) {
+    SIVIFLOW_TRY(check_bound(barrier.resource, nullptr, false));
+  }
 
   const bool labels = table.has_debug_labels() && table.vkCmdEndDebugUtilsLabelEXT != nullptr;
-  for (const Step& step : *steps) {
+  for (size_t s = 0; s < steps_.size(); ++s) {
+    const Step& step = steps_[s];
     const Pass& pass = passes_[step.pass];
     if (labels) {
       VkDebugUtilsLabelEXT label{VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT};
       label.pLabelName = pass.name.c_str();
       table.vkCmdBeginDebugUtilsLabelEXT(cmd, &label);
     }
-    emit_barriers(table, cmd, bindings, step.barriers);
+    emit_barriers(table, cmd, bindings, barriers->steps[s]);
     if (pass.kind == PassKind::Graphics) {
       auto attachment_info = [&](const Attachment& a) {
         VkRenderingAttachmentInfo info{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
@@ -714,7 +739,8 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
         info.clearValue = resources_[a.resource].image.clear;
         return info;
       };
-      std::vector<VkRenderingAttachmentInfo> colors;
+      std::vector<VkRenderingAttachmentInfo>& colors = color_scratch_;
+      colors.clear();
       for (const Attachment& a : step.colors) colors.push_back(attachment_info(a));
       VkRenderingAttachmentInfo depth{};
       if (step.depth) depth = attachment_info(*step.depth);
@@ -735,8 +761,47 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
                            status.code());
     }
   }
-  emit_barriers(table, cmd, bindings, *final_barriers);
+  emit_barriers(table, cmd, bindings, barriers->final);
   return Status();
+}
+
+// The declared states' barriers when nothing is overridden; otherwise those of the override set,
+// derived again only when it differs from the previous execute's. Null (and *status) on error.
+const FrameGraph::Barriers* FrameGraph::barriers_for(const FrameBindings& bindings,
+                                                     Status* status) const {
+  bool any = false;
+  bool same = cached_valid_;
+  for (uint32_t i = 0; i < resources_.size(); ++i) {
+    const Resource& r = resources_[i];
+    const FrameBindings::Bound* bound = bindings.find(i);
+    const bool in = bound != nullptr && bound->incoming.has_value();
+    const bool out = bound != nullptr && bound->outgoing.has_value();
+    if ((in && r.origin == Origin::Transient) || (out && r.origin != Origin::Imported)) {
+      *status = Status::error("frame graph: '" + r.name +
+                              "' takes no per-execute state (only imports, and persistent images "
+                              "for their incoming state)");
+      return nullptr;
+    }
+    if (out) {
+      *status = check_outgoing(i, *bound->outgoing);
+      if (!status->ok()) return nullptr;
+    }
+    any = any || in || out;
+    if (same) {
+      same = bound != nullptr ? cached_key_[i] == Override{bound->incoming, bound->outgoing}
+                              : cached_key_[i] == Override{};
+    }
+  }
+  if (!any) return &barriers_;
+  if (same) return &cached_;
+  cached_key_.assign(resources_.size(), Override{});
+  for (uint32_t i = 0; i < resources_.size(); ++i) {
+    const FrameBindings::Bound* bound = bindings.find(i);
+    if (bound != nullptr) cached_key_[i] = {bound->incoming, bound->outgoing};
+  }
+  derive_barriers(starts_, cached_key_, cached_, nullptr);
+  cached_valid_ = true;
+  return &cached_;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -788,9 +853,10 @@ std::string FrameGraph::dump_text() const {
       out += "culled " + pass.name + " (" + kind + ")\n";
       continue;
     }
+    const std::vector<Barrier>& barriers = barriers_.steps[next];
     const Step& step = steps_[next++];
     out += "pass " + pass.name + " (" + kind + ")\n";
-    for (const Barrier& barrier : step.barriers) out += "  " + barrier_line(barrier) + "\n";
+    for (const Barrier& barrier : barriers) out += "  " + barrier_line(barrier) + "\n";
     auto attachment_line = [&](const char* what, const Attachment& a) {
       out += std::string("  ") + what + " " + resources_[a.resource].name + ": load " +
              load_name(a.load) + ", store " + store_name(a.store) + "\n";
@@ -799,7 +865,7 @@ std::string FrameGraph::dump_text() const {
     if (step.depth) attachment_line("depth", *step.depth);
   }
   out += "final\n";
-  for (const Barrier& barrier : final_barriers_) out += "  " + barrier_line(barrier) + "\n";
+  for (const Barrier& barrier : barriers_.final) out += "  " + barrier_line(barrier) + "\n";
   return out;
 }
 

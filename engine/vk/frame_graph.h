@@ -22,12 +22,22 @@
 // - Passes that reach no output are culled. Outputs are imported resources with an outgoing
 //   state, persistent images, and passes marked side_effect() (e.g. a readback).
 // - Transient images lose their contents between frames; their first barrier in a frame
-//   waits on their last use of the previous frame, so one image may serve every frame slot.
+//   waits on every use of the previous frame not yet ordered by a barrier (the last write and
+//   all reads since), so one image may serve every frame slot.
 //   Persistent images keep their contents: the graph assumes they start each frame in the
-//   state their last use left them; on the first execute after creating one, the owner must
-//   call FrameBindings::set_incoming(handle, ResourceState{}) (undefined layout).
+//   state the previous frame left them (the same steady state every frame); on the first
+//   execute after creating one, the owner must call
+//   FrameBindings::set_incoming(handle, ResourceState{}) (undefined layout).
 // - Imported images and buffers start in the incoming state given at import (or overridden
-//   per execute) and are handed back in their outgoing state after the last pass.
+//   per execute) and are handed back in their outgoing state after the last pass: the final
+//   transition makes every access of the frame (reads included) happen before the outgoing
+//   stage. An image's outgoing layout must not be UNDEFINED or PREINITIALIZED (a barrier cannot
+//   transition to them); compile() and execute() reject that, naming the resource.
+// - Images with a depth/stencil format are sampled in DEPTH_STENCIL_READ_ONLY_OPTIMAL, so a
+//   pass may both depth_read() and sample one image. Descriptors must take their layout from
+//   PassContext::layout().
+// - execute() derives barriers again only when the per-execute states differ from the previous
+//   execute's; with the same states every frame (or none), it neither derives nor allocates.
 // - execute() records into the caller's command buffer, outside any render pass; it never
 //   submits or waits. If it returns an error after recording started, discard the buffer.
 // - Not thread-safe; handles and PassBuilders must not outlive (or be moved away from) their
@@ -202,6 +212,7 @@ class FrameGraph {
 
   // Records every surviving pass into cmd, then the transitions to the outgoing states. Every
   // resource a surviving pass uses must be bound (attachments with a view); checked first.
+  // Const for callers, but it keeps caches (barriers per override set, scratch arrays).
   Status execute(const DeviceTable& table, VkCommandBuffer cmd,
                  const FrameBindings& bindings) const;
 
@@ -270,10 +281,29 @@ class FrameGraph {
   };
   struct Step {  // one surviving pass, ready to record
     uint32_t pass = kNoPass;
-    std::vector<Barrier> barriers;
     std::vector<Attachment> colors;
     std::optional<Attachment> depth;
     VkExtent2D extent{};
+  };
+  struct Barriers {  // derived from one set of incoming and outgoing states
+    std::vector<std::vector<Barrier>> steps;  // before each step, parallel to steps_
+    std::vector<Barrier> final;               // to the outgoing states
+  };
+  // What a resource has been through since its last barrier, so that the next use gets exactly
+  // the barrier it needs (Granite's invalidate/flush bookkeeping, per resource).
+  struct Track {
+    VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    VkPipelineStageFlags2 write_stage = 0;  // last write or layout transition: later uses wait
+    VkAccessFlags2 write_access = 0;        // its writes, still to be made available
+    VkPipelineStageFlags2 read_stages = 0;  // reads since: a later write must wait on them (WAR)
+    VkPipelineStageFlags2 visible_stages = 0;  // where the last write is already visible
+    VkAccessFlags2 visible_access = 0;
+    bool operator==(const Track&) const = default;
+  };
+  struct Override {  // one resource's per-execute states
+    std::optional<ResourceState> incoming;
+    std::optional<ResourceState> outgoing;
+    bool operator==(const Override&) const = default;
   };
 
   uint32_t add_resource(std::string name, bool is_image, Origin origin, ResourceState incoming,
@@ -286,9 +316,14 @@ class FrameGraph {
                    LoadOp load);
   void fail(std::string message);
   const Use* find_use(uint32_t pass, uint32_t id) const;
-  void derive_barriers(const std::vector<ResourceState>& incoming,
-                       const std::vector<std::optional<ResourceState>>& outgoing,
-                       std::vector<Step>& steps, std::vector<Barrier>& final_barriers) const;
+  static Track start_track(const ResourceState& incoming);
+  static bool advance(Track& track, const ResourceState& use, bool image, ResourceState* src);
+  static bool finish(const Track& track, const ResourceState& out, bool image, ResourceState* src);
+  // overrides is empty or has one entry per resource; ends (if given) gets the final tracks.
+  void derive_barriers(const std::vector<Track>& starts, const std::vector<Override>& overrides,
+                       Barriers& out, std::vector<Track>* ends) const;
+  Status check_outgoing(uint32_t resource, const ResourceState& outgoing) const;
+  const Barriers* barriers_for(const FrameBindings& bindings, Status* status) const;
   void emit_barriers(const DeviceTable& table, VkCommandBuffer cmd, const FrameBindings& bindings,
                      const std::vector<Barrier>& barriers) const;
   std::string barrier_line(const Barrier& barrier) const;
@@ -298,7 +333,16 @@ class FrameGraph {
   std::string error_;  // first declaration error
   bool compiled_ = false;
   std::vector<Step> steps_;
-  std::vector<Barrier> final_barriers_;
+  std::vector<Track> starts_;  // where each resource starts a frame (no overrides)
+  Barriers barriers_;          // for the declared states: the listing of dump_text()
+
+  // execute() caches: barriers for the last override set, and scratch arrays reused per call.
+  mutable bool cached_valid_ = false;
+  mutable std::vector<Override> cached_key_;
+  mutable Barriers cached_;
+  mutable std::vector<VkImageMemoryBarrier2> image_scratch_;
+  mutable std::vector<VkBufferMemoryBarrier2> buffer_scratch_;
+  mutable std::vector<VkRenderingAttachmentInfo> color_scratch_;
 };
 
 }  // namespace siviflow
