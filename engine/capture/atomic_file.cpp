@@ -1,4 +1,4 @@
-#include "capture/atomic_file.h"
+#include "siviflow/atomic_file.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <exception>
 
-#include "capture/atomic_file.h"
+#include "siviflow/atomic_file.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow {

@@ -14,7 +14,7 @@
 #include <exception>
 #include <set>
 
-#include "capture/atomic_file.h"
+#include "siviflow/atomic_file.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow {

@@ -8,7 +8,7 @@
 #include <cstring>
 #include <exception>
 
-#include "capture/atomic_file.h"
+#include "siviflow/atomic_file.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow {

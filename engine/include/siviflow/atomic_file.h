@@ -1,4 +1,4 @@
-// Whole-file atomic replacement, shared by the EXR and PNG writers.
+// Whole-file atomic replacement, shared by every file SiViFlow writes (EXR, PNG, CSV).
 #pragma once
 
 #include <cstddef>

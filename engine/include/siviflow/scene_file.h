@@ -1,0 +1,125 @@
+// The scene file, version 1: JSON that says which river to simulate, how it flows, what stands in
+// it, where the camera goes and how to render. Its JSON Schema (draft 2020-12) is
+// engine/scene/scene.schema.json; keep the two in step.
+//
+//   { "$schema": "...",                                   optional, ignored (for editors)
+//     "version": 1,                                       required, must be 1
+//     "river": { "gltf": "river.glb", "mesh": "River" }   required: a glTF river (mesh optional:
+//            | { "procedural": { ...params..., "seed": 7 } }        first mesh), or the generator
+//     "flow":      { "discharge": 20.0, "p": 1.5, "search_radius": 30.0 },
+//     "obstacles": [ { "center": [x,y,z], "radius": 1.5,
+//                      "keys": [ { "t": 0.0, "center": [..] } ] } ],
+//     "objects":   [ { "gltf": "duck.glb", "translation": [..], "rotation": [x,y,z,w],
+//                      "scale": [..], "obstacle": true } ],
+//     "camera":    { "fov_y_deg": 50, "keys": [ { "t": 0.0, "position": [..], "target": [..] } ] },
+//     "render":    { "size": [1280, 720], "fps": 30, "seed": 1 } }
+//
+// Defaults of everything optional (metres, seconds, degrees; glTF axes: +Y up):
+//   river.mesh              first mesh of the file
+//   river.procedural.*      each field of ProceduralRiverParams (sim/procedural_river.h) is
+//                           optional with that struct's default; see procedural_river_keys()
+//   flow.discharge          kDefaultSceneDischarge (20 m^2/s)
+//   flow.p                  kDefaultShepardPower (1.5)
+//   flow.search_radius      absent: 3 x the widest section (FlowParams::search_radius = 0)
+//   obstacles               none; keys: none (the obstacle stays at `center`)
+//   objects[].translation   [0, 0, 0];  rotation [0, 0, 0, 1] (normalised on load);
+//   objects[].scale         [1, 1, 1];  obstacle false
+//   camera.fov_y_deg        kDefaultCameraFovYDeg (50)
+//   camera.keys             none: the built-in camera that glides down the river
+//   render.size             [1280, 720];  fps 30;  seed 1
+//
+// Rules: unknown keys and duplicate keys are errors; numbers must be finite; key lists are
+// strictly increasing in t; `gltf` paths are relative to the scene file's folder (absolute paths
+// are kept). Every error message is "<file>: <json path>: <what is wrong>", e.g.
+// "scene.json: obstacles[1].keys[2].t: keys are not sorted by t (1.5 after 2)".
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "sim/obstacle.h"
+#include "sim/procedural_river.h"
+#include "sim/status.h"
+#include "sim/stream_function.h"
+
+namespace siviflow {
+
+// --- Limits and defaults of the scene file, in one place ---------------------------------------
+inline constexpr uint32_t kSceneFileVersion = 1;
+inline constexpr size_t kMaxSceneFileBytes = size_t{16} << 20;  // hand-written JSON is tiny
+inline constexpr int kMaxSceneJsonDepth = 64;  // the format nests 5 levels; deeper is hostile
+inline constexpr uint32_t kMaxRenderDimension = 16384;  // maxImageDimension2D of common devices
+inline constexpr double kMaxRenderFps = 1000.0;
+inline constexpr size_t kMaxSceneObjects = 4096;
+inline constexpr size_t kMaxCameraKeys = size_t{1} << 20;
+inline constexpr float kDefaultSceneDischarge = 20.0f;  // m^2/s: ~1.7 m/s in the default 12 m river
+inline constexpr float kDefaultCameraFovYDeg = 50.0f;
+inline constexpr uint32_t kDefaultRenderWidth = 1280;
+inline constexpr uint32_t kDefaultRenderHeight = 720;
+inline constexpr double kDefaultRenderFps = 30.0;
+inline constexpr uint32_t kDefaultRenderSeed = 1;
+
+struct SceneRiver {
+  enum class Source : uint8_t { kProcedural, kGltf };
+  Source source = Source::kProcedural;
+  std::string gltf;                  // kGltf: the file, resolved against the scene's folder
+  std::string mesh;                  // kGltf: mesh name; empty: the first mesh
+  ProceduralRiverParams procedural;  // kProcedural: the generator's parameters
+};
+
+struct SceneObject {
+  std::string gltf;  // resolved against the scene's folder
+  glm::vec3 translation{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // unit; the file writes it x, y, z, w as glTF does
+  glm::vec3 scale{1.0f};                       // every component non-zero
+  bool obstacle = false;                       // its footprint on the water plane cuts the river
+};
+
+struct CameraKey {
+  double t = 0.0;  // seconds
+  glm::vec3 position{0.0f};
+  glm::vec3 target{0.0f};  // differs from position
+};
+
+struct SceneCamera {
+  float fov_y_deg = kDefaultCameraFovYDeg;  // in (0, 180)
+  std::vector<CameraKey> keys;  // strictly increasing t; empty: the built-in river camera
+};
+
+struct SceneRender {
+  uint32_t width = kDefaultRenderWidth;  // 1 .. kMaxRenderDimension
+  uint32_t height = kDefaultRenderHeight;
+  double fps = kDefaultRenderFps;  // (0, kMaxRenderFps]
+  uint32_t seed = kDefaultRenderSeed;
+};
+
+struct SceneFile {
+  std::string path;    // the file as given
+  std::string folder;  // absolute folder that relative paths were resolved against
+  SceneRiver river;
+  FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
+  std::vector<Obstacle> obstacles;  // circles (radius > 0), keys optional
+  std::vector<SceneObject> objects;
+  SceneCamera camera;
+  SceneRender render;
+};
+
+// Reads and checks a scene file (regular file, at most kMaxSceneFileBytes). `out` is left
+// untouched on failure. Does not open the glTF files it names.
+Status load_scene_file(const std::string& path, SceneFile* out);
+
+// The same from text already in memory: `file` names it in messages and `folder` is what
+// relative paths are resolved against (for tests and fuzzing).
+Status parse_scene_file(std::string_view text, const std::string& file, const std::string& folder,
+                        SceneFile* out);
+
+// The keys `river.procedural` accepts: the fields of ProceduralRiverParams.
+std::vector<std::string> procedural_river_keys();
+
+}  // namespace siviflow
