@@ -1,7 +1,5 @@
 // The siviflow command end to end: bad input gets exit status 1 and a message naming the
 // problem; a capture writes readable EXR frames (and PNG previews) validation-clean.
-#include <sys/wait.h>
-
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -9,31 +7,13 @@
 
 #include <gtest/gtest.h>
 
+#include "run_command.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow::testing {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-RunResult run(const std::string& args, const std::string& env = "") {
-  const std::string command =
-      env + " " + std::string(SIVIFLOW_BINARY_DIR) + "/tools/siviflow " + args + " 2>&1";
-  RunResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  size_t n = 0;
-  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
 
 class CliTest : public ::testing::Test {
  protected:
@@ -52,64 +32,64 @@ class CliTest : public ::testing::Test {
 };
 
 TEST_F(CliTest, UnknownCommandAndFlag) {
-  expect_error(run("frobnicate"), "unknown command 'frobnicate'");
-  expect_error(run("capture --out " + dir_.string() + " --bogus"), "unknown option '--bogus'");
-  expect_error(run("capture --frames 2"), "--out DIR is required");
-  expect_error(run("capture --frames 0 --out " + dir_.string()), "--frames");
-  expect_error(run("capture --aov nonsense --out " + dir_.string()), "unknown AOV 'nonsense'");
-  expect_error(run("info --bogus"), "unknown argument '--bogus'");
+  expect_error(run_siviflow("frobnicate"), "unknown command 'frobnicate'");
+  expect_error(run_siviflow("capture --out " + dir_.string() + " --bogus"), "unknown option '--bogus'");
+  expect_error(run_siviflow("capture --frames 2"), "--out DIR is required");
+  expect_error(run_siviflow("capture --frames 0 --out " + dir_.string()), "--frames");
+  expect_error(run_siviflow("capture --aov nonsense --out " + dir_.string()), "unknown AOV 'nonsense'");
+  expect_error(run_siviflow("info --bogus"), "unknown argument '--bogus'");
 }
 
 TEST_F(CliTest, BadSizes) {
   const std::string out = " --out " + dir_.string();
-  expect_error(run("capture --size 0x720" + out), "width and height must be at least 1");
-  expect_error(run("capture --size -5x720" + out), "invalid value '-5x720'");
-  expect_error(run("capture --size axb" + out), "invalid value 'axb'");
-  expect_error(run("capture --size 1280" + out), "expected WIDTHxHEIGHT");
-  expect_error(run("capture --size 20000x16" + out), "exceeds the device limit");
-  expect_error(run("capture --size 16000x16000" + out), "memory budget");
+  expect_error(run_siviflow("capture --size 0x720" + out), "width and height must be at least 1");
+  expect_error(run_siviflow("capture --size -5x720" + out), "invalid value '-5x720'");
+  expect_error(run_siviflow("capture --size axb" + out), "invalid value 'axb'");
+  expect_error(run_siviflow("capture --size 1280" + out), "expected WIDTHxHEIGHT");
+  expect_error(run_siviflow("capture --size 20000x16" + out), "exceeds the device limit");
+  expect_error(run_siviflow("capture --size 16000x16000" + out), "memory budget");
 }
 
 TEST_F(CliTest, BadOutputFolder) {
-  expect_error(run("capture --out " + (dir_ / "missing").string()), "missing");
+  expect_error(run_siviflow("capture --out " + (dir_ / "missing").string()), "missing");
   const fs::path file = dir_.parent_path() / "plain_file";
   FILE* f = std::fopen(file.c_str(), "w");
   ASSERT_NE(f, nullptr);
   std::fclose(f);
-  expect_error(run("capture --out " + file.string()), "is not a folder");
+  expect_error(run_siviflow("capture --out " + file.string()), "is not a folder");
 }
 
 TEST_F(CliTest, NoVulkanDriver) {
-  const RunResult r = run("capture --frames 1 --size 32x32 --out " + dir_.string(),
+  const RunResult r = run_siviflow("capture --frames 1 --size 32x32 --out " + dir_.string(),
                           "VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json");
   expect_error(r, "no Vulkan driver");
-  expect_error(run("info", "VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json"),
+  expect_error(run_siviflow("info", "VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json"),
                "no Vulkan driver");
 }
 
 TEST_F(CliTest, MissingRequiredFeatureIsNamed) {
-  const RunResult r = run("capture --frames 1 --size 32x32 --out " + dir_.string(),
+  const RunResult r = run_siviflow("capture --frames 1 --size 32x32 --out " + dir_.string(),
                           "SIVIFLOW_HIDE_DEVICE_FEATURES=shaderClipDistance");
   expect_error(r, "shaderClipDistance");
 }
 
 TEST_F(CliTest, MissingValidationLayerIsAFailureNotASkip) {
-  const RunResult r = run("capture --frames 1 --size 32x32 --validation --out " + dir_.string(),
+  const RunResult r = run_siviflow("capture --frames 1 --size 32x32 --validation --out " + dir_.string(),
                           "VK_LAYER_PATH=/nonexistent-layers");
   expect_error(r, "VK_LAYER_KHRONOS_validation is required but not installed");
-  const RunResult info = run("info", "VK_LAYER_PATH=/nonexistent-layers");
+  const RunResult info = run_siviflow("info", "VK_LAYER_PATH=/nonexistent-layers");
   EXPECT_NE(info.output.find("VK_LAYER_KHRONOS_validation: missing"), std::string::npos) << info.output;
 }
 
 TEST_F(CliTest, InfoNamesDeviceAndLayer) {
-  const RunResult r = run("info");
+  const RunResult r = run_siviflow("info");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("llvmpipe"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("VK_LAYER_KHRONOS_validation: present"), std::string::npos) << r.output;
 }
 
 TEST_F(CliTest, CaptureWritesExrFramesAndPreviews) {
-  const RunResult r = run("capture --frames 3 --size 96x54 --seed 9 --aov depth --preview --validation --out " +
+  const RunResult r = run_siviflow("capture --frames 3 --size 96x54 --seed 9 --aov depth --preview --validation --out " +
                           dir_.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output.find("[vulkan error]"), std::string::npos) << r.output;
@@ -155,8 +135,8 @@ TEST_F(CliTest, RangeShardsEqualTheFullRun) {
   const fs::path shard = dir_ / "shard";
   fs::create_directories(full);
   fs::create_directories(shard);
-  ASSERT_EQ(run("capture --frames 4 --size 64x36 --out " + full.string()).exit_code, 0);
-  ASSERT_EQ(run("capture --range 2:4 --size 64x36 --out " + shard.string()).exit_code, 0);
+  ASSERT_EQ(run_siviflow("capture --frames 4 --size 64x36 --out " + full.string()).exit_code, 0);
+  ASSERT_EQ(run_siviflow("capture --range 2:4 --size 64x36 --out " + shard.string()).exit_code, 0);
   EXPECT_FALSE(fs::exists(shard / "frame_00000.exr"));
   for (const char* name : {"frame_00002.exr", "frame_00003.exr"}) {
     ExrImage a;

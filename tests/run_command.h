@@ -1,0 +1,31 @@
+// Runs the siviflow tool as a user would, capturing its exit status and output.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <string>
+
+namespace siviflow::testing {
+
+struct RunResult {
+  int exit_code = -1;  // -1: did not exit normally (a crash counts as a failure)
+  std::string output;  // stdout and stderr
+};
+
+// `env` is prepended as shell assignments, e.g. "VK_DRIVER_FILES=/x.json".
+inline RunResult run_siviflow(const std::string& args, const std::string& env = "") {
+  const std::string command =
+      env + " " + std::string(SIVIFLOW_BINARY_DIR) + "/tools/siviflow " + args + " 2>&1";
+  RunResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  size_t n = 0;
+  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) result.output.append(buffer, n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+}  // namespace siviflow::testing

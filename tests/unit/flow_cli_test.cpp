@@ -1,0 +1,203 @@
+// `siviflow flow`: the solved field of a scene's river as CSV, from a procedural river and from a
+// glTF file, with obstacles at a time; bad input gets exit status 1 and no output file.
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "run_command.h"
+#include "sim/procedural_river.h"
+
+namespace siviflow::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kHeader = "vertex,x,y,z,section,bank,width,d_left,d_right,psi,vx,vy,vz,wet";
+
+struct Row {
+  double v[14];
+};
+
+std::vector<Row> read_csv(const fs::path& path, std::string* header) {
+  std::ifstream file(path);
+  std::vector<Row> rows;
+  std::getline(file, *header);
+  std::string line;
+  while (std::getline(file, line)) {
+    Row row{};
+    std::stringstream cells(line);
+    std::string cell;
+    for (int i = 0; i < 14 && std::getline(cells, cell, ','); ++i) row.v[i] = std::stod(cell);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+class FlowCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(SIVIFLOW_BINARY_DIR) / "tests" / "flow_cli_out" /
+           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  fs::path dir_;
+};
+
+// A straight channel along +Z, `across` vertices per section, width w, as glTF with a .bin.
+void write_channel_gltf(const fs::path& gltf, int sections, int across, float width, float spacing) {
+  std::vector<float> positions;
+  for (int k = 0; k < sections; ++k) {
+    for (int j = 0; j < across; ++j) {
+      positions.push_back(width * 0.5f - width * static_cast<float>(j) / (across - 1));  // left = +X
+      positions.push_back(0.0f);
+      positions.push_back(spacing * static_cast<float>(k));
+    }
+  }
+  std::vector<uint32_t> indices;
+  for (int k = 0; k + 1 < sections; ++k) {
+    for (int j = 0; j + 1 < across; ++j) {
+      const uint32_t a = k * across + j, b = a + 1, c = a + across, d = c + 1;
+      indices.insert(indices.end(), {a, c, b, b, c, d});
+    }
+  }
+  const size_t position_bytes = positions.size() * sizeof(float);
+  const size_t index_bytes = indices.size() * sizeof(uint32_t);
+  std::ofstream bin(fs::path(gltf).replace_extension(".bin"), std::ios::binary);
+  bin.write(reinterpret_cast<const char*>(positions.data()), static_cast<std::streamsize>(position_bytes));
+  bin.write(reinterpret_cast<const char*>(indices.data()), static_cast<std::streamsize>(index_bytes));
+  bin.close();
+  const float half = width * 0.5f;
+  std::ostringstream json;
+  json << R"({"asset":{"version":"2.0"},"meshes":[{"name":"River","primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+       << R"("buffers":[{"uri":")" << fs::path(gltf).replace_extension(".bin").filename().string()
+       << R"(","byteLength":)" << position_bytes + index_bytes << "}],"
+       << R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" << position_bytes
+       << R"(},{"buffer":0,"byteOffset":)" << position_bytes << R"(,"byteLength":)" << index_bytes << "}],"
+       << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << positions.size() / 3
+       << R"(,"type":"VEC3","min":[)" << -half << ",0,0],\"max\":[" << half << ",0,"
+       << spacing * static_cast<float>(sections - 1) << "]},"
+       << R"({"bufferView":1,"componentType":5125,"count":)" << indices.size() << R"(,"type":"SCALAR"}]})";
+  write_text(gltf, json.str());
+}
+
+TEST_F(FlowCliTest, StraightGltfChannelIsUniformAndInAccessorOrder) {
+  constexpr int kSections = 30;
+  constexpr int kAcross = 9;
+  constexpr float kWidth = 8.0f;
+  write_channel_gltf(dir_ / "channel.gltf", kSections, kAcross, kWidth, 1.0f);
+  write_text(dir_ / "scene.json", R"({"version":1,"river":{"gltf":"channel.gltf","mesh":"River"},
+    "flow":{"discharge":12.0,"p":1.0,"search_radius":400.0}})");
+  const RunResult r = run_siviflow("flow " + (dir_ / "scene.json").string() + " --out " + (dir_ / "flow.csv").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::string header;
+  const std::vector<Row> rows = read_csv(dir_ / "flow.csv", &header);
+  EXPECT_EQ(header, kHeader);
+  ASSERT_EQ(rows.size(), size_t{kSections} * kAcross);
+  const double expected_speed = 12.0 / kWidth;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const double* v = rows[i].v;
+    EXPECT_EQ(v[0], static_cast<double>(i));
+    const int k = static_cast<int>(i) / kAcross;
+    const int j = static_cast<int>(i) % kAcross;
+    EXPECT_NEAR(v[1], kWidth * 0.5 - kWidth * j / (kAcross - 1), 1e-5) << "row " << i;  // accessor order
+    EXPECT_NEAR(v[3], k, 1e-5) << "row " << i;
+    EXPECT_EQ(v[4], k) << "section of row " << i;
+    EXPECT_EQ(v[5], j == 0 ? -1 : (j == kAcross - 1 ? 1 : 0)) << "bank of row " << i;
+    EXPECT_NEAR(v[6], kWidth, 1e-4);
+    EXPECT_NEAR(v[7] + v[8], kWidth, 1e-3);
+    const double speed = std::sqrt(v[10] * v[10] + v[11] * v[11] + v[12] * v[12]);
+    EXPECT_NEAR(speed, expected_speed, 0.01 * expected_speed) << "row " << i;
+    EXPECT_GT(v[12], 0.0) << "flow runs downstream (+Z)";
+    EXPECT_EQ(v[13], 1.0);
+    if (HasFailure()) break;
+  }
+}
+
+TEST_F(FlowCliTest, ProceduralRiverWithAMovingObstacle) {
+  ProceduralRiverParams params;
+  params.length = 80.0f;
+  params.seed = 3;
+  const ProceduralRiver river(params);
+  // The obstacle glides down the middle of the river, from z = -30 at t = 0 to z = 30 at t = 2.
+  const float x0 = river.centreline_x(-30.0f);
+  const float x2 = river.centreline_x(30.0f);
+  std::ostringstream scene;
+  scene << R"({"version":1,"river":{"procedural":{"length":80.0,"seed":3}},"flow":{"discharge":20.0},)"
+        << R"("obstacles":[{"center":[)" << x0 << R"(,0,-30],"radius":1.5,"keys":[{"t":0.0,"center":[)"
+        << x0 << R"(,0,-30]},{"t":2.0,"center":[)" << x2 << ",0,30]}]}]}";
+  write_text(dir_ / "scene.json", scene.str());
+  const fs::path at0 = dir_ / "t0.csv";
+  const fs::path at2 = dir_ / "t2.csv";
+  ASSERT_EQ(run_siviflow("flow " + (dir_ / "scene.json").string() + " --out " + at0.string()).exit_code, 0);
+  ASSERT_EQ(run_siviflow("flow " + (dir_ / "scene.json").string() + " --time 2 --out " + at2.string()).exit_code, 0);
+  std::string header;
+  const std::vector<Row> rows0 = read_csv(at0, &header);
+  const std::vector<Row> rows2 = read_csv(at2, &header);
+  ASSERT_EQ(rows0.size(), rows2.size());
+  ASSERT_FALSE(rows0.empty());
+  size_t dry0 = 0;
+  size_t dry2 = 0;
+  for (size_t i = 0; i < rows0.size(); ++i) {
+    const double* a = rows0[i].v;
+    const double* b = rows2[i].v;
+    // Banks carry psi = Q on the left and 0 on the right, at any time.
+    if (a[5] == -1) {
+      EXPECT_NEAR(a[9], 20.0, 1e-9);
+    } else if (a[5] == 1) {
+      EXPECT_NEAR(a[9], 0.0, 1e-9);
+    }
+    EXPECT_GE(a[9], -1e-9);
+    EXPECT_LE(a[9], 20.0 + 1e-9);
+    // A dry vertex lies inside the obstacle where it is at that time, and does not move.
+    if (a[13] == 0) {
+      ++dry0;
+      EXPECT_LT(std::hypot(a[1] - x0, a[3] + 30.0), 1.5 + 1e-3);
+      EXPECT_EQ(a[10], 0.0);
+      EXPECT_EQ(a[12], 0.0);
+    }
+    if (b[13] == 0) {
+      ++dry2;
+      EXPECT_LT(std::hypot(b[1] - x2, b[3] - 30.0), 1.5 + 1e-3);
+    }
+  }
+  EXPECT_GT(dry0, 0u) << "the obstacle in mid-river makes some vertices dry";
+  EXPECT_GT(dry2, 0u);
+}
+
+TEST_F(FlowCliTest, BadInputIsAnErrorAndWritesNothing) {
+  const std::string out = " --out " + (dir_ / "flow.csv").string();
+  const auto expect_error = [&](const RunResult& r, const std::string& needle) {
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find(needle), std::string::npos) << "expected '" << needle << "' in:\n" << r.output;
+    EXPECT_FALSE(fs::exists(dir_ / "flow.csv"));
+  };
+  expect_error(run_siviflow("flow" + out), "a scene file is required");
+  expect_error(run_siviflow("flow " + (dir_ / "missing.json").string() + out), "missing.json");
+  write_text(dir_ / "unknown.json", R"({"version":1,"river":{"procedural":{}},"flw":{}})");
+  expect_error(run_siviflow("flow " + (dir_ / "unknown.json").string() + out), "flw");
+  write_text(dir_ / "badgltf.json", R"({"version":1,"river":{"gltf":"nothere.glb"}})");
+  expect_error(run_siviflow("flow " + (dir_ / "badgltf.json").string() + out), "nothere.glb");
+  write_text(dir_ / "ok.json", R"({"version":1,"river":{"procedural":{"length":40.0}}})");
+  expect_error(run_siviflow("flow " + (dir_ / "ok.json").string() + " --time nan" + out), "--time");
+  expect_error(run_siviflow("flow " + (dir_ / "ok.json").string()), "--out FILE.csv is required");
+  expect_error(run_siviflow("flow " + (dir_ / "ok.json").string() + " --bogus" + out), "unknown option '--bogus'");
+  // A one-section river is not a strip of sections: named, exit 1.
+  write_channel_gltf(dir_ / "tiny.gltf", 1, 2, 4.0f, 1.0f);
+  write_text(dir_ / "tiny.json", R"({"version":1,"river":{"gltf":"tiny.gltf"}})");
+  expect_error(run_siviflow("flow " + (dir_ / "tiny.json").string() + out), "tiny");
+}
+
+}  // namespace
+}  // namespace siviflow::testing
