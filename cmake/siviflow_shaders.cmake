@@ -64,8 +64,10 @@ const ShaderBlob* find_shader(std::string_view name) {
 ]=] @ONLY)
 
   add_library(${S_TARGET} STATIC ${registry} ${headers})
-  target_include_directories(${S_TARGET} PUBLIC ${S_INCLUDE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}
-                                         PRIVATE ${out_dir})
+  # Only the engine compiles against these headers; an installed static library needs no includes.
+  target_include_directories(${S_TARGET}
+    PUBLIC  $<BUILD_INTERFACE:${S_INCLUDE_DIR}> $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}>
+    PRIVATE ${out_dir})
   add_custom_target(${S_TARGET}_spv ALL DEPENDS ${spv_files})
   set_property(GLOBAL PROPERTY SIVIFLOW_SPV_FILES ${spv_files})
 endfunction()
