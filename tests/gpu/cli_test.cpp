@@ -1,5 +1,7 @@
 // The siviflow command end to end: bad input gets exit status 1 and a message naming the
 // problem; a capture writes readable EXR frames (and PNG previews) validation-clean.
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -57,6 +59,19 @@ TEST_F(CliTest, BadOutputFolder) {
   ASSERT_NE(f, nullptr);
   std::fclose(f);
   expect_error(run_siviflow("capture --out " + file.string()), "is not a folder");
+}
+
+TEST_F(CliTest, UnwritableOutputFolder) {
+  // As root every folder is writable, so when the tests run as root the tool runs as nobody.
+  const bool root = geteuid() == 0;
+  fs::permissions(dir_, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec |
+                            fs::perms::others_read | fs::perms::others_exec);
+  if (!root) fs::permissions(dir_, fs::perms::owner_write, fs::perm_options::remove);
+  const std::string as_nobody = root ? "setpriv --reuid=65534 --regid=65534 --clear-groups " : "";
+  const RunResult r = run_siviflow("capture --frames 1 --size 32x32 --out " + dir_.string(),
+                                   "HOME=/tmp " + as_nobody);
+  if (!root) fs::permissions(dir_, fs::perms::owner_write, fs::perm_options::add);
+  expect_error(r, "is not writable");
 }
 
 TEST_F(CliTest, NoVulkanDriver) {
