@@ -187,7 +187,15 @@ Status Renderer::Impl::declare_static_graph() {
   static_uploads.buffers = {{0, vertices, vertex_buffer.size}, {0, indices, index_buffer.size}};
   static_uploads.images = {{0, detail, detail_extent}};
   add_upload_pass(static_graph, static_staging, &static_uploads);
-  return static_graph.compile();
+  SIVIFLOW_TRY(static_graph.compile());
+  // The frame graph only samples the detail texture.
+  const VkImageUsageFlags detail_usage =
+      static_graph.image_usage(static_uploads.images[0].destination) | VK_IMAGE_USAGE_SAMPLED_BIT;
+  SIVIFLOW_TRY(create_image(gpu, VK_FORMAT_R8G8B8A8_UNORM, detail_extent, detail_usage,
+                            "ground detail", &detail_image));
+  SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
+  scene_pass.set_detail_texture(gpu, detail_image.view);
+  return Status::success();
 }
 
 Status Renderer::Impl::declare_graph() {
@@ -223,17 +231,8 @@ Status Renderer::Impl::declare_graph() {
     add_readback_pass(graph, &readback);
   }
   SIVIFLOW_TRY(graph.compile());
-  SIVIFLOW_TRY(declare_static_graph());
-
-  SIVIFLOW_TRY(create_image(gpu, kDepthFormat, extent, graph.image_usage(scene.depth), "depth",
-                            &depth_image));
-  SIVIFLOW_TRY(create_image(gpu, VK_FORMAT_R8G8B8A8_UNORM, detail_extent,
-                            graph.image_usage(scene.detail) |
-                                static_graph.image_usage(static_uploads.images[0].destination),
-                            "ground detail", &detail_image));
-  SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
-  scene_pass.set_detail_texture(gpu, detail_image.view);
-  return Status::success();
+  return create_image(gpu, kDepthFormat, extent, graph.image_usage(scene.depth), "depth",
+                      &depth_image);
 }
 
 Status Renderer::Impl::stage_static_data() {
@@ -284,6 +283,7 @@ Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) 
   auto impl = std::make_unique<Impl>();
   Status status = impl->validate_info(info);
   if (status.ok()) status = impl->create_static_resources();
+  if (status.ok()) status = impl->declare_static_graph();
   if (status.ok()) status = impl->declare_graph();
   if (!status.ok()) {
     if (info.log != nullptr) info.log(LogLevel::kError, status.message().c_str(), info.log_user);
@@ -368,6 +368,29 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   r.frame_begun = false;
   r.frame_updated = false;
   return Status::success();
+}
+
+Status Renderer::resize(VkExtent2D extent) {
+  Impl& r = *impl_;
+  if (r.frame_begun) return Status::error("Renderer::resize called between begin_frame and record");
+  if (extent.width == 0 || extent.height == 0) return invalid("resize: extent must be at least 1x1");
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  r.table.vkGetPhysicalDeviceProperties2(r.info.physical_device, &props);
+  const uint32_t limit = props.properties.limits.maxImageDimension2D;
+  if (extent.width > limit || extent.height > limit) {
+    return invalid("resize: extent " + std::to_string(extent.width) + "x" +
+                   std::to_string(extent.height) + " exceeds the device limit of " +
+                   std::to_string(limit));
+  }
+  // Frames of any slot still in flight may use the old depth image: free it once all came round.
+  Image retired = r.depth_image;
+  r.depth_image = Image{};
+  r.ring.defer_deletion_until_all_slots(
+      [gpu_context = r.gpu, retired]() mutable { destroy_image(gpu_context, &retired); });
+  r.info.extent = extent;
+  r.graph = FrameGraph{};
+  r.bindings.reset();
+  return r.declare_graph();
 }
 
 Camera Renderer::scene_camera(double time_seconds) const {

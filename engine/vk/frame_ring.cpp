@@ -1,10 +1,12 @@
 #include "vk/frame_ring.h"
 
+#include <memory>
 #include <string>
 
 namespace siviflow {
 
 bool LinearAllocator::allocate(VkDeviceSize size, VkDeviceSize alignment, VkDeviceSize* offset) {
+  if (alignment == 0 || (alignment & (alignment - 1)) != 0) return false;  // not a power of two
   const VkDeviceSize aligned = (used_ + alignment - 1) & ~(alignment - 1);
   if (aligned > capacity_ || size > capacity_ - aligned) return false;
   *offset = aligned;
@@ -67,6 +69,17 @@ Status FrameRing::allocate_staging(VkDeviceSize size, VkDeviceSize alignment,
 
 void FrameRing::defer_deletion(std::function<void()> destroy) {
   slots_[current_].deletions.defer(std::move(destroy));
+}
+
+void FrameRing::defer_deletion_until_all_slots(std::function<void()> destroy) {
+  // Each slot holds one reference; the last slot to come round runs the deletion.
+  auto shared = std::make_shared<std::function<void()>>(std::move(destroy));
+  for (Slot& slot : slots_) {
+    slot.deletions.defer([shared]() mutable {
+      if (shared.use_count() == 1) (*shared)();
+      shared.reset();
+    });
+  }
 }
 
 VkDeviceSize FrameRing::staging_used() const { return slots_[current_].allocator.used(); }

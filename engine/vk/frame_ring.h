@@ -17,7 +17,8 @@ namespace siviflow {
 class LinearAllocator {
  public:
   explicit LinearAllocator(VkDeviceSize capacity = 0) : capacity_(capacity) {}
-  // Offset of `size` bytes aligned to `alignment` (a power of two), or false when full.
+  // Offset of `size` bytes aligned to `alignment`, or false when full or `alignment` is not a
+  // power of two.
   bool allocate(VkDeviceSize size, VkDeviceSize alignment, VkDeviceSize* offset);
   void reset() { used_ = 0; }
   VkDeviceSize used() const { return used_; }
@@ -55,7 +56,10 @@ class FrameRing {
   // The host guarantees the GPU finished this slot's previous frame.
   Status begin_slot(uint32_t slot);
   Status allocate_staging(VkDeviceSize size, VkDeviceSize alignment, StagingAllocation* out);
+  // Runs `destroy` when the current slot comes round again: for what only this slot's frame used.
   void defer_deletion(std::function<void()> destroy);
+  // Runs `destroy` once every slot has come round again: for what frames of any slot may use.
+  void defer_deletion_until_all_slots(std::function<void()> destroy);
   VkDeviceSize staging_used() const;
   VkBuffer staging_buffer() const { return slots_[current_].staging.buffer; }
 

@@ -18,17 +18,19 @@ constexpr uint32_t kWidth = 320;
 constexpr uint32_t kHeight = 180;
 
 struct Frame {
+  uint32_t width = 0;
   std::vector<float> rgba;   // linear, 4 floats per pixel
   std::vector<float> depth;  // window depth, 0 near .. 1 far
 
-  const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * kWidth + x) * 4]; }
+  const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * width + x) * 4]; }
 };
 
 class RenderTest : public GpuTest {
  protected:
   // Renders frames [first, end) with two frames in flight (one host slot, target and readback
   // set each; a slot is waited on only when it is reused) and returns them in order.
-  std::vector<Frame> render(uint32_t first, uint32_t end) {
+  std::vector<Frame> render(uint32_t first, uint32_t end, uint32_t width = kWidth,
+                            uint32_t height = kHeight) {
     std::vector<Frame> frames;
     if (renderer_ == nullptr) {
       const Status status = Renderer::create(make_create_info(kWidth, kHeight), &renderer_);
@@ -44,17 +46,18 @@ class RenderTest : public GpuTest {
     };
     Slot slots[2];
     for (Slot& slot : slots) {
-      EXPECT_TRUE(context_->create_target_image(VK_FORMAT_R16G16B16A16_SFLOAT, {kWidth, kHeight}, &slot.target).ok());
+      EXPECT_TRUE(context_->create_target_image(VK_FORMAT_R16G16B16A16_SFLOAT, {width, height}, &slot.target).ok());
       EXPECT_TRUE(context_->create_readback_buffer(renderer_->readback_color_bytes(), &slot.color).ok());
       EXPECT_TRUE(context_->create_readback_buffer(renderer_->readback_depth_bytes(), &slot.depth).ok());
     }
     const auto collect = [&](Slot& slot) {
       Frame out;
+      out.width = width;
       const auto* halves = static_cast<const uint16_t*>(slot.color.data);
-      out.rgba.resize(size_t{kWidth} * kHeight * 4);
+      out.rgba.resize(size_t{width} * height * 4);
       for (size_t i = 0; i < out.rgba.size(); ++i) out.rgba[i] = glm::unpackHalf1x16(halves[i]);
       const auto* depths = static_cast<const float*>(slot.depth.data);
-      out.depth.assign(depths, depths + size_t{kWidth} * kHeight);
+      out.depth.assign(depths, depths + size_t{width} * height);
       frames.push_back(std::move(out));
       slot.pending = false;
     };
@@ -134,6 +137,19 @@ TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {
   EXPECT_EQ(std::memcmp(run[3].rgba.data(), shard[0].rgba.data(), run[3].rgba.size() * sizeof(float)), 0);
   EXPECT_EQ(run[3].depth, shard[0].depth);
   EXPECT_NE(run[0].rgba, run[3].rgba) << "the camera moves: frames must differ";
+}
+
+TEST_F(RenderTest, ResizeBetweenFramesKeepsFramesInFlightValid) {
+  ASSERT_EQ(render(0, 3).size(), 3u);
+  ASSERT_TRUE(renderer_->resize({160, 90}).ok());
+  EXPECT_EQ(renderer_->readback_color_bytes(), 160u * 90u * 8u);
+  const std::vector<Frame> small = render(3, 6, 160, 90);
+  ASSERT_EQ(small.size(), 3u);
+  const float* sky = small[0].pixel(80, 2);
+  EXPECT_GT(sky[2], sky[0]);
+  EXPECT_EQ(small[0].depth[2 * 160 + 80], 1.0f);
+  EXPECT_LT(small[0].depth[88 * 160 + 80], 0.999f);
+  EXPECT_FALSE(renderer_->resize({0, 90}).ok());
 }
 
 TEST_F(RenderTest, FrameGraphRunsSceneThenReadback) {

@@ -35,6 +35,15 @@ TEST(LinearAllocator, HugeRequestsDoNotWrapAround) {
   EXPECT_TRUE(allocator.allocate(924, 1, &offset));
 }
 
+TEST(LinearAllocator, RefusesAlignmentThatIsNotAPowerOfTwo) {
+  LinearAllocator allocator(64);
+  VkDeviceSize offset = 0;
+  ASSERT_TRUE(allocator.allocate(3, 1, &offset));
+  EXPECT_FALSE(allocator.allocate(4, 0, &offset));
+  EXPECT_FALSE(allocator.allocate(4, 12, &offset));
+  EXPECT_EQ(allocator.used(), 3u);
+}
+
 TEST(DeferredDeletions, RunInOrderOnceThenEmpty) {
   DeferredDeletions deletions;
   std::vector<int> order;

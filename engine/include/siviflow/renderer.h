@@ -118,6 +118,10 @@ class Renderer {
   // Records the frame into `cmd` (in the recording state, outside any render pass).
   Status record(VkCommandBuffer cmd, const FrameInputs& inputs);
 
+  // New output size. Call between frames (not between begin_frame and record); images that
+  // frames in flight still use are freed once every slot has come round again.
+  Status resize(VkExtent2D extent);
+
   // The camera of the scene's own camera path at that time (the default scene glides downstream).
   Camera scene_camera(double time_seconds) const;
 
