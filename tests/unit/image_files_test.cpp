@@ -23,6 +23,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -273,20 +274,18 @@ TEST_F(ImageFilesExr, ReadRefusesFifoWithoutBlocking) {
   EXPECT_FALSE(check_exr_file(fifo).ok());
 }
 
-// Runs write_exr in a child whose file-size limit is `limit` bytes; returns the child's
-// message. The child has its own limit, so this process keeps writing normally.
-std::string write_in_size_limited_child(const std::string& file, const ExrFrame& frame,
-                                        rlim_t limit, bool* child_reported_error) {
+// Runs write_exr in a child after `restrict_child` (a file-size limit, dropped privileges...);
+// returns the child's message. The restriction stays in the child: this process is unaffected.
+std::string write_in_restricted_child(const std::string& file, const ExrFrame& frame,
+                                      const std::function<bool()>& restrict_child,
+                                      bool* child_reported_error) {
   int fds[2];
   if (::pipe(fds) != 0) return "pipe failed";
   const pid_t pid = ::fork();
   if (pid < 0) return "fork failed";
   if (pid == 0) {
     ::close(fds[0]);
-    // Without this the kernel kills the writer with SIGXFSZ instead of failing with EFBIG.
-    ::signal(SIGXFSZ, SIG_IGN);
-    const struct rlimit rl = {limit, limit};
-    if (::setrlimit(RLIMIT_FSIZE, &rl) != 0) ::_exit(3);
+    if (!restrict_child()) ::_exit(3);
     const Status s = write_exr(file, frame);
     const std::string& message = s.message();
     if (::write(fds[1], message.data(), message.size()) < 0) ::_exit(4);
@@ -309,6 +308,16 @@ std::string write_in_size_limited_child(const std::string& file, const ExrFrame&
   }
   *child_reported_error = WIFEXITED(status) && WEXITSTATUS(status) == 0;
   return message;
+}
+
+std::string write_in_size_limited_child(const std::string& file, const ExrFrame& frame,
+                                        rlim_t limit, bool* child_reported_error) {
+  return write_in_restricted_child(file, frame, [limit] {
+    // Without this the kernel kills the writer with SIGXFSZ instead of failing with EFBIG.
+    ::signal(SIGXFSZ, SIG_IGN);
+    const struct rlimit rl = {limit, limit};
+    return ::setrlimit(RLIMIT_FSIZE, &rl) == 0;
+  }, child_reported_error);
 }
 
 TEST_F(ImageFilesAtomic, FileSizeLimitReportsErrorAndLeavesNoFile) {
@@ -402,15 +411,18 @@ TEST_F(ImageFilesAtomic, MissingFolderIsNamedInTheError) {
 }
 
 TEST_F(ImageFilesAtomic, UnwritableFolderIsReported) {
-  if (::geteuid() == 0) GTEST_SKIP() << "root ignores folder permissions";
   TestFrame data(4, 4);
   const std::string folder = path("readonly");
   ASSERT_TRUE(fs::create_directory(folder));
   ASSERT_EQ(::chmod(folder.c_str(), 0555), 0);
-  const Status s = write_exr(folder + "/frame.exr", data.frame());
+  // Root ignores folder permissions, so a root test process writes as nobody in a child.
+  bool child_reported_error = false;
+  const std::string message = write_in_restricted_child(folder + "/frame.exr", data.frame(), [] {
+    return ::geteuid() != 0 || (::setgid(65534) == 0 && ::setuid(65534) == 0);
+  }, &child_reported_error);
   ::chmod(folder.c_str(), 0755);
-  EXPECT_FALSE(s.ok());
-  EXPECT_NE(s.message().find(std::strerror(EACCES)), std::string::npos) << s.message();
+  EXPECT_TRUE(child_reported_error) << message;
+  EXPECT_NE(message.find(std::strerror(EACCES)), std::string::npos) << message;
   EXPECT_TRUE(list_dir(folder).empty());
 }
 
