@@ -434,7 +434,9 @@ VKAPI_ATTR void VKAPI_CALL fake_barrier(VkCommandBuffer, const VkDependencyInfo*
   std::string line = "barrier images=" + std::to_string(dependency->imageMemoryBarrierCount) +
                      " buffers=" + std::to_string(dependency->bufferMemoryBarrierCount);
   for (uint32_t i = 0; i < dependency->imageMemoryBarrierCount; ++i) {
-    line += " " + layout_name(dependency->pImageMemoryBarriers[i].newLayout);
+    // Two appends: GCC 12 warns falsely (-Wrestrict) on `" " + std::string` here in Release.
+    line += ' ';
+    line += layout_name(dependency->pImageMemoryBarriers[i].newLayout);
   }
   g_calls->push_back(line);
 }
