@@ -1,5 +1,6 @@
 #include "siviflow/renderer.h"
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -55,14 +56,30 @@ struct Renderer::Impl {
   ProceduralRiver river{default_river_params()};
   SceneLook look = default_scene_look();
 
-  SceneGeometry geometry;  // kept until the first frame has copied it to the GPU
-  uint32_t index_count = 0;
-  Buffer vertex_buffer;
-  Buffer index_buffer;
+  // Geometry that never changes: copied to the GPU once, then only read.
+  enum StaticBufferId { kSceneVertices, kSceneIndices, kRiverVertices, kRiverIndices, kStaticBufferCount };
+  struct StaticBuffer {
+    const char* name;
+    Access read_as;  // how the frame graph reads it
+    VkBufferUsageFlags usage;
+    std::vector<uint8_t> bytes;  // kept until staged for the first frame
+    Buffer buffer;
+    BufferHandle in_frame_graph;
+  };
+  std::array<StaticBuffer, kStaticBufferCount> static_buffers{{
+      {"scene vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
+      {"scene indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, {}, {}, {}},
+      {"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
+      {"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, {}, {}, {}}}};
+  uint32_t scene_index_count = 0;
+  uint32_t river_index_count = 0;
   DetailTexture detail_pixels;
   Image detail_image;
   Image depth_image;
+  Image water_mask_image;  // only with readback: the water.mask AOV
+  ImageHandle water_mask;
   ScenePass scene_pass;
+  WaterMaskPass water_mask_pass;
 
   // One-off graph that copies the static scene data on the first frame; the frame graph then
   // only reads it, so later frames carry no upload barriers for it.
@@ -74,7 +91,7 @@ struct Renderer::Impl {
   FrameGraph graph;
   ScenePass::Handles scene;
   ImageHandle output;
-  ReadbackHandles readback;
+  std::vector<ReadbackCopy> readbacks;  // one per ReadbackImage when readback is enabled
   FrameBindings bindings;
   gpu::SceneConstants constants{};
 
@@ -159,32 +176,39 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
 }
 
 Status Renderer::Impl::create_static_resources() {
-  geometry = build_default_scene_geometry(river);
-  index_count = static_cast<uint32_t>(geometry.indices.size());
+  const auto bytes_of = [](const auto& items) {
+    const auto* first = reinterpret_cast<const uint8_t*>(items.data());
+    return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
+  };
+  const SceneGeometry geometry = build_default_scene_geometry(river);
+  scene_index_count = static_cast<uint32_t>(geometry.indices.size());
+  static_buffers[kSceneVertices].bytes = bytes_of(geometry.vertices);
+  static_buffers[kSceneIndices].bytes = bytes_of(geometry.indices);
+  RiverMesh river_mesh;
+  SIVIFLOW_TRY(river.generate_mesh(&river_mesh));
+  river_index_count = static_cast<uint32_t>(river_mesh.indices.size());
+  static_buffers[kRiverVertices].bytes = bytes_of(river_mesh.positions);
+  static_buffers[kRiverIndices].bytes = bytes_of(river_mesh.indices);
   detail_pixels = make_detail_texture();
-  const VkDeviceSize vertex_bytes = geometry.vertices.size() * sizeof(SceneVertex);
-  const VkDeviceSize index_bytes = geometry.indices.size() * sizeof(uint32_t);
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
-  SIVIFLOW_TRY(create_buffer(gpu, vertex_bytes,
-                             VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                             false, "scene vertices", &vertex_buffer));
-  SIVIFLOW_TRY(create_buffer(gpu, index_bytes,
-                             VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                             false, "scene indices", &index_buffer));
+  for (StaticBuffer& b : static_buffers) {
+    SIVIFLOW_TRY(create_buffer(gpu, b.bytes.size(), b.usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                               false, b.name, &b.buffer));
+  }
   return Status::success();
 }
 
 Status Renderer::Impl::declare_static_graph() {
   const VkExtent2D detail_extent{detail_pixels.size, detail_pixels.size};
   static_staging = static_graph.import_buffer({"static staging", 0}, ResourceState{});
-  const BufferHandle vertices = static_graph.import_buffer(
-      {"scene vertices", vertex_buffer.size}, ResourceState{}, state_of(Access::VertexBufferRead));
-  const BufferHandle indices = static_graph.import_buffer(
-      {"scene indices", index_buffer.size}, ResourceState{}, state_of(Access::IndexBufferRead));
+  for (const StaticBuffer& b : static_buffers) {
+    const BufferHandle handle = static_graph.import_buffer({b.name, b.buffer.size}, ResourceState{},
+                                                           state_of(b.read_as));
+    static_uploads.buffers.push_back({0, handle, b.buffer.size});
+  }
   const ImageHandle detail =
       static_graph.import_image({"ground detail", VK_FORMAT_R8G8B8A8_UNORM, detail_extent, {}},
                                 ResourceState{}, state_of(Access::SampledFragment));
-  static_uploads.buffers = {{0, vertices, vertex_buffer.size}, {0, indices, index_buffer.size}};
   static_uploads.images = {{0, detail, detail_extent}};
   add_upload_pass(static_graph, static_staging, &static_uploads);
   SIVIFLOW_TRY(static_graph.compile());
@@ -194,6 +218,7 @@ Status Renderer::Impl::declare_static_graph() {
   SIVIFLOW_TRY(create_image(gpu, VK_FORMAT_R8G8B8A8_UNORM, detail_extent, detail_usage,
                             "ground detail", &detail_image));
   SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
+  SIVIFLOW_TRY(water_mask_pass.create(gpu, info.pipeline_cache, kDepthFormat));
   scene_pass.set_detail_texture(gpu, detail_image.view);
   return Status::success();
 }
@@ -202,12 +227,12 @@ Status Renderer::Impl::declare_graph() {
   const VkExtent2D extent = info.extent;
   const VkExtent2D detail_extent{detail_pixels.size, detail_pixels.size};
   // Static data arrives through the static graph and is only read from then on.
-  scene.vertices = graph.import_buffer({"scene vertices", vertex_buffer.size},
-                                       state_of(Access::VertexBufferRead),
-                                       state_of(Access::VertexBufferRead));
-  scene.indices = graph.import_buffer({"scene indices", index_buffer.size},
-                                      state_of(Access::IndexBufferRead),
-                                      state_of(Access::IndexBufferRead));
+  for (StaticBuffer& b : static_buffers) {
+    b.in_frame_graph = graph.import_buffer({b.name, b.buffer.size}, state_of(b.read_as),
+                                           state_of(b.read_as));
+  }
+  scene.vertices = static_buffers[kSceneVertices].in_frame_graph;
+  scene.indices = static_buffers[kSceneIndices].in_frame_graph;
   scene.detail = graph.import_image({"ground detail", VK_FORMAT_R8G8B8A8_UNORM, detail_extent, {}},
                                     state_of(Access::SampledFragment),
                                     state_of(Access::SampledFragment));
@@ -219,45 +244,61 @@ Status Renderer::Impl::declare_graph() {
                               state_of(Access::SampledFragment));
   scene.color = output;
   scene.depth = graph.create_image({"depth", kDepthFormat, extent, far_depth});
-  scene_pass.declare(graph, &constants, index_count, &scene);
+  scene_pass.declare(graph, &constants, scene_index_count, &scene);
 
   if (info.enable_readback) {
-    readback.color = scene.color;
-    readback.depth = scene.depth;
-    readback.color_buffer = graph.import_buffer({"readback colour", 0}, ResourceState{},
-                                                state_of(Access::HostRead));
-    readback.depth_buffer = graph.import_buffer({"readback depth", 0}, ResourceState{},
-                                                state_of(Access::HostRead));
-    add_readback_pass(graph, &readback);
+    WaterMaskPass::Handles water;
+    water.mask = graph.create_image({"water mask", WaterMaskPass::kFormat, extent, {}});
+    water.depth = scene.depth;
+    water.vertices = static_buffers[kRiverVertices].in_frame_graph;
+    water.indices = static_buffers[kRiverIndices].in_frame_graph;
+    water_mask_pass.declare(graph, &constants, river_index_count, &water);
+    water_mask = water.mask;
+    const ImageHandle images[kReadbackImageCount] = {scene.color, scene.depth, water.mask};
+    readbacks.clear();
+    for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
+      const BufferHandle buffer = graph.import_buffer(
+          {readback_image_name(static_cast<ReadbackImage>(i)), 0}, ResourceState{},
+          state_of(Access::HostRead));
+      readbacks.push_back({images[i], buffer});
+    }
+    add_readback_pass(graph, &readbacks);
   }
   SIVIFLOW_TRY(graph.compile());
+  if (info.enable_readback) {
+    SIVIFLOW_TRY(create_image(gpu, WaterMaskPass::kFormat, extent, graph.image_usage(water_mask),
+                              "water mask", &water_mask_image));
+  }
   return create_image(gpu, kDepthFormat, extent, graph.image_usage(scene.depth), "depth",
                       &depth_image);
 }
 
 Status Renderer::Impl::stage_static_data() {
-  const VkDeviceSize vertex_bytes = vertex_buffer.size;
-  const VkDeviceSize index_bytes = index_buffer.size;
-  const VkDeviceSize detail_bytes = detail_pixels.texels.size();
-  SIVIFLOW_TRY(create_buffer(gpu, vertex_bytes + index_bytes + detail_bytes,
-                             VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true,
+  VkDeviceSize total = detail_pixels.texels.size();
+  for (const StaticBuffer& b : static_buffers) total += b.bytes.size();
+  SIVIFLOW_TRY(create_buffer(gpu, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true,
                              "static staging", &static_staging_buffer));
   auto* bytes = static_cast<uint8_t*>(static_staging_buffer.mapped);
-  std::memcpy(bytes, geometry.vertices.data(), vertex_bytes);
-  std::memcpy(bytes + vertex_bytes, geometry.indices.data(), index_bytes);
-  std::memcpy(bytes + vertex_bytes + index_bytes, detail_pixels.texels.data(), detail_bytes);
-  static_uploads.buffers[0].staging_offset = 0;
-  static_uploads.buffers[1].staging_offset = vertex_bytes;
-  static_uploads.images[0].staging_offset = vertex_bytes + index_bytes;
-  geometry = SceneGeometry{};  // the staging copy is the only one needed from now on
+  // Detail texels first: their copy offset must be a multiple of the texel size.
+  std::memcpy(bytes, detail_pixels.texels.data(), detail_pixels.texels.size());
+  static_uploads.images[0].staging_offset = 0;
+  VkDeviceSize offset = detail_pixels.texels.size();
+  for (size_t i = 0; i < static_buffers.size(); ++i) {
+    std::vector<uint8_t>& source = static_buffers[i].bytes;
+    std::memcpy(bytes + offset, source.data(), source.size());
+    static_uploads.buffers[i].staging_offset = offset;
+    offset += source.size();
+    source = std::vector<uint8_t>();  // the staging copy is the only one needed from now on
+  }
   return Status::success();
 }
 
 Status Renderer::Impl::record_static_upload(VkCommandBuffer cmd) {
   FrameBindings static_bindings;
   static_bindings.bind_buffer(static_staging, static_staging_buffer.buffer);
-  static_bindings.bind_buffer(static_uploads.buffers[0].destination, vertex_buffer.buffer);
-  static_bindings.bind_buffer(static_uploads.buffers[1].destination, index_buffer.buffer);
+  for (size_t i = 0; i < static_buffers.size(); ++i) {
+    static_bindings.bind_buffer(static_uploads.buffers[i].destination, static_buffers[i].buffer.buffer);
+  }
   static_bindings.bind_image(static_uploads.images[0].destination, detail_image.image,
                              detail_image.view);
   SIVIFLOW_TRY(static_graph.execute(table, cmd, static_bindings));
@@ -271,10 +312,11 @@ Status Renderer::Impl::record_static_upload(VkCommandBuffer cmd) {
 void Renderer::Impl::destroy() {
   if (gpu.table == nullptr) return;  // failed before any Vulkan object existed
   scene_pass.destroy(gpu);
+  water_mask_pass.destroy(gpu);
   destroy_image(gpu, &depth_image);
+  destroy_image(gpu, &water_mask_image);
   destroy_image(gpu, &detail_image);
-  destroy_buffer(gpu, &vertex_buffer);
-  destroy_buffer(gpu, &index_buffer);
+  for (StaticBuffer& b : static_buffers) destroy_buffer(gpu, &b.buffer);
   destroy_buffer(gpu, &static_staging_buffer);
   ring.destroy();
 }
@@ -339,15 +381,18 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   if (inputs.output.final.layout == VK_IMAGE_LAYOUT_UNDEFINED) {
     return Status::error("Renderer::record: FrameInputs::output.final.layout must not be UNDEFINED");
   }
-  if (r.info.enable_readback &&
-      (inputs.readback.color == VK_NULL_HANDLE || inputs.readback.depth == VK_NULL_HANDLE)) {
-    return Status::error("Renderer::record: readback is enabled but FrameInputs::readback is empty");
+  if (r.info.enable_readback) {
+    for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
+      if (inputs.readback.buffers[i] == VK_NULL_HANDLE) {
+        return Status::error(std::string("Renderer::record: readback is enabled but FrameInputs::readback has no ") +
+                             readback_image_name(static_cast<ReadbackImage>(i)) + " buffer");
+      }
+    }
   }
   if (!r.static_data_uploaded) SIVIFLOW_TRY(r.record_static_upload(cmd));
   FrameBindings& b = r.bindings;
   b.reset();
-  b.bind_buffer(r.scene.vertices, r.vertex_buffer.buffer);
-  b.bind_buffer(r.scene.indices, r.index_buffer.buffer);
+  for (const Impl::StaticBuffer& sb : r.static_buffers) b.bind_buffer(sb.in_frame_graph, sb.buffer.buffer);
   b.bind_image(r.scene.detail, r.detail_image.image, r.detail_image.view);
   b.bind_image(r.output, inputs.output.image, inputs.output.view);
   b.bind_image(r.scene.depth, r.depth_image.image, r.depth_image.view);
@@ -355,10 +400,10 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
                             inputs.output.current.layout});
   b.set_outgoing(r.output, {inputs.output.final.stage, inputs.output.final.access,
                             inputs.output.final.layout});
-  if (r.info.enable_readback) {
-    b.bind_buffer(r.readback.color_buffer, inputs.readback.color);
-    b.bind_buffer(r.readback.depth_buffer, inputs.readback.depth);
+  for (uint32_t i = 0; i < r.readbacks.size(); ++i) {
+    b.bind_buffer(r.readbacks[i].buffer, inputs.readback.buffers[i]);
   }
+  if (r.info.enable_readback) b.bind_image(r.water_mask, r.water_mask_image.image, r.water_mask_image.view);
   const Status status = r.graph.execute(r.table, cmd, b);
   if (!status.ok()) {
     if (r.info.log != nullptr) r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
@@ -382,11 +427,13 @@ Status Renderer::resize(VkExtent2D extent) {
                    std::to_string(extent.height) + " exceeds the device limit of " +
                    std::to_string(limit));
   }
-  // Frames of any slot still in flight may use the old depth image: free it once all came round.
-  Image retired = r.depth_image;
-  r.depth_image = Image{};
-  r.ring.defer_deletion_until_all_slots(
-      [gpu_context = r.gpu, retired]() mutable { destroy_image(gpu_context, &retired); });
+  // Frames of any slot still in flight may use the old images: free them once all came round.
+  for (Image* image : {&r.depth_image, &r.water_mask_image}) {
+    Image retired = *image;
+    *image = Image{};
+    r.ring.defer_deletion_until_all_slots(
+        [gpu_context = r.gpu, retired]() mutable { destroy_image(gpu_context, &retired); });
+  }
   r.info.extent = extent;
   r.graph = FrameGraph{};
   r.bindings.reset();
@@ -397,13 +444,28 @@ Camera Renderer::scene_camera(double time_seconds) const {
   return default_camera(impl_->river, time_seconds);
 }
 
-VkDeviceSize Renderer::readback_color_bytes() const {
-  return VkDeviceSize{impl_->info.extent.width} * impl_->info.extent.height *
-         texel_bytes(impl_->info.color_format);
+VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
+  const VkDeviceSize pixels = VkDeviceSize{impl_->info.extent.width} * impl_->info.extent.height;
+  switch (image) {
+    case ReadbackImage::kColor:
+      return pixels * texel_bytes(impl_->info.color_format);
+    case ReadbackImage::kDepth:
+    case ReadbackImage::kWaterMask:
+      return pixels * sizeof(float);
+  }
+  return 0;
 }
 
-VkDeviceSize Renderer::readback_depth_bytes() const {
-  return VkDeviceSize{impl_->info.extent.width} * impl_->info.extent.height * sizeof(float);
+const char* readback_image_name(ReadbackImage image) {
+  switch (image) {
+    case ReadbackImage::kColor:
+      return "readback colour";
+    case ReadbackImage::kDepth:
+      return "readback depth";
+    case ReadbackImage::kWaterMask:
+      return "readback water mask";
+  }
+  return "readback";
 }
 
 std::string Renderer::dump_frame_graph() const { return impl_->graph.dump_text(); }

@@ -135,8 +135,7 @@ float linear_depth(float window_depth, float near_plane, float far_plane) {
 
 struct SlotTargets {
   HostImage output;
-  HostBuffer color;
-  HostBuffer depth;
+  HostBuffer readback[kReadbackImageCount];
   bool pending = false;  // a submitted frame whose readback has not been copied out yet
   uint32_t frame = 0;
   Camera camera;
@@ -202,8 +201,10 @@ Status Capture::run() {
   const VkExtent2D extent{options_.size.width, options_.size.height};
   for (SlotTargets& slot : slots) {
     SIVIFLOW_TRY(context_->create_target_image(kOutputFormat, extent, &slot.output));
-    SIVIFLOW_TRY(context_->create_readback_buffer(renderer_->readback_color_bytes(), &slot.color));
-    SIVIFLOW_TRY(context_->create_readback_buffer(renderer_->readback_depth_bytes(), &slot.depth));
+    for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
+      SIVIFLOW_TRY(context_->create_readback_buffer(
+          renderer_->readback_bytes(static_cast<ReadbackImage>(i)), &slot.readback[i]));
+    }
   }
 
   uint32_t written = 0;
@@ -226,8 +227,7 @@ Status Capture::run() {
     inputs.output.current = ImageState{};  // contents discarded: we overwrite every pixel
     inputs.output.final = {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-    inputs.readback.color = slot.color.buffer;
-    inputs.readback.depth = slot.depth.buffer;
+    for (uint32_t i = 0; i < kReadbackImageCount; ++i) inputs.readback.buffers[i] = slot.readback[i].buffer;
     SIVIFLOW_TRY(renderer_->record(cmd, inputs));
     SIVIFLOW_TRY(context_->end_slot_and_submit(index));
     slot.pending = true;
@@ -259,9 +259,9 @@ void Capture::copy_out(const SlotTargets& slot) {
   const size_t pixels = size_t{options_.size.width} * options_.size.height;
   finished_.frame = slot.frame;
   finished_.camera = slot.camera;
-  const auto* halves = static_cast<const uint16_t*>(slot.color.data);
+  const auto* halves = static_cast<const uint16_t*>(slot.readback[0].data);
   finished_.color_halves.assign(halves, halves + pixels * 4);
-  const auto* depth = static_cast<const float*>(slot.depth.data);
+  const auto* depth = static_cast<const float*>(slot.readback[1].data);
   finished_.window_depth.assign(depth, depth + pixels);
 }
 

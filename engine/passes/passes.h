@@ -76,14 +76,34 @@ class ScenePass {
   VkPipeline scene_pipeline_ = VK_NULL_HANDLE;
 };
 
-// ---- readback: output colour and depth -> host buffers (tools and tests only) ----
+// ---- water mask: 1 where the river surface is the nearest thing on screen ----
 
-struct ReadbackHandles {
-  ImageHandle color;
-  ImageHandle depth;
-  BufferHandle color_buffer;  // imported, handed back in the HostRead state
-  BufferHandle depth_buffer;
+class WaterMaskPass {
+ public:
+  static constexpr VkFormat kFormat = VK_FORMAT_R32_SFLOAT;
+  Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat depth_format);
+  void destroy(const GpuContext& gpu);
+
+  struct Handles {
+    ImageHandle mask;        // written (cleared to 0, 1 on visible water)
+    ImageHandle depth;       // the scene's depth, tested against, not written
+    BufferHandle vertices;   // river surface positions (vec3)
+    BufferHandle indices;
+  };
+  void declare(FrameGraph& graph, const gpu::SceneConstants* constants, uint32_t index_count,
+               Handles* handles);
+
+ private:
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
 };
-void add_readback_pass(FrameGraph& graph, ReadbackHandles* handles);
+
+// ---- readback: images -> host buffers (tools and tests only) ----
+
+struct ReadbackCopy {
+  ImageHandle image;    // copied whole, tightly packed (depth formats: the depth aspect)
+  BufferHandle buffer;  // imported, handed back in the HostRead state; replaced by the written version
+};
+void add_readback_pass(FrameGraph& graph, std::vector<ReadbackCopy>* copies);
 
 }  // namespace siviflow

@@ -23,24 +23,24 @@ int main() {
   if (!status.ok()) return std::fprintf(stderr, "%s\n", status.message().c_str()), 1;
 
   HostImage target;
-  HostBuffer color;
-  HostBuffer depth;
-  if (!host->create_target_image(VK_FORMAT_R8G8B8A8_UNORM, {64, 36}, &target).ok() ||
-      !host->create_readback_buffer(renderer->readback_color_bytes(), &color).ok() ||
-      !host->create_readback_buffer(renderer->readback_depth_bytes(), &depth).ok()) {
-    return 1;
+  if (!host->create_target_image(VK_FORMAT_R8G8B8A8_UNORM, {64, 36}, &target).ok()) return 1;
+  HostBuffer readback[kReadbackImageCount];
+  FrameInputs inputs;
+  for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
+    if (!host->create_readback_buffer(renderer->readback_bytes(static_cast<ReadbackImage>(i)), &readback[i]).ok()) {
+      return 1;
+    }
+    inputs.readback.buffers[i] = readback[i].buffer;
   }
   VkCommandBuffer cmd = VK_NULL_HANDLE;
-  FrameInputs inputs;
   inputs.output = {target.image, target.view, ImageState{},
                    {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_GENERAL}};
-  inputs.readback = {color.buffer, depth.buffer};
   if (!host->begin_slot(0, &cmd).ok() || !renderer->begin_frame(0).ok() ||
       !renderer->update(renderer->scene_camera(0.0), 0.0).ok() || !renderer->record(cmd, inputs).ok() ||
       !host->end_slot_and_submit(0).ok() || !host->wait_slot(0).ok()) {
     return std::fprintf(stderr, "frame failed\n"), 1;
   }
-  const auto* texels = static_cast<const unsigned char*>(color.data);
+  const auto* texels = static_cast<const unsigned char*>(readback[0].data);
   unsigned long sum = 0;
   for (int i = 0; i < 64 * 36 * 4; ++i) sum += texels[i];
   renderer.reset();

@@ -21,6 +21,7 @@ struct Frame {
   uint32_t width = 0;
   std::vector<float> rgba;   // linear, 4 floats per pixel
   std::vector<float> depth;  // window depth, 0 near .. 1 far
+  std::vector<float> water_mask;
 
   const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * width + x) * 4]; }
 };
@@ -39,25 +40,28 @@ class RenderTest : public GpuTest {
     }
     struct Slot {
       HostImage target;
-      HostBuffer color;
-      HostBuffer depth;
+      HostBuffer readback[kReadbackImageCount];
       ImageState state;  // where the host's image was left last time (undefined at first)
       bool pending = false;
     };
     Slot slots[2];
     for (Slot& slot : slots) {
       EXPECT_TRUE(context_->create_target_image(VK_FORMAT_R16G16B16A16_SFLOAT, {width, height}, &slot.target).ok());
-      EXPECT_TRUE(context_->create_readback_buffer(renderer_->readback_color_bytes(), &slot.color).ok());
-      EXPECT_TRUE(context_->create_readback_buffer(renderer_->readback_depth_bytes(), &slot.depth).ok());
+      for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
+        EXPECT_TRUE(context_->create_readback_buffer(
+            renderer_->readback_bytes(static_cast<ReadbackImage>(i)), &slot.readback[i]).ok());
+      }
     }
     const auto collect = [&](Slot& slot) {
       Frame out;
       out.width = width;
-      const auto* halves = static_cast<const uint16_t*>(slot.color.data);
+      const auto* halves = static_cast<const uint16_t*>(slot.readback[0].data);
       out.rgba.resize(size_t{width} * height * 4);
       for (size_t i = 0; i < out.rgba.size(); ++i) out.rgba[i] = glm::unpackHalf1x16(halves[i]);
-      const auto* depths = static_cast<const float*>(slot.depth.data);
+      const auto* depths = static_cast<const float*>(slot.readback[1].data);
       out.depth.assign(depths, depths + size_t{width} * height);
+      const auto* mask = static_cast<const float*>(slot.readback[2].data);
+      out.water_mask.assign(mask, mask + size_t{width} * height);
       frames.push_back(std::move(out));
       slot.pending = false;
     };
@@ -74,7 +78,7 @@ class RenderTest : public GpuTest {
       inputs.output = {slot.target.image, slot.target.view, slot.state,
                        {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
-      inputs.readback = {slot.color.buffer, slot.depth.buffer};
+      for (uint32_t i = 0; i < kReadbackImageCount; ++i) inputs.readback.buffers[i] = slot.readback[i].buffer;
       const Status status = renderer_->record(cmd, inputs);
       EXPECT_TRUE(status.ok()) << status.message();
       slot.state = inputs.output.final;  // the host's image is now where it asked us to leave it
@@ -127,6 +131,25 @@ TEST_F(RenderTest, DefaultSceneShowsSkyAboveTerrainBelow) {
   EXPECT_GT(sum_sq / n - (sum / n) * (sum / n), 0.01) << "the frame is (nearly) constant";
 }
 
+TEST_F(RenderTest, WaterMaskCoversTheRiverOnly) {
+  const std::vector<Frame> frames = render(0, 1);
+  ASSERT_EQ(frames.size(), 1u);
+  const Frame& f = frames[0];
+  size_t water = 0;
+  for (size_t i = 0; i < f.water_mask.size(); ++i) {
+    ASSERT_TRUE(f.water_mask[i] == 0.0f || f.water_mask[i] == 1.0f) << "pixel " << i;
+    if (f.water_mask[i] == 1.0f) {
+      ++water;
+      EXPECT_LT(f.depth[i], 1.0f) << "water seen where only sky is: pixel " << i;
+    }
+  }
+  // The camera looks down the river: water below the centre, none in the sky at the top.
+  EXPECT_EQ(f.water_mask[4 * kWidth + kWidth / 2], 0.0f);
+  EXPECT_EQ(f.water_mask[(kHeight - 4) * kWidth + kWidth / 2], 1.0f);
+  EXPECT_GT(water, size_t{kWidth} * kHeight / 20);
+  EXPECT_LT(water, size_t{kWidth} * kHeight / 2);
+}
+
 TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {
   const std::vector<Frame> run = render(0, 4);
   ASSERT_TRUE(context_->wait_idle().ok());
@@ -142,7 +165,7 @@ TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {
 TEST_F(RenderTest, ResizeBetweenFramesKeepsFramesInFlightValid) {
   ASSERT_EQ(render(0, 3).size(), 3u);
   ASSERT_TRUE(renderer_->resize({160, 90}).ok());
-  EXPECT_EQ(renderer_->readback_color_bytes(), 160u * 90u * 8u);
+  EXPECT_EQ(renderer_->readback_bytes(ReadbackImage::kColor), 160u * 90u * 8u);
   const std::vector<Frame> small = render(3, 6, 160, 90);
   ASSERT_EQ(small.size(), 3u);
   const float* sky = small[0].pixel(80, 2);

@@ -89,11 +89,19 @@ struct ExternalImage {
   ImageState final;
 };
 
-// Host-visible buffers that receive the frame when CreateInfo::enable_readback is set:
-// colour as the output format's texels, depth as 32-bit floats (window depth, 0 near .. 1 far).
+// What CreateInfo::enable_readback copies each frame into host-visible buffers, tightly packed
+// rows, top-left origin:
+enum class ReadbackImage : uint32_t {
+  kColor,      // the output, in its format's texels
+  kDepth,      // 32-bit float window depth, 0 near .. 1 far (sky: 1)
+  kWaterMask,  // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
+};
+inline constexpr uint32_t kReadbackImageCount = 3;
+const char* readback_image_name(ReadbackImage image);
+
 struct ReadbackTargets {
-  VkBuffer color = VK_NULL_HANDLE;
-  VkBuffer depth = VK_NULL_HANDLE;
+  VkBuffer buffers[kReadbackImageCount] = {};  // indexed by ReadbackImage
+  VkBuffer& operator[](ReadbackImage image) { return buffers[static_cast<uint32_t>(image)]; }
 };
 
 struct FrameInputs {
@@ -125,9 +133,8 @@ class Renderer {
   // The camera of the scene's own camera path at that time (the default scene glides downstream).
   Camera scene_camera(double time_seconds) const;
 
-  // Byte size of one readback buffer for colour / depth at the configured extent.
-  VkDeviceSize readback_color_bytes() const;
-  VkDeviceSize readback_depth_bytes() const;
+  // Byte size of the readback buffer of that image at the configured extent.
+  VkDeviceSize readback_bytes(ReadbackImage image) const;
   // The frame graph of the current configuration, as text and as Graphviz.
   std::string dump_frame_graph() const;
   std::string dump_frame_graph_graphviz() const;
