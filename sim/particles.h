@@ -1,0 +1,247 @@
+// River Particle Generator (paper §2.2.2-2.2.3, Algorithm 2; algorithms.md §1.2): a screen-space
+// Poisson-disk set of particles over the visible water, each anchored at a world point of the
+// river surface and carrying the flow data of its nearest river vertex.
+//
+// Every update (one frame):
+//   1. fades advance; a particle whose fade-out ends is deleted;
+//   2. (option) particles advect along the flow and are snapped back onto the surface;
+//   3. every particle is re-projected; those outside the view frustum (plus a margin) go at once;
+//   4. thinning: live particles (active or fading in), oldest first, closer than min_distance_px
+//      to an older kept one start fading out; fading-out ones are ignored by this test, and one
+//      whose spot has become free again fades back in (no id churn under jitter);
+//   5. fill: Dunbar-Humphreys boundary sampling grows new particles from the live ones next to a
+//      gap, plus seeds tried on a coarse grid for water not connected on screen to any particle;
+//      in two tiers: first at the preferred spacing (fill_spacing x min distance), then the gaps
+//      left, each filler pushed to the point of its gap farthest from every particle. With the
+//      camera still (and on a cut) the fill closes every gap wider than the minimum distance;
+//      while it moves, only those wider than kMovingCoverFactor x it, so the fillers have room
+//      to survive the motion instead of being thinned again the next frame (churn);
+//   6. conversion: a new particle's pixel ray is cast into the river (BVH); a miss makes none.
+// Fill method: Dunbar & Humphreys boundary sampling, not Bridson's dart throwing. It only works
+// at the boundary of the covered region (cost scales with the gap, not the screen), it yields
+// a maximal set (no point of the water is left farther than the spacing from a particle, which
+// the flow texture needs), and each try removes a fixed angular range of a particle's circle so
+// it terminates without a retry budget; Bridson's k random tries can leave holes and cost k rays.
+// Cost: a still camera casts no ray and recomputes no circle; a moving one recomputes the
+// circles of new particles, of the neighbours of removed ones, of those near the screen edge and
+// 1/kArcRecheckFrames of the rest, and caches rays that missed the water (dry sectors, seed cells).
+//
+// Determinism: the state after frame N is a function of (river, params, seed, cameras of frames
+// 0..N, dt of frames 0..N). Every random number of frame N comes from a generator seeded with
+// (seed, N), and everything is processed in id order. To start a run at frame N, call update()
+// for frames 0..N-1 first (no packing, no rendering needed); that is what makes frame N the same
+// whatever frame the run started from. update() refuses a frame index that is not the next one.
+//
+// Memory is bounded by the screen: particles, slots and grids are sized from the viewport and
+// the spacing, never from the river (the BVH is the only per-river structure).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "sim/particle_tuning.h"
+#include "sim/river_bvh.h"
+#include "sim/status.h"
+
+namespace siviflow {
+
+// The per-vertex river data the particles consume (the River Surface Generator's and the stream
+// function's output, or any mesh with the same data). Spans into caller-owned arrays: they must
+// outlive the ParticleField. Positions and indices must not change after create() (the BVH is
+// built on them); flow, speed, depth and slope may change between updates (they are re-read
+// every update, so a re-solved flow reaches the particles the next frame).
+struct RiverFlowField {
+  std::span<const glm::vec3> positions;  // world space, metres, +Y up
+  std::span<const uint32_t> indices;     // 3 per triangle; empty: every 3 positions are one
+  std::span<const glm::vec3> flow;       // flow vector per vertex (direction, or velocity)
+  std::span<const float> speed;          // m/s per vertex; empty: |flow|
+  std::span<const float> depth;          // water depth per vertex, metres; empty: 0
+  std::span<const float> slope;          // riverbed slope per vertex; empty: 0
+};
+
+// What the particles see through: a world -> clip matrix in Vulkan conventions (clip depth 0..1,
+// +Y down, i.e. the projection built with projection[1][1] *= -1) and the output size. Screen
+// positions are in pixels of that output, origin top-left, pixel centres at +0.5.
+struct ScreenCamera {
+  glm::mat4 view_proj{1.0f};
+  glm::uvec2 viewport{0u};
+};
+
+struct ParticleParams {
+  uint64_t seed = 0;
+  glm::uvec2 viewport{1280u, 720u};
+  // Minimum screen distance between live particles; 0: kDefaultMinDistancePx scaled from 720
+  // lines to the viewport height.
+  float min_distance_px = 0.0f;
+  // New particles are placed this multiple of min_distance_px apart where there is room (>= 1);
+  // the gaps left are then filled at the minimum distance, so the cover stays within it.
+  float fill_spacing = kDefaultFillSpacing;
+  float fade_in_seconds = kDefaultFadeInSeconds;    // 0: born active
+  float fade_out_seconds = kDefaultFadeOutSeconds;  // 0: removed at once
+  float vertex_search_radius = kDefaultVertexSearchRadius;  // metres
+  // Advection along the flow (Yu et al.); off in the paper. A particle moves by
+  // flow * advection_scale * dt and is snapped back onto the surface (one vertical ray and one
+  // nearest-vertex query per particle per frame: not within the 1 ms budget at 1080p).
+  bool advect = false;
+  float advection_scale = 1.0f;
+};
+
+enum class ParticleState : uint8_t { kActive, kFadingIn, kFadingOut };
+// "active", "fading_in", "fading_out" (the `state` column of the particle dumps).
+const char* to_string(ParticleState state);
+
+struct Particle {
+  uint32_t id = 0;    // unique over the run, from 1, in order of birth
+  uint16_t slot = 0;  // 1..slot_count(): the GPU index (flow texture id, aux texel); reused
+  ParticleState state = ParticleState::kFadingIn;
+  float fade = 0.0f;         // 0..1: 0 invisible, 1 fully in
+  glm::vec3 world{0.0f};     // on the river surface
+  glm::vec2 screen{0.0f};    // this frame, pixels
+  uint32_t vertex = 0;       // nearest river vertex: flow, speed, depth and slope are its own
+  glm::vec3 flow{0.0f};
+  float speed = 0.0f;
+  float depth = 0.0f;
+  float slope = 0.0f;
+  // Live particles take part in the Poisson-disk test; fading-out ones do not.
+  bool live() const { return state != ParticleState::kFadingOut; }
+};
+
+// What the last update did (for tests, logs and the benchmark).
+struct ParticleStats {
+  uint32_t live = 0;
+  uint32_t fading_out = 0;
+  uint32_t born = 0;
+  uint32_t expired = 0;   // fade-out finished
+  uint32_t culled = 0;    // outside the frustum + margin
+  uint32_t thinned = 0;   // started fading out: too close to an older live particle
+  uint32_t revived = 0;   // fading out, spot free again: fading back in
+  uint32_t evicted = 0;   // fading out, slot taken early because the slots ran out
+  uint32_t left_river = 0;  // advection carried it off the water
+  uint32_t rays = 0;      // pixel rays cast (conversion and seeding)
+  uint32_t ray_misses = 0;
+  uint32_t arc_checks = 0;  // particles whose fill circle was recomputed
+  uint32_t seed_tests = 0;  // seed cells tested
+  bool cut = false;         // the frame rebuilt everything (first frame or camera cut)
+};
+
+class ParticleField {
+ public:
+  // Validates the river (sizes of the per-vertex spans, indices, finite positions) and the
+  // parameters, builds the BVH (O(n log n) in the triangles, done once) and sizes every buffer
+  // from the viewport. Fails with a message naming what is wrong; `out` is untouched then.
+  static Status create(const RiverFlowField& river, const ParticleParams& params,
+                       ParticleField* out);
+  // The same with a BVH already built on river.positions / river.indices (the same spans), so
+  // a new viewport or a second view of a large river does not rebuild it.
+  static Status create(const RiverFlowField& river, std::shared_ptr<const RiverBvh> bvh,
+                       const ParticleParams& params, ParticleField* out);
+
+  // Advances one frame (Algorithm 2). `camera.viewport` must equal params.viewport and
+  // `frame_index` must be next_frame(); dt_seconds >= 0 drives the fades and the advection.
+  // On failure nothing changes.
+  Status update(const ScreenCamera& camera, uint64_t frame_index, float dt_seconds);
+  // Back to the state before frame 0 (ids restart at 1).
+  void reset();
+
+  // In id order (ascending), so in birth order.
+  std::span<const Particle> particles() const { return particles_; }
+  const ParticleStats& stats() const { return stats_; }
+  uint64_t next_frame() const { return next_frame_; }
+
+  const ParticleParams& params() const { return params_; }
+  float min_distance_px() const { return min_distance_; }
+  float fill_spacing_px() const { return spacing_; }
+  // With the camera still (or on the first frame, or a cut) the fill leaves no point of the
+  // visible water (away from its edges) farther than this from a live particle: the minimum
+  // distance plus a hair against float noise. While the camera moves, gaps are filled once
+  // they exceed moving_cover_radius_px() (hysteresis against churn); the frame it stops, the
+  // exact cover is restored.
+  float cover_radius_px() const { return tight_spacing_; }
+  float moving_cover_radius_px() const { return moving_spacing_; }
+  // Slots run from 1 to slot_count() (0 is "no particle"): the aux data needs slot_count() + 1
+  // entries. Fixed by the viewport and the spacing.
+  uint32_t slot_count() const { return slot_count_; }
+  const RiverBvh& bvh() const { return *bvh_; }
+  std::shared_ptr<const RiverBvh> shared_bvh() const { return bvh_; }
+  const RiverFlowField& river() const { return river_; }
+
+ private:
+  // Per-slot upkeep caches; a slot belongs to one particle for its whole life.
+  struct SlotData {
+    uint32_t dry_mask = 0;       // sectors of the fill circle whose ray missed the water
+    uint32_t dry_epoch = 0;      // camera epoch the dry sectors were found in
+    uint32_t settled_epoch = 0;  // camera epoch the fill circle was last found full in
+    bool settled = false;        // the fill circle had no free arc left
+    bool dirty = true;           // a neighbour went away: recompute the fill circle
+    bool tight = false;          // settled to the exact cover (camera still), not the moving one
+  };
+  struct Frame;  // per-update scratch: camera, generator, domains
+  struct Neighbour {
+    float angle;     // of the direction from the particle being grown, radians
+    float distance;  // pixels
+  };
+  static Neighbour neighbour(const glm::vec2& c, const glm::vec2& q);
+
+  void clear_state();
+  void advance_fades(float dt);
+  void advect(float dt);
+  void project_and_cull(Frame& f);
+  void refresh_attributes();
+  void build_grid();
+  void grid_insert(uint32_t index);
+  bool any_live_within(const glm::vec2& p, float radius, uint32_t except) const;
+  void mark_dirty_around(const glm::vec2& p, float radius);
+  void thin_and_revive(Frame& f);
+  void fill(Frame& f);
+  void grow(Frame& f, uint32_t index);
+  void seed(Frame& f);
+  bool try_create(Frame& f, const glm::vec2& screen, uint32_t* index);
+  bool acquire_slot(uint16_t* slot);
+  void release_slot(uint16_t slot);
+  void convert(Particle& p, const RayHit& hit) const;
+  void remove_dead();
+
+  RiverFlowField river_;
+  ParticleParams params_;
+  std::shared_ptr<const RiverBvh> bvh_;
+  float min_distance_ = 0.0f;  // px
+  float spacing_ = 0.0f;        // px: preferred placement distance of the fill (first tier)
+  float tight_spacing_ = 0.0f;  // px: placement distance of the second tier (the gaps)
+  float moving_spacing_ = 0.0f; // px: the same while the camera moves (kMovingCoverFactor)
+  float fill_margin_ = 0.0f;
+  float cull_margin_ = 0.0f;
+  uint32_t slot_count_ = 0;
+
+  // Screen grid of live particles over the cull domain: cells of min_distance_ pixels, each a
+  // linked list through grid_next_ (indices into particles_). Also the seed grid.
+  glm::vec2 grid_origin_{0.0f};
+  int grid_w_ = 0;
+  int grid_h_ = 0;
+  std::vector<int32_t> grid_head_;
+  std::vector<int32_t> grid_next_;
+  std::vector<uint32_t> seed_epoch_;  // per cell: camera epoch of its last seed test (+1)
+
+  std::vector<Particle> particles_;
+  std::vector<SlotData> slots_;        // indexed by slot
+  std::vector<uint16_t> free_slots_;   // min-heap: the lowest free slot is reused first
+  std::vector<uint32_t> queue_;        // fill candidates (indices into particles_)
+  std::vector<glm::vec2> removed_at_;  // screen positions of this frame's thinned particles
+  std::vector<float> arcs_;            // scratch: free arcs as [begin, end) pairs of angles
+  std::vector<float> arcs_tmp_;        // scratch of the arc subtraction
+  std::vector<glm::vec2> near_;        // scratch: screen positions around a gap being filled
+  std::vector<Neighbour> neighbours_;  // scratch: the live neighbours of the particle grown
+
+  uint32_t next_id_ = 1;
+  uint64_t next_frame_ = 0;
+  uint32_t camera_epoch_ = 0;  // bumps whenever the camera changes
+  glm::mat4 last_view_proj_{0.0f};
+  ParticleStats stats_;
+};
+
+}  // namespace siviflow

@@ -1,0 +1,332 @@
+#include "sim/river_bvh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <glm/geometric.hpp>
+
+namespace siviflow {
+namespace {
+
+// Binned SAH: leaves of <= 4 triangles are cheap to test and keep the node count near n/2.
+constexpr uint32_t kLeafTriangles = 4;
+// A node stays a leaf up to this size when splitting would not pay (SAH).
+constexpr uint32_t kMaxLeafTriangles = 16;
+constexpr int kBins = 16;
+// Below this depth splits fall back to the object median, so the traversal stack is bounded.
+constexpr int kMaxSahDepth = 40;
+constexpr int kStackSize = 128;  // > kMaxSahDepth + 32 median levels
+
+struct Aabb {
+  glm::vec3 lo{std::numeric_limits<float>::infinity()};
+  glm::vec3 hi{-std::numeric_limits<float>::infinity()};
+  void grow(const glm::vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void grow(const Aabb& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
+  float half_area() const {
+    const glm::vec3 e = hi - lo;
+    return e.x < 0.0f ? 0.0f : e.x * e.y + e.y * e.z + e.z * e.x;
+  }
+};
+
+// A triangle during the build: its bounds travel with it, so partitioning stays cache-local.
+struct Ref {
+  glm::vec3 lo;
+  glm::vec3 hi;
+  uint32_t triangle;
+  float centroid(int axis) const { return 0.5f * (lo[axis] + hi[axis]); }
+};
+
+struct BuildTask {
+  uint32_t node;
+  uint32_t begin;
+  uint32_t end;
+  int depth;
+};
+
+// Squared distance from p to the box (0 inside).
+float box_distance2(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& p) {
+  const glm::vec3 d = glm::max(glm::max(lo - p, p - hi), glm::vec3(0.0f));
+  return d.x * d.x + d.y * d.y + d.z * d.z;
+}
+
+}  // namespace
+
+Status RiverBvh::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                       RiverBvh* out) {
+  const size_t corner_count = indices.empty() ? positions.size() : indices.size();
+  if (corner_count == 0) return Status::error("river BVH: the mesh has no triangles");
+  if (corner_count % 3 != 0) {
+    return Status::error("river BVH: " + std::to_string(corner_count) +
+                         (indices.empty() ? " positions" : " indices") +
+                         " is not a multiple of 3 (a non-indexed mesh needs 3 per triangle)");
+  }
+  const size_t tri_count = corner_count / 3;
+  if (tri_count > std::numeric_limits<uint32_t>::max() / 4 ||
+      positions.size() > std::numeric_limits<uint32_t>::max()) {
+    return Status::error("river BVH: too many triangles (" + std::to_string(tri_count) + ")");
+  }
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const glm::vec3& p = positions[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return Status::error("river BVH: vertex " + std::to_string(i) + " is not finite");
+    }
+  }
+  for (size_t i = 0; i < indices.size(); ++i) {
+    if (indices[i] >= positions.size()) {
+      return Status::error("river BVH: index " + std::to_string(i) + " (" +
+                           std::to_string(indices[i]) + ") is out of range (" +
+                           std::to_string(positions.size()) + " vertices)");
+    }
+  }
+
+  RiverBvh bvh;
+  bvh.positions_ = positions;
+  bvh.indices_ = indices;
+  std::vector<Ref> refs(tri_count);
+  Aabb root_box;
+  for (uint32_t t = 0; t < tri_count; ++t) {
+    Aabb b;
+    for (int k = 0; k < 3; ++k) b.grow(positions[bvh.triangle_vertex(t, k)]);
+    refs[t] = {b.lo, b.hi, t};
+    root_box.grow(b);
+  }
+  bvh.nodes_.reserve(2 * (tri_count / kLeafTriangles) + 1);
+  bvh.nodes_.push_back({root_box.lo, 0, root_box.hi, 0});
+
+  std::vector<BuildTask> tasks{{0, 0, static_cast<uint32_t>(tri_count), 0}};
+  struct Bin {
+    Aabb box;
+    uint32_t count = 0;
+  };
+  while (!tasks.empty()) {
+    const BuildTask task = tasks.back();
+    tasks.pop_back();
+    const uint32_t count = task.end - task.begin;
+    Node& node = bvh.nodes_[task.node];
+    const Aabb node_box{node.lo, node.hi};
+    if (count <= kLeafTriangles) {
+      node.first = task.begin;
+      node.count = count;
+      continue;
+    }
+    Aabb centroids;
+    for (uint32_t i = task.begin; i < task.end; ++i) {
+      centroids.grow(0.5f * (refs[i].lo + refs[i].hi));
+    }
+    const glm::vec3 extent = centroids.hi - centroids.lo;
+
+    int best_axis = -1;
+    int best_split = 0;
+    float best_cost = std::numeric_limits<float>::infinity();
+    if (task.depth < kMaxSahDepth) {
+      for (int axis = 0; axis < 3; ++axis) {
+        if (!(extent[axis] > 0.0f)) continue;
+        Bin bins[kBins];
+        const float scale = kBins / extent[axis];
+        for (uint32_t i = task.begin; i < task.end; ++i) {
+          const int b = std::min(
+              kBins - 1, static_cast<int>((refs[i].centroid(axis) - centroids.lo[axis]) * scale));
+          bins[b].count++;
+          bins[b].box.grow(Aabb{refs[i].lo, refs[i].hi});
+        }
+        float right_area[kBins];
+        uint32_t right_count[kBins];
+        Aabb acc;
+        uint32_t n = 0;
+        for (int b = kBins - 1; b > 0; --b) {
+          acc.grow(bins[b].box);
+          n += bins[b].count;
+          right_area[b] = acc.half_area();
+          right_count[b] = n;
+        }
+        acc = Aabb{};
+        n = 0;
+        for (int b = 0; b < kBins - 1; ++b) {
+          acc.grow(bins[b].box);
+          n += bins[b].count;
+          if (n == 0 || right_count[b + 1] == 0) continue;
+          const float cost = acc.half_area() * static_cast<float>(n) +
+                             right_area[b + 1] * static_cast<float>(right_count[b + 1]);
+          if (cost < best_cost) {
+            best_cost = cost;
+            best_axis = axis;
+            best_split = b + 1;
+          }
+        }
+      }
+      const float leaf_cost = node_box.half_area() * static_cast<float>(count);
+      if (count <= kMaxLeafTriangles && !(best_cost < leaf_cost)) {
+        node.first = task.begin;
+        node.count = count;
+        continue;
+      }
+    }
+
+    uint32_t mid = 0;
+    if (best_axis >= 0) {
+      const float lo = centroids.lo[best_axis];
+      const float scale = kBins / extent[best_axis];
+      const int axis = best_axis;
+      const int split = best_split;
+      Ref* m = std::partition(refs.data() + task.begin, refs.data() + task.end, [&](const Ref& r) {
+        return std::min(kBins - 1, static_cast<int>((r.centroid(axis) - lo) * scale)) < split;
+      });
+      mid = static_cast<uint32_t>(m - refs.data());
+    }
+    if (best_axis < 0 || mid == task.begin || mid == task.end) {
+      // Too deep for SAH, or centroids that coincide: the object median on the longest axis.
+      const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+      mid = task.begin + count / 2;
+      std::nth_element(refs.data() + task.begin, refs.data() + mid, refs.data() + task.end,
+                       [axis](const Ref& a, const Ref& b) {
+                         return a.centroid(axis) < b.centroid(axis) ||
+                                (a.centroid(axis) == b.centroid(axis) && a.triangle < b.triangle);
+                       });
+    }
+    Aabb left_box, right_box;
+    for (uint32_t i = task.begin; i < mid; ++i) left_box.grow(Aabb{refs[i].lo, refs[i].hi});
+    for (uint32_t i = mid; i < task.end; ++i) right_box.grow(Aabb{refs[i].lo, refs[i].hi});
+    const uint32_t left = static_cast<uint32_t>(bvh.nodes_.size());
+    bvh.nodes_[task.node].first = left;  // `node` may dangle once the vector grows
+    bvh.nodes_[task.node].count = 0;
+    bvh.nodes_.push_back({left_box.lo, 0, left_box.hi, 0});
+    bvh.nodes_.push_back({right_box.lo, 0, right_box.hi, 0});
+    tasks.push_back({left + 1, mid, task.end, task.depth + 1});
+    tasks.push_back({left, task.begin, mid, task.depth + 1});
+  }
+  bvh.nodes_.shrink_to_fit();
+  bvh.order_.resize(tri_count);
+  for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
+  *out = std::move(bvh);
+  return Status::success();
+}
+
+size_t RiverBvh::memory_bytes() const {
+  return nodes_.capacity() * sizeof(Node) + order_.capacity() * sizeof(uint32_t);
+}
+
+bool RiverBvh::intersect(const glm::vec3& origin, const glm::vec3& direction, float t_max,
+                         RayHit* hit) const {
+  if (nodes_.empty()) return false;
+  // A zero component would make 0 * inf = NaN in the slab test; a tiny one keeps it ordered.
+  glm::vec3 inv;
+  for (int a = 0; a < 3; ++a) {
+    const float d = std::fabs(direction[a]) < 1e-30f ? std::copysign(1e-30f, direction[a])
+                                                     : direction[a];
+    inv[a] = 1.0f / d;
+  }
+  const auto enter = [&](const Node& n, float limit) {
+    const glm::vec3 t0 = (n.lo - origin) * inv;
+    const glm::vec3 t1 = (n.hi - origin) * inv;
+    const glm::vec3 tn = glm::min(t0, t1), tf = glm::max(t0, t1);
+    const float t_near = std::max(std::max(tn.x, tn.y), std::max(tn.z, 0.0f));
+    const float t_far = std::min(std::min(tf.x, tf.y), std::min(tf.z, limit));
+    return t_near <= t_far ? t_near : std::numeric_limits<float>::infinity();
+  };
+
+  float best = t_max;
+  bool found = false;
+  uint32_t stack[kStackSize];
+  int top = 0;
+  if (enter(nodes_[0], best) == std::numeric_limits<float>::infinity()) return false;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (n.count > 0) {
+      for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+        const uint32_t tri = order_[i];
+        const glm::vec3& v0 = positions_[triangle_vertex(tri, 0)];
+        const glm::vec3 e1 = positions_[triangle_vertex(tri, 1)] - v0;
+        const glm::vec3 e2 = positions_[triangle_vertex(tri, 2)] - v0;
+        const glm::vec3 p = glm::cross(direction, e2);
+        const float det = glm::dot(e1, p);
+        if (det == 0.0f || !std::isfinite(det)) continue;
+        const float inv_det = 1.0f / det;
+        const glm::vec3 s = origin - v0;
+        const float u = glm::dot(s, p) * inv_det;
+        if (u < 0.0f || u > 1.0f) continue;
+        const glm::vec3 q = glm::cross(s, e1);
+        const float v = glm::dot(direction, q) * inv_det;
+        if (v < 0.0f || u + v > 1.0f) continue;
+        const float t = glm::dot(e2, q) * inv_det;
+        if (t < 0.0f || t > best) continue;
+        if (found && t == best && tri > hit->triangle) continue;  // ties: the lower triangle
+        best = t;
+        found = true;
+        hit->t = t;
+        hit->triangle = tri;
+        // On the triangle's plane, not along a long ray: the particle lies on the surface.
+        hit->position = v0 + u * e1 + v * e2;
+      }
+      continue;
+    }
+    const uint32_t l = n.first, r = n.first + 1;
+    const float tl = enter(nodes_[l], best), tr = enter(nodes_[r], best);
+    const float inf = std::numeric_limits<float>::infinity();
+    // Push the far child first so the near one is popped first and shrinks `best` early.
+    if (tl <= tr) {
+      if (tr != inf) stack[top++] = r;
+      if (tl != inf) stack[top++] = l;
+    } else {
+      if (tl != inf) stack[top++] = l;
+      if (tr != inf) stack[top++] = r;
+    }
+  }
+  return found;
+}
+
+uint32_t RiverBvh::nearest_vertex(const glm::vec3& p, float radius, uint32_t hint_triangle) const {
+  uint32_t best_v = triangle_vertex(hint_triangle, 0);
+  float best_d2 = distance2(p, positions_[best_v]);
+  for (int k = 1; k < 3; ++k) {
+    const uint32_t v = triangle_vertex(hint_triangle, k);
+    const float d2 = distance2(p, positions_[v]);
+    if (d2 < best_d2 || (d2 == best_d2 && v < best_v)) {
+      best_d2 = d2;
+      best_v = v;
+    }
+  }
+  const float r2 = radius * radius;
+  if (nodes_.empty() || !(r2 > 0.0f)) return best_v;
+  uint32_t stack[kStackSize];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (box_distance2(n.lo, n.hi, p) > std::min(best_d2, r2)) continue;
+    if (n.count > 0) {
+      for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t v = triangle_vertex(order_[i], k);
+          const float d2 = distance2(p, positions_[v]);
+          if (d2 <= r2 && (d2 < best_d2 || (d2 == best_d2 && v < best_v))) {
+            best_d2 = d2;
+            best_v = v;
+          }
+        }
+      }
+      continue;
+    }
+    const uint32_t l = n.first, r = n.first + 1;
+    const float dl = box_distance2(nodes_[l].lo, nodes_[l].hi, p);
+    const float dr = box_distance2(nodes_[r].lo, nodes_[r].hi, p);
+    if (dl <= dr) {
+      stack[top++] = r;
+      stack[top++] = l;
+    } else {
+      stack[top++] = l;
+      stack[top++] = r;
+    }
+  }
+  return best_v;
+}
+
+}  // namespace siviflow

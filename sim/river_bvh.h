@@ -1,0 +1,71 @@
+// A bounding volume hierarchy over the river triangles: the closest hit of a ray (a pixel's ray
+// into the water surface) and the nearest river vertex to a point, each in O(log n) of the mesh.
+// Built once per mesh; the queries are const and allocate nothing.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "sim/status.h"
+
+namespace siviflow {
+
+struct RayHit {
+  float t = 0.0f;         // origin + t * direction
+  uint32_t triangle = 0;  // index of the triangle (3 consecutive indices, or 3 positions)
+  glm::vec3 position{0.0f};
+};
+
+class RiverBvh {
+ public:
+  // `indices` holds 3 vertex indices per triangle; when empty, every 3 positions are a triangle.
+  // The spans are referenced, not copied: they must outlive the BVH and keep their contents.
+  // Fails on no triangles, a count that is not a multiple of 3, an index out of range, a non-
+  // finite position, or more triangles than 32-bit indices address.
+  static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                      RiverBvh* out);
+
+  size_t triangle_count() const { return order_.size(); }
+  std::span<const glm::vec3> positions() const { return positions_; }
+  std::span<const uint32_t> indices() const { return indices_; }
+  uint32_t triangle_vertex(uint32_t triangle, int corner) const {
+    return indices_.empty() ? triangle * 3 + static_cast<uint32_t>(corner)
+                            : indices_[size_t{triangle} * 3 + static_cast<size_t>(corner)];
+  }
+  // Bytes held by the hierarchy itself (not the referenced mesh).
+  size_t memory_bytes() const;
+
+  // Closest intersection of origin + t * direction, t in [0, t_max], with any triangle (both
+  // sides). False when the ray misses.
+  bool intersect(const glm::vec3& origin, const glm::vec3& direction, float t_max,
+                 RayHit* hit) const;
+
+  // The vertex nearest to `p` (ties: the lower index) among the vertices within `radius` of it;
+  // when none is, the nearest corner of `hint_triangle` (usually the triangle `p` lies on).
+  uint32_t nearest_vertex(const glm::vec3& p, float radius, uint32_t hint_triangle) const;
+
+ private:
+  struct Node {
+    glm::vec3 lo;
+    uint32_t first;  // leaf: first entry of order_; inner: index of the left child (right = +1)
+    glm::vec3 hi;
+    uint32_t count;  // leaf: triangle count (> 0); inner: 0
+  };
+  static_assert(sizeof(Node) == 32);
+
+  std::span<const glm::vec3> positions_;
+  std::span<const uint32_t> indices_;
+  std::vector<Node> nodes_;
+  std::vector<uint32_t> order_;  // triangle indices, leaf by leaf
+};
+
+// Squared distance, written once so every caller (and test) rounds the same way.
+inline float distance2(const glm::vec3& a, const glm::vec3& b) {
+  const glm::vec3 e = a - b;
+  return e.x * e.x + e.y * e.y + e.z * e.z;
+}
+
+}  // namespace siviflow
