@@ -13,6 +13,8 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/siviflow
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/sim DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
+# The GPU layouts the sim's packing writes (included as "shaders/shared.h").
+install(FILES ${PROJECT_SOURCE_DIR}/shaders/shared.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/shaders)
 install(EXPORT siviflowTargets NAMESPACE siviflow:: FILE siviflowTargets.cmake
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/siviflow)
 

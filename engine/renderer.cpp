@@ -10,6 +10,8 @@
 #include "passes/passes.h"
 #include "scene/default_scene.h"
 #include "scene/detail_texture.h"
+#include "scene/river_simulation.h"
+#include "siviflow/scene_file.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
@@ -23,6 +25,10 @@ constexpr uint32_t kMaxFramesInFlight = 8;
 constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkDeviceSize kDefaultStagingBytes = 8ull << 20;
+constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we copy
+// Layouts documented in shaders/shared.h.
+constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
+constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 
 uint32_t texel_bytes(VkFormat format) {
   switch (format) {
@@ -55,6 +61,8 @@ struct Renderer::Impl {
   FrameRing ring;
   ProceduralRiver river{default_river_params()};
   SceneLook look = default_scene_look();
+  RiverSimulation simulation;  // the river's flow, particles and flow textures, on the CPU
+  double last_time = 0.0;
 
   // Geometry that never changes: copied to the GPU once, then only read.
   enum StaticBufferId { kSceneVertices, kSceneIndices, kRiverVertices, kRiverIndices, kStaticBufferCount };
@@ -89,6 +97,13 @@ struct Renderer::Impl {
   Buffer static_staging_buffer;  // sized for the static data; freed when its slot comes round
 
   FrameGraph graph;
+  BufferHandle frame_staging;  // the slot's staging block: this frame's flow textures
+  UploadList frame_uploads;    // flow texture and particle aux, every frame
+  ImageHandle flow_texture;
+  ImageHandle particle_aux;
+  Image flow_image;
+  Image aux_image;
+  bool flow_images_new = true;  // created since the last record: no previous contents
   ScenePass::Handles scene;
   ImageHandle output;
   std::vector<ReadbackCopy> readbacks;  // one per ReadbackImage when readback is enabled
@@ -104,6 +119,7 @@ struct Renderer::Impl {
   Status declare_static_graph();
   Status declare_graph();
   Status stage_static_data();
+  Status simulate(const Camera& camera, double time_seconds);
   Status record_static_upload(VkCommandBuffer cmd);
   void destroy();
 };
@@ -184,8 +200,9 @@ Status Renderer::Impl::create_static_resources() {
   scene_index_count = static_cast<uint32_t>(geometry.indices.size());
   static_buffers[kSceneVertices].bytes = bytes_of(geometry.vertices);
   static_buffers[kSceneIndices].bytes = bytes_of(geometry.indices);
-  RiverMesh river_mesh;
-  SIVIFLOW_TRY(river.generate_mesh(&river_mesh));
+  SIVIFLOW_TRY(simulation.create(river, kDefaultSceneDischarge, info.seed,
+                                 {info.extent.width, info.extent.height}));
+  const RiverMesh& river_mesh = simulation.mesh();
   river_index_count = static_cast<uint32_t>(river_mesh.indices.size());
   static_buffers[kRiverVertices].bytes = bytes_of(river_mesh.positions);
   static_buffers[kRiverIndices].bytes = bytes_of(river_mesh.indices);
@@ -244,6 +261,17 @@ Status Renderer::Impl::declare_graph() {
                               state_of(Access::SampledFragment));
   scene.color = output;
   scene.depth = graph.create_image({"depth", kDepthFormat, extent, far_depth});
+
+  // Every frame's flow texture and particle aux data go through the slot's staging block.
+  const FlowTextureLayout& layout = simulation.layout();
+  const VkExtent2D flow_extent{layout.flow_extent.x, layout.flow_extent.y};
+  const VkExtent2D aux_extent{layout.aux_extent.x, layout.aux_extent.y};
+  frame_staging = graph.import_buffer({"frame staging", 0}, ResourceState{});
+  flow_texture = graph.create_persistent_image({"flow texture", kFlowTextureFormat, flow_extent, {}});
+  particle_aux = graph.create_persistent_image({"particle aux", kParticleAuxFormat, aux_extent, {}});
+  frame_uploads.buffers.clear();
+  frame_uploads.images = {{0, flow_texture, flow_extent}, {0, particle_aux, aux_extent}};
+  add_upload_pass(graph, frame_staging, &frame_uploads);
   scene_pass.declare(graph, &constants, scene_index_count, &scene);
 
   if (info.enable_readback) {
@@ -254,7 +282,9 @@ Status Renderer::Impl::declare_graph() {
     water.indices = static_buffers[kRiverIndices].in_frame_graph;
     water_mask_pass.declare(graph, &constants, river_index_count, &water);
     water_mask = water.mask;
-    const ImageHandle images[kReadbackImageCount] = {scene.color, scene.depth, water.mask};
+    const ImageHandle images[kReadbackImageCount] = {scene.color, scene.depth, water.mask,
+                                                     frame_uploads.images[0].destination,
+                                                     frame_uploads.images[1].destination};
     readbacks.clear();
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
       const BufferHandle buffer = graph.import_buffer(
@@ -265,6 +295,11 @@ Status Renderer::Impl::declare_graph() {
     add_readback_pass(graph, &readbacks);
   }
   SIVIFLOW_TRY(graph.compile());
+  SIVIFLOW_TRY(create_image(gpu, kFlowTextureFormat, flow_extent, graph.image_usage(flow_texture),
+                            "flow texture", &flow_image));
+  SIVIFLOW_TRY(create_image(gpu, kParticleAuxFormat, aux_extent, graph.image_usage(particle_aux),
+                            "particle aux", &aux_image));
+  flow_images_new = true;
   if (info.enable_readback) {
     SIVIFLOW_TRY(create_image(gpu, WaterMaskPass::kFormat, extent, graph.image_usage(water_mask),
                               "water mask", &water_mask_image));
@@ -315,6 +350,8 @@ void Renderer::Impl::destroy() {
   water_mask_pass.destroy(gpu);
   destroy_image(gpu, &depth_image);
   destroy_image(gpu, &water_mask_image);
+  destroy_image(gpu, &flow_image);
+  destroy_image(gpu, &aux_image);
   destroy_image(gpu, &detail_image);
   for (StaticBuffer& b : static_buffers) destroy_buffer(gpu, &b.buffer);
   destroy_buffer(gpu, &static_staging_buffer);
@@ -347,24 +384,45 @@ Status Renderer::begin_frame(uint32_t slot) {
   return Status::success();
 }
 
-Status Renderer::update(const Camera& camera, double time_seconds) {
-  Impl& r = *impl_;
-  if (!r.frame_begun) return Status::error("Renderer::update called before begin_frame");
+Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
   if (!std::isfinite(time_seconds) || camera.near_plane <= 0.0f ||
       camera.far_plane <= camera.near_plane || camera.fov_y_deg <= 0.0f ||
       camera.fov_y_deg >= 180.0f || camera.position == camera.target) {
-    return Status::error("Renderer::update: invalid camera or time");
+    return Status::error("Renderer: invalid camera or time");
   }
-  const float aspect = static_cast<float>(r.info.extent.width) / static_cast<float>(r.info.extent.height);
+  const float dt = simulation.next_frame() == 0 ? 0.0f : static_cast<float>(time_seconds - last_time);
+  if (dt < 0.0f) return Status::error("Renderer: time went backwards");
+  const float aspect = static_cast<float>(info.extent.width) / static_cast<float>(info.extent.height);
   glm::mat4 projection = glm::perspectiveRH_ZO(glm::radians(camera.fov_y_deg), aspect,
                                                camera.near_plane, camera.far_plane);
   projection[1][1] *= -1.0f;  // Vulkan's clip space has +Y down
   const glm::mat4 view = glm::lookAtRH(camera.position, camera.target, glm::vec3(0.0f, 1.0f, 0.0f));
-  r.constants.view_proj = projection * view;
-  r.constants.camera_position = glm::vec4(camera.position, 1.0f);
-  r.constants.sun_direction = glm::vec4(glm::normalize(r.look.sun_direction), r.look.sun_disc_intensity);
-  r.constants.clip_plane = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // main view: nothing clipped
-  r.constants.fog = glm::vec4(r.look.fog_density, r.look.fog_height_falloff, 0.0f, 0.0f);
+  constants.view_proj = projection * view;
+  constants.camera_position = glm::vec4(camera.position, 1.0f);
+  constants.sun_direction = glm::vec4(glm::normalize(look.sun_direction), look.sun_disc_intensity);
+  constants.clip_plane = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // main view: nothing clipped
+  constants.fog = glm::vec4(look.fog_density, look.fog_height_falloff, 0.0f, 0.0f);
+  SIVIFLOW_TRY(simulation.simulate(constants.view_proj, dt));
+  last_time = time_seconds;
+  return Status::success();
+}
+
+Status Renderer::simulate(const Camera& camera, double time_seconds) {
+  if (impl_->frame_begun) return Status::error("Renderer::simulate called between begin_frame and record");
+  return impl_->simulate(camera, time_seconds);
+}
+
+Status Renderer::update(const Camera& camera, double time_seconds) {
+  Impl& r = *impl_;
+  if (!r.frame_begun) return Status::error("Renderer::update called before begin_frame");
+  if (r.frame_updated) return Status::error("Renderer::update called twice for one frame");
+  SIVIFLOW_TRY(r.simulate(camera, time_seconds));
+  const FlowTextureLayout& layout = r.simulation.layout();
+  StagingAllocation staging;
+  SIVIFLOW_TRY(r.ring.allocate_staging(layout.total_bytes, kStagingAlignment, &staging));
+  SIVIFLOW_TRY(r.simulation.pack({static_cast<std::byte*>(staging.data), layout.total_bytes}));
+  r.frame_uploads.images[0].staging_offset = staging.offset + layout.flow_offset;
+  r.frame_uploads.images[1].staging_offset = staging.offset + layout.aux_offset;
   if (!r.static_data_uploaded && r.static_staging_buffer.buffer == VK_NULL_HANDLE) {
     SIVIFLOW_TRY(r.stage_static_data());
   }
@@ -404,12 +462,20 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
     b.bind_buffer(r.readbacks[i].buffer, inputs.readback.buffers[i]);
   }
   if (r.info.enable_readback) b.bind_image(r.water_mask, r.water_mask_image.image, r.water_mask_image.view);
+  b.bind_buffer(r.frame_staging, r.ring.staging_buffer());
+  b.bind_image(r.flow_texture, r.flow_image.image, r.flow_image.view);
+  b.bind_image(r.particle_aux, r.aux_image.image, r.aux_image.view);
+  if (r.flow_images_new) {
+    b.set_incoming(r.flow_texture, ResourceState{});
+    b.set_incoming(r.particle_aux, ResourceState{});
+  }
   const Status status = r.graph.execute(r.table, cmd, b);
   if (!status.ok()) {
     if (r.info.log != nullptr) r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
     return status;
   }
   r.static_data_uploaded = true;
+  r.flow_images_new = false;
   r.frame_begun = false;
   r.frame_updated = false;
   return Status::success();
@@ -428,13 +494,16 @@ Status Renderer::resize(VkExtent2D extent) {
                    std::to_string(limit));
   }
   // Frames of any slot still in flight may use the old images: free them once all came round.
-  for (Image* image : {&r.depth_image, &r.water_mask_image}) {
+  for (Image* image : {&r.depth_image, &r.water_mask_image, &r.flow_image, &r.aux_image}) {
     Image retired = *image;
     *image = Image{};
     r.ring.defer_deletion_until_all_slots(
         [gpu_context = r.gpu, retired]() mutable { destroy_image(gpu_context, &retired); });
   }
   r.info.extent = extent;
+  // The particles live in screen space: a new viewport starts them afresh at frame 0.
+  SIVIFLOW_TRY(r.simulation.create(r.river, kDefaultSceneDischarge, r.info.seed,
+                                   {extent.width, extent.height}));
   r.graph = FrameGraph{};
   r.bindings.reset();
   return r.declare_graph();
@@ -452,6 +521,10 @@ VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
     case ReadbackImage::kDepth:
     case ReadbackImage::kWaterMask:
       return pixels * sizeof(float);
+    case ReadbackImage::kFlowTexture:
+      return impl_->simulation.layout().flow_bytes;
+    case ReadbackImage::kParticleAux:
+      return impl_->simulation.layout().aux_bytes;
   }
   return 0;
 }
@@ -464,9 +537,17 @@ const char* readback_image_name(ReadbackImage image) {
       return "readback depth";
     case ReadbackImage::kWaterMask:
       return "readback water mask";
+    case ReadbackImage::kFlowTexture:
+      return "readback flow texture";
+    case ReadbackImage::kParticleAux:
+      return "readback particle aux";
   }
   return "readback";
 }
+
+const ParticleField& Renderer::particle_field() const { return impl_->simulation.particle_field(); }
+const FlowTextureLayout& Renderer::flow_texture_layout() const { return impl_->simulation.layout(); }
+uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 
 std::string Renderer::dump_frame_graph() const { return impl_->graph.dump_text(); }
 std::string Renderer::dump_frame_graph_graphviz() const { return impl_->graph.dump_graphviz(); }

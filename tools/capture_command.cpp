@@ -15,6 +15,8 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "shaders/shared.h"
+#include "siviflow/atomic_file.h"
 #include "siviflow/headless_context.h"
 #include "siviflow/image_files.h"
 #include "siviflow/renderer.h"
@@ -40,6 +42,8 @@ struct CaptureOptions {
   bool preview = false;
   bool validation = false;
   bool depth_aov = false;
+  bool flow_aov = false;       // flow.X/Y/Z and water.mask
+  bool particles_aov = false;  // particle.id and frame_NNNNN.particles.csv
 };
 
 void print_help() {
@@ -53,8 +57,14 @@ void print_help() {
       "  --out DIR      existing folder to write into (required)\n"
       "  --seed S       simulation seed, recorded in the EXR metadata (default 1)\n"
       "  --fps F        frames per second of scene time (default 30)\n"
-      "  --aov LIST     comma list of extra EXR layers; available: depth (depth.Z, view-axis\n"
-      "                 distance in metres, +inf where only sky is seen)\n"
+      "  --aov LIST     comma list of extra EXR layers:\n"
+      "                 depth      depth.Z: view-axis distance in metres, +inf where only sky is seen\n"
+      "                 flow       flow.X/Y/Z: the flow texture upsampled (nearest) to the output;\n"
+      "                            water.mask: 1 where the river surface is visible\n"
+      "                 particles  particle.id: the id of the particle whose flow texel covers the\n"
+      "                            pixel, on visible water (-1 elsewhere); and beside each frame\n"
+      "                            frame_NNNNN.particles.csv: id,state,sx,sy,wx,wy,wz,fx,fy,fz,\n"
+      "                            speed,depth,slope,fade\n"
       "  --preview      also write DIR/frame_NNNNN.png (sRGB, clamped)\n"
       "  --validation   run with the Khronos validation layer; any error fails the capture\n");
 }
@@ -94,8 +104,12 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
       for (const std::string& aov : cli::split_list(value)) {
         if (aov == "depth") {
           options->depth_aov = true;
+        } else if (aov == "flow") {
+          options->flow_aov = true;
+        } else if (aov == "particles") {
+          options->particles_aov = true;
         } else {
-          return Status::error("--aov: unknown AOV '" + aov + "' (available: depth)");
+          return Status::error("--aov: unknown AOV '" + aov + "' (available: depth, flow, particles)");
         }
       }
     } else if (arg == "--preview") {
@@ -139,6 +153,7 @@ struct SlotTargets {
   bool pending = false;  // a submitted frame whose readback has not been copied out yet
   uint32_t frame = 0;
   Camera camera;
+  std::vector<Particle> particles;  // as simulated for this frame
 };
 
 // A finished frame copied out of its readback buffers, so that the buffers can take the next
@@ -148,6 +163,9 @@ struct FinishedFrame {
   Camera camera;
   std::vector<uint16_t> color_halves;
   std::vector<float> window_depth;
+  std::vector<float> water_mask;
+  std::vector<std::byte> flow_texture;  // as uploaded: shaders/shared.h FlowTexel per texel
+  std::vector<Particle> particles;
 };
 
 class Capture {
@@ -168,9 +186,13 @@ class Capture {
   CaptureOptions options_;
   std::unique_ptr<HeadlessContext> context_;
   std::unique_ptr<Renderer> renderer_;
+  Status write_particles_csv(const std::string& path) const;
+
   FinishedFrame finished_;
   std::vector<float> rgba_;
   std::vector<float> depth_;
+  std::vector<float> flow_[3];
+  std::vector<float> particle_id_;
 };
 
 Status Capture::run() {
@@ -195,7 +217,14 @@ Status Capture::run() {
       {options_.size.width, options_.size.height}, kOutputFormat);
   info.frames_in_flight = kFramesInFlight;
   info.enable_readback = true;
+  info.seed = options_.seed;
   SIVIFLOW_TRY(Renderer::create(info, &renderer_));
+  // The particles carry state from frame to frame: a shard starting at frame A first advances
+  // the simulation through frames 0..A-1, without rendering, so that its frames equal a full run's.
+  for (uint32_t frame = 0; frame < options_.first_frame; ++frame) {
+    const double time = static_cast<double>(frame) / options_.fps;
+    SIVIFLOW_TRY(renderer_->simulate(renderer_->scene_camera(time), time));
+  }
 
   std::vector<SlotTargets> slots(kFramesInFlight);
   const VkExtent2D extent{options_.size.width, options_.size.height};
@@ -221,6 +250,8 @@ Status Capture::run() {
     SIVIFLOW_TRY(renderer_->begin_frame(index));
     slot.camera = renderer_->scene_camera(time);
     SIVIFLOW_TRY(renderer_->update(slot.camera, time));
+    const std::span<const Particle> particles = renderer_->particle_field().particles();
+    slot.particles.assign(particles.begin(), particles.end());
     FrameInputs inputs;
     inputs.output.image = slot.output.image;
     inputs.output.view = slot.output.view;
@@ -263,6 +294,11 @@ void Capture::copy_out(const SlotTargets& slot) {
   finished_.color_halves.assign(halves, halves + pixels * 4);
   const auto* depth = static_cast<const float*>(slot.readback[1].data);
   finished_.window_depth.assign(depth, depth + pixels);
+  const auto* mask = static_cast<const float*>(slot.readback[2].data);
+  finished_.water_mask.assign(mask, mask + pixels);
+  const auto* flow = static_cast<const std::byte*>(slot.readback[3].data);
+  finished_.flow_texture.assign(flow, flow + renderer_->readback_bytes(ReadbackImage::kFlowTexture));
+  finished_.particles = slot.particles;
 }
 
 Status Capture::write_frame() {
@@ -284,6 +320,41 @@ Status Capture::write_frame() {
     }
     frame.channels.push_back({"depth.Z", depth_.data()});
   }
+  const FlowTextureLayout& layout = renderer_->flow_texture_layout();
+  const auto texel_at = [&](size_t pixel) {
+    const uint32_t x = static_cast<uint32_t>(pixel % width) / layout.texel_px;
+    const uint32_t y = static_cast<uint32_t>(pixel / width) / layout.texel_px;
+    gpu::FlowTexel texel{};
+    std::memcpy(&texel, finished_.flow_texture.data() + (size_t{y} * layout.flow_extent.x + x) * sizeof(texel),
+                sizeof(texel));
+    return texel;
+  };
+  if (options_.flow_aov) {
+    for (std::vector<float>& plane : flow_) plane.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      const gpu::FlowTexel texel = texel_at(i);
+      const glm::vec3 flow = texel.id == SIVIFLOW_PARTICLE_NONE ? glm::vec3(0.0f) : decode_flow(texel);
+      flow_[0][i] = flow.x;
+      flow_[1][i] = flow.y;
+      flow_[2][i] = flow.z;
+    }
+    frame.channels.push_back({"flow.X", flow_[0].data()});
+    frame.channels.push_back({"flow.Y", flow_[1].data()});
+    frame.channels.push_back({"flow.Z", flow_[2].data()});
+    frame.channels.push_back({"water.mask", finished_.water_mask.data()});
+  }
+  if (options_.particles_aov) {
+    // The flow texture holds GPU slots; the layer and the CSV use the ids unique over the run.
+    std::vector<float> id_of_slot(size_t{layout.slot_count} + 1, -1.0f);
+    for (const Particle& particle : finished_.particles) id_of_slot[particle.slot] = static_cast<float>(particle.id);
+    particle_id_.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      const gpu::FlowTexel texel = texel_at(i);
+      const bool on_water = finished_.water_mask[i] > 0.5f;
+      particle_id_[i] = on_water && texel.id <= layout.slot_count ? id_of_slot[texel.id] : -1.0f;
+    }
+    frame.channels.push_back({"particle.id", particle_id_.data()});
+  }
   frame.metadata.scene = "default";
   frame.metadata.frame = static_cast<int>(finished_.frame);
   frame.metadata.time_seconds = static_cast<float>(finished_.frame / options_.fps);
@@ -293,11 +364,24 @@ Status Capture::write_frame() {
   char name[32];
   std::snprintf(name, sizeof(name), "frame_%05u", finished_.frame);
   const std::string base = options_.out_dir + "/" + name;
+  if (options_.particles_aov) SIVIFLOW_TRY(write_particles_csv(base + ".particles.csv"));
   SIVIFLOW_TRY(write_exr(base + ".exr", frame));
   if (options_.preview) {
     SIVIFLOW_TRY(write_png(base + ".png", frame.width, frame.height, rgba_.data(), PngChannels::kRgb));
   }
   return Status::success();
+}
+
+Status Capture::write_particles_csv(const std::string& path) const {
+  std::string csv = "id,state,sx,sy,wx,wy,wz,fx,fy,fz,speed,depth,slope,fade\n";
+  char row[512];
+  for (const Particle& p : finished_.particles) {
+    std::snprintf(row, sizeof(row), "%u,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+                  p.id, to_string(p.state), p.screen.x, p.screen.y, p.world.x, p.world.y, p.world.z,
+                  p.flow.x, p.flow.y, p.flow.z, p.speed, p.depth, p.slope, p.fade);
+    csv += row;
+  }
+  return write_file_atomically(path, csv.data(), csv.size());
 }
 
 void Capture::report_progress(uint32_t done_count) {

@@ -127,7 +127,11 @@ Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,
     result = vk.vkBindImageMemory(vk.device, out->image, out->memory, 0);
     if (result != VK_SUCCESS) status = vk_failure("vkBindImageMemory", debug_name, result);
   }
-  if (status.ok()) {
+  // Views only for images that shaders or attachments use; copy-only images have none.
+  constexpr VkImageUsageFlags kViewUsages =
+      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT;
+  if (status.ok() && (usage & kViewUsages) != 0) {
     VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     view.image = out->image;
     view.viewType = VK_IMAGE_VIEW_TYPE_2D;

@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include "gpu_test.h"
+#include "shaders/shared.h"
+#include "sim/flow_textures.h"
 
 namespace siviflow::testing {
 namespace {
@@ -22,6 +24,8 @@ struct Frame {
   std::vector<float> rgba;   // linear, 4 floats per pixel
   std::vector<float> depth;  // window depth, 0 near .. 1 far
   std::vector<float> water_mask;
+  std::vector<std::byte> flow_texture;  // as uploaded and read back
+  std::vector<std::byte> particle_aux;
 
   const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * width + x) * 4]; }
 };
@@ -62,6 +66,10 @@ class RenderTest : public GpuTest {
       out.depth.assign(depths, depths + size_t{width} * height);
       const auto* mask = static_cast<const float*>(slot.readback[2].data);
       out.water_mask.assign(mask, mask + size_t{width} * height);
+      const auto* flow = static_cast<const std::byte*>(slot.readback[3].data);
+      out.flow_texture.assign(flow, flow + renderer_->readback_bytes(ReadbackImage::kFlowTexture));
+      const auto* aux = static_cast<const std::byte*>(slot.readback[4].data);
+      out.particle_aux.assign(aux, aux + renderer_->readback_bytes(ReadbackImage::kParticleAux));
       frames.push_back(std::move(out));
       slot.pending = false;
     };
@@ -150,6 +158,52 @@ TEST_F(RenderTest, WaterMaskCoversTheRiverOnly) {
   EXPECT_LT(water, size_t{kWidth} * kHeight / 2);
 }
 
+TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
+  // Two frames: the second reuses the images and the other staging slot.
+  const std::vector<Frame> frames = render(0, 2);
+  ASSERT_EQ(frames.size(), 2u);
+  const ParticleField& field = renderer_->particle_field();
+  ASSERT_FALSE(field.particles().empty());
+  FlowTextures textures;
+  ASSERT_TRUE(FlowTextures::create(field, kDefaultFlowTexelPx, &textures).ok());
+  const FlowTextureLayout& layout = textures.layout();
+  std::vector<std::byte> packed(layout.total_bytes);
+  ASSERT_TRUE(textures.pack(field, packed).ok());
+  const Frame& last = frames[1];
+  ASSERT_EQ(last.flow_texture.size(), layout.flow_bytes);
+  ASSERT_EQ(last.particle_aux.size(), layout.aux_bytes);
+  EXPECT_EQ(std::memcmp(last.flow_texture.data(), packed.data() + layout.flow_offset, layout.flow_bytes), 0);
+  EXPECT_EQ(std::memcmp(last.particle_aux.data(), packed.data() + layout.aux_offset, layout.aux_bytes), 0);
+  // And the values decode to the particles': aux by slot, and a particle's own texel names it
+  // (unless a neighbour sits nearer to that texel's centre, which the spacing makes rare).
+  std::vector<std::byte> read_back(layout.total_bytes);
+  std::memcpy(read_back.data() + layout.flow_offset, last.flow_texture.data(), layout.flow_bytes);
+  std::memcpy(read_back.data() + layout.aux_offset, last.particle_aux.data(), layout.aux_bytes);
+  size_t on_screen = 0;
+  size_t own_texel = 0;
+  for (const Particle& p : field.particles()) {
+    gpu::ParticleAux aux{};
+    ASSERT_TRUE(read_particle_aux(read_back, layout, p.slot, &aux).ok());
+    EXPECT_FLOAT_EQ(aux.speed, p.speed);
+    EXPECT_FLOAT_EQ(aux.depth, p.depth);
+    EXPECT_FLOAT_EQ(aux.slope, p.slope);
+    EXPECT_FLOAT_EQ(aux.fade, p.fade);
+    if (p.screen.x < 0 || p.screen.y < 0 || p.screen.x >= kWidth || p.screen.y >= kHeight) continue;
+    ++on_screen;
+    gpu::FlowTexel texel{};
+    ASSERT_TRUE(read_flow_texel(read_back, layout, static_cast<uint32_t>(p.screen.x) / layout.texel_px,
+                                static_cast<uint32_t>(p.screen.y) / layout.texel_px, &texel).ok());
+    if (texel.id == p.slot) {
+      ++own_texel;
+      const glm::vec3 flow = decode_flow(texel);
+      EXPECT_NEAR(flow.x, p.flow.x, 2e-3f * (1.0f + std::abs(p.flow.x)));  // binary16
+      EXPECT_NEAR(flow.z, p.flow.z, 2e-3f * (1.0f + std::abs(p.flow.z)));
+    }
+  }
+  EXPECT_GT(on_screen, 20u);
+  EXPECT_GE(own_texel * 100, on_screen * 95);
+}
+
 TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {
   const std::vector<Frame> run = render(0, 4);
   ASSERT_TRUE(context_->wait_idle().ok());
@@ -178,13 +232,20 @@ TEST_F(RenderTest, ResizeBetweenFramesKeepsFramesInFlightValid) {
 TEST_F(RenderTest, FrameGraphRunsSceneThenReadback) {
   ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
   const std::string dump = renderer_->dump_frame_graph();
-  // Static data is uploaded by a one-off graph: the frame graph itself has no upload pass.
-  EXPECT_EQ(dump.find("pass upload"), std::string::npos) << dump;
+  // Static data is uploaded by a one-off graph: the frame graph's upload pass carries only the
+  // flow texture and the particles' aux data, every frame.
+  const size_t upload = dump.find("pass upload");
   const size_t scene = dump.find("pass scene");
+  const size_t water = dump.find("pass water mask");
   const size_t readback = dump.find("pass readback");
+  ASSERT_NE(upload, std::string::npos) << dump;
   ASSERT_NE(scene, std::string::npos) << dump;
+  ASSERT_NE(water, std::string::npos) << dump;
   ASSERT_NE(readback, std::string::npos) << dump;
-  EXPECT_LT(scene, readback) << dump;
+  EXPECT_LT(upload, scene) << dump;
+  EXPECT_LT(scene, water) << dump;
+  EXPECT_LT(water, readback) << dump;
+  EXPECT_EQ(dump.find("scene vertices"), std::string::npos) << "static data is not uploaded per frame\n" << dump;
   EXPECT_NE(renderer_->dump_frame_graph_graphviz().find("digraph"), std::string::npos);
 }
 

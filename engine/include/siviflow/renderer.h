@@ -15,12 +15,15 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan.h>
 
+#include "sim/flow_textures.h"
+#include "sim/particles.h"
 #include "sim/status.h"
 
 namespace siviflow {
@@ -41,7 +44,8 @@ struct CreateInfo {
   uint32_t frames_in_flight = 0;       // ring slots; 0 means 2
   VkFormat color_format = VK_FORMAT_UNDEFINED;  // output image format; 0 means RGBA16F
   VkExtent2D extent = {0, 0};          // output size in pixels; required
-  bool enable_readback = false;        // record a copy of colour and depth into host buffers
+  bool enable_readback = false;        // record copies of the frame's images into host buffers
+  uint64_t seed = 0;                   // seed of the river particles' random choices
   VkDeviceSize staging_bytes_per_slot = 0;  // per-slot staging block; 0 means 8 MiB
   bool debug_utils = false;            // the host enabled VK_EXT_debug_utils: label passes, name objects
   VkPipelineCache pipeline_cache = VK_NULL_HANDLE;         // optional
@@ -95,8 +99,10 @@ enum class ReadbackImage : uint32_t {
   kColor,      // the output, in its format's texels
   kDepth,      // 32-bit float window depth, 0 near .. 1 far (sky: 1)
   kWaterMask,  // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
+  kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h), flow_texture_layout()
+  kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)
 };
-inline constexpr uint32_t kReadbackImageCount = 3;
+inline constexpr uint32_t kReadbackImageCount = 5;
 const char* readback_image_name(ReadbackImage image);
 
 struct ReadbackTargets {
@@ -121,8 +127,12 @@ class Renderer {
 
   // The host has waited until the GPU finished the commands last recorded for this slot.
   Status begin_frame(uint32_t slot);
-  // CPU only: camera and simulation time for the frame being prepared.
+  // CPU only: camera and simulation time for the frame being prepared: advances the river's
+  // particles one frame and packs the flow textures into the slot's staging block.
   Status update(const Camera& camera, double time_seconds);
+  // CPU only, outside begin_frame/record: advances the particles one frame without rendering,
+  // so that a capture starting at frame N gets the same frame N as one starting at 0.
+  Status simulate(const Camera& camera, double time_seconds);
   // Records the frame into `cmd` (in the recording state, outside any render pass).
   Status record(VkCommandBuffer cmd, const FrameInputs& inputs);
 
@@ -132,6 +142,13 @@ class Renderer {
 
   // The camera of the scene's own camera path at that time (the default scene glides downstream).
   Camera scene_camera(double time_seconds) const;
+
+  // The particles of the last simulated frame (particles() in id order, their parameters).
+  const ParticleField& particle_field() const;
+  // Where the flow texture's and the aux data's texels are (sizes, texel size in pixels).
+  const FlowTextureLayout& flow_texture_layout() const;
+  // The index of the next frame update() or simulate() will advance to.
+  uint64_t next_frame() const;
 
   // Byte size of the readback buffer of that image at the configured extent.
   VkDeviceSize readback_bytes(ReadbackImage image) const;

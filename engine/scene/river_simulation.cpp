@@ -1,0 +1,59 @@
+#include "scene/river_simulation.h"
+
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "sim/river_surface.h"
+
+namespace siviflow {
+namespace {
+
+constexpr float kShepardPower = 1.5f;      // the paper's p
+constexpr float kSlopeStep = 0.5f;         // metres: finite-difference step of the riverbed slope
+
+}  // namespace
+
+Status RiverSimulation::create(const ProceduralRiver& river, float discharge, uint64_t seed,
+                               glm::uvec2 viewport) {
+  viewport_ = viewport;
+  SIVIFLOW_TRY(river.generate_mesh(&mesh_));
+  RiverSurface surface;
+  SIVIFLOW_TRY(RiverSurface::build(mesh_.positions, mesh_.indices, RiverSurfaceOptions{}, &surface));
+  SIVIFLOW_TRY(StreamFunction::create(std::move(surface), FlowParams{discharge, kShepardPower, 0.0f},
+                                      &flow_));
+  const size_t count = mesh_.positions.size();
+  velocity_.resize(count);
+  speed_.resize(count);
+  slope_.resize(count);
+  for (size_t v = 0; v < count; ++v) {
+    velocity_[v] = flow_.velocity(v);
+    speed_[v] = glm::length(velocity_[v]);
+    const glm::vec3& p = mesh_.positions[v];
+    const float dx = river.terrain_height(p.x + kSlopeStep, p.z) - river.terrain_height(p.x - kSlopeStep, p.z);
+    const float dz = river.terrain_height(p.x, p.z + kSlopeStep) - river.terrain_height(p.x, p.z - kSlopeStep);
+    slope_[v] = std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
+  }
+  RiverFlowField field;
+  field.positions = mesh_.positions;
+  field.indices = mesh_.indices;
+  field.flow = velocity_;
+  field.speed = speed_;
+  field.depth = mesh_.depth;
+  field.slope = slope_;
+  ParticleParams params;
+  params.seed = seed;
+  params.viewport = viewport;
+  SIVIFLOW_TRY(ParticleField::create(field, params, &particles_));
+  return FlowTextures::create(particles_, kDefaultFlowTexelPx, &flow_textures_);
+}
+
+Status RiverSimulation::simulate(const glm::mat4& view_proj, float dt_seconds) {
+  return particles_.update(ScreenCamera{view_proj, viewport_}, particles_.next_frame(), dt_seconds);
+}
+
+Status RiverSimulation::pack(std::span<std::byte> staging) {
+  return flow_textures_.pack(particles_, staging);
+}
+
+}  // namespace siviflow

@@ -1,0 +1,50 @@
+// The simulation half of a frame for the default scene's river, on the CPU: the river surface
+// and its stream-function flow (solved once), and the screen-space particles and flow textures
+// (kept every frame). No Vulkan: the renderer copies pack()'s bytes into its staging block.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "sim/flow_textures.h"
+#include "sim/particles.h"
+#include "sim/procedural_river.h"
+#include "sim/status.h"
+#include "sim/stream_function.h"
+
+namespace siviflow {
+
+class RiverSimulation {
+ public:
+  // Builds the river's surface mesh, solves its flow (discharge in m^2/s) and sizes the particles
+  // and flow textures for `viewport`. Must not be moved after create(): the particles keep spans
+  // into this object's per-vertex arrays.
+  Status create(const ProceduralRiver& river, float discharge, uint64_t seed, glm::uvec2 viewport);
+
+  // One frame of Algorithm 2. Frames must come in order from 0; dt is the time since the last.
+  Status simulate(const glm::mat4& view_proj, float dt_seconds);
+  // Packs this frame's flow texture and auxiliary data into `staging` (layout().total_bytes).
+  Status pack(std::span<std::byte> staging);
+
+  uint64_t next_frame() const { return particles_.next_frame(); }
+  const FlowTextureLayout& layout() const { return flow_textures_.layout(); }
+  const ParticleField& particle_field() const { return particles_; }
+  const RiverMesh& mesh() const { return mesh_; }
+
+ private:
+  RiverMesh mesh_;
+  StreamFunction flow_;
+  std::vector<glm::vec3> velocity_;  // per vertex, m/s
+  std::vector<float> speed_;
+  std::vector<float> slope_;         // riverbed slope under the vertex (rise over run)
+  ParticleField particles_;
+  FlowTextures flow_textures_;
+  glm::uvec2 viewport_{0u};
+};
+
+}  // namespace siviflow
