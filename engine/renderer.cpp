@@ -1,5 +1,6 @@
 #include "siviflow/renderer.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -11,6 +12,7 @@
 #include "scene/default_scene.h"
 #include "scene/detail_texture.h"
 #include "scene/river_simulation.h"
+#include "scene/water_normal_map.h"
 #include "siviflow/scene_file.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
@@ -29,6 +31,14 @@ constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we co
 // Layouts documented in shaders/shared.h.
 constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
 constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kNormalMapFormat = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr VkFormat kDetailFormat = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the output
+
+// Tunables of the water's look, in one place.
+constexpr float kReflectionDistortion = 0.04f;    // screen uv offset per unit of normal tilt
+constexpr float kTdfTileMetres = 3.0f;            // Tiled Directional Flow tile size on the water
+constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
 
 uint32_t texel_bytes(VkFormat format) {
   switch (format) {
@@ -64,8 +74,11 @@ struct Renderer::Impl {
   RiverSimulation simulation;  // the river's flow, particles and flow textures, on the CPU
   double last_time = 0.0;
 
-  // Geometry that never changes: copied to the GPU once, then only read.
-  enum StaticBufferId { kSceneVertices, kSceneIndices, kRiverVertices, kRiverIndices, kStaticBufferCount };
+  // Geometry and textures that never change: copied to the GPU once by the static graph, then
+  // only read by the frame graph, so later frames carry no upload barriers for them.
+  enum StaticBufferId {
+    kSceneVertices, kSceneIndices, kRiverVertices, kRiverDepths, kRiverIndices, kStaticBufferCount
+  };
   struct StaticBuffer {
     const char* name;
     Access read_as;  // how the frame graph reads it
@@ -78,37 +91,49 @@ struct Renderer::Impl {
       {"scene vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
       {"scene indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, {}, {}, {}},
       {"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
+      {"river depths", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
       {"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, {}, {}, {}}}};
+  enum StaticImageId { kDetail, kNormalMap, kStaticImageCount };
+  struct StaticImage {
+    const char* name;
+    VkFormat format;
+    VkExtent2D extent;
+    std::vector<uint8_t> texels;         // every mip level, kept until staged
+    std::vector<size_t> mip_offsets;     // into texels
+    Image image;
+    ImageHandle in_frame_graph;
+  };
+  std::array<StaticImage, kStaticImageCount> static_images{{
+      {"ground detail", kDetailFormat, {}, {}, {}, {}, {}},
+      {"water normal map", kNormalMapFormat, {}, {}, {}, {}, {}}}};
   uint32_t scene_index_count = 0;
   uint32_t river_index_count = 0;
-  DetailTexture detail_pixels;
-  Image detail_image;
-  Image depth_image;
-  Image water_mask_image;  // only with readback: the water.mask AOV
-  ImageHandle water_mask;
   ScenePass scene_pass;
-  WaterMaskPass water_mask_pass;
+  FlowPass flow_pass;
 
-  // One-off graph that copies the static scene data on the first frame; the frame graph then
-  // only reads it, so later frames carry no upload barriers for it.
   FrameGraph static_graph;
   BufferHandle static_staging;
   UploadList static_uploads;
   Buffer static_staging_buffer;  // sized for the static data; freed when its slot comes round
 
+  // Images the frame graph declares; created after it compiles, with the usage it derived.
+  struct FrameImage {
+    ImageHandle handle;
+    Image image;
+    bool persistent = false;  // keeps its contents from frame to frame
+  };
+  std::vector<FrameImage> frame_images;
+  bool frame_images_new = true;  // persistent ones have no previous contents yet
+
   FrameGraph graph;
   BufferHandle frame_staging;  // the slot's staging block: this frame's flow textures
   UploadList frame_uploads;    // flow texture and particle aux, every frame
-  ImageHandle flow_texture;
-  ImageHandle particle_aux;
-  Image flow_image;
-  Image aux_image;
-  bool flow_images_new = true;  // created since the last record: no previous contents
-  ScenePass::Handles scene;
   ImageHandle output;
   std::vector<ReadbackCopy> readbacks;  // one per ReadbackImage when readback is enabled
   FrameBindings bindings;
   gpu::SceneConstants constants{};
+  gpu::SceneConstants reflection_constants{};
+  gpu::FlowConstants flow_constants{};
 
   bool static_data_uploaded = false;
   bool frame_begun = false;
@@ -118,9 +143,13 @@ struct Renderer::Impl {
   Status create_static_resources();
   Status declare_static_graph();
   Status declare_graph();
+  ImageHandle frame_image(ImageHandle handle, bool persistent = false);
+  Status create_frame_images();
+  const Image* find_frame_image(ImageHandle handle) const;
   Status stage_static_data();
   Status simulate(const Camera& camera, double time_seconds);
   Status record_static_upload(VkCommandBuffer cmd);
+  void retire_frame_images();
   void destroy();
 };
 
@@ -205,8 +234,18 @@ Status Renderer::Impl::create_static_resources() {
   const RiverMesh& river_mesh = simulation.mesh();
   river_index_count = static_cast<uint32_t>(river_mesh.indices.size());
   static_buffers[kRiverVertices].bytes = bytes_of(river_mesh.positions);
+  static_buffers[kRiverDepths].bytes = bytes_of(river_mesh.depth);
   static_buffers[kRiverIndices].bytes = bytes_of(river_mesh.indices);
-  detail_pixels = make_detail_texture();
+
+  DetailTexture detail = make_detail_texture();
+  static_images[kDetail].extent = {detail.size, detail.size};
+  static_images[kDetail].texels = std::move(detail.texels);
+  static_images[kDetail].mip_offsets = {0};
+  WaterNormalMap normal_map = make_water_normal_map();
+  static_images[kNormalMap].extent = {normal_map.size, normal_map.size};
+  static_images[kNormalMap].texels = std::move(normal_map.texels);
+  static_images[kNormalMap].mip_offsets = std::move(normal_map.mip_offsets);
+
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
   for (StaticBuffer& b : static_buffers) {
     SIVIFLOW_TRY(create_buffer(gpu, b.bytes.size(), b.usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -216,75 +255,120 @@ Status Renderer::Impl::create_static_resources() {
 }
 
 Status Renderer::Impl::declare_static_graph() {
-  const VkExtent2D detail_extent{detail_pixels.size, detail_pixels.size};
   static_staging = static_graph.import_buffer({"static staging", 0}, ResourceState{});
   for (const StaticBuffer& b : static_buffers) {
     const BufferHandle handle = static_graph.import_buffer({b.name, b.buffer.size}, ResourceState{},
                                                            state_of(b.read_as));
     static_uploads.buffers.push_back({0, handle, b.buffer.size});
   }
-  const ImageHandle detail =
-      static_graph.import_image({"ground detail", VK_FORMAT_R8G8B8A8_UNORM, detail_extent, {}},
-                                ResourceState{}, state_of(Access::SampledFragment));
-  static_uploads.images = {{0, detail, detail_extent}};
+  std::vector<ImageHandle> image_handles;
+  for (const StaticImage& i : static_images) {
+    const ImageHandle handle = static_graph.import_image({i.name, i.format, i.extent, {}},
+                                                         ResourceState{},
+                                                         state_of(Access::SampledFragment));
+    image_handles.push_back(handle);
+    for (uint32_t level = 0; level < i.mip_offsets.size(); ++level) {
+      const VkExtent2D extent{std::max(1u, i.extent.width >> level), std::max(1u, i.extent.height >> level)};
+      static_uploads.images.push_back({0, handle, extent, level});
+    }
+  }
   add_upload_pass(static_graph, static_staging, &static_uploads);
   SIVIFLOW_TRY(static_graph.compile());
-  // The frame graph only samples the detail texture.
-  const VkImageUsageFlags detail_usage =
-      static_graph.image_usage(static_uploads.images[0].destination) | VK_IMAGE_USAGE_SAMPLED_BIT;
-  SIVIFLOW_TRY(create_image(gpu, VK_FORMAT_R8G8B8A8_UNORM, detail_extent, detail_usage,
-                            "ground detail", &detail_image));
+  for (size_t n = 0; n < static_images.size(); ++n) {
+    StaticImage& i = static_images[n];
+    // The frame graph only samples the static images.
+    const VkImageUsageFlags usage = static_graph.image_usage(image_handles[n]) | VK_IMAGE_USAGE_SAMPLED_BIT;
+    SIVIFLOW_TRY(create_image(gpu, i.format, i.extent, usage, i.name, &i.image,
+                              static_cast<uint32_t>(i.mip_offsets.size())));
+  }
   SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
-  SIVIFLOW_TRY(water_mask_pass.create(gpu, info.pipeline_cache, kDepthFormat));
-  scene_pass.set_detail_texture(gpu, detail_image.view);
+  SIVIFLOW_TRY(flow_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat,
+                                info.enable_readback));
+  scene_pass.set_detail_texture(gpu, static_images[kDetail].image.view);
   return Status::success();
+}
+
+ImageHandle Renderer::Impl::frame_image(ImageHandle handle, bool persistent) {
+  frame_images.push_back({handle, Image{}, persistent});
+  return handle;
 }
 
 Status Renderer::Impl::declare_graph() {
   const VkExtent2D extent = info.extent;
-  const VkExtent2D detail_extent{detail_pixels.size, detail_pixels.size};
-  // Static data arrives through the static graph and is only read from then on.
+  const VkExtent2D reflection_extent{
+      std::max(1u, static_cast<uint32_t>(std::lround(extent.width * kDefaultReflectionScale))),
+      std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
+  frame_images.clear();
   for (StaticBuffer& b : static_buffers) {
     b.in_frame_graph = graph.import_buffer({b.name, b.buffer.size}, state_of(b.read_as),
                                            state_of(b.read_as));
   }
-  scene.vertices = static_buffers[kSceneVertices].in_frame_graph;
-  scene.indices = static_buffers[kSceneIndices].in_frame_graph;
-  scene.detail = graph.import_image({"ground detail", VK_FORMAT_R8G8B8A8_UNORM, detail_extent, {}},
-                                    state_of(Access::SampledFragment),
-                                    state_of(Access::SampledFragment));
-  VkClearValue sky_clear{};
+  for (StaticImage& i : static_images) {
+    i.in_frame_graph = graph.import_image({i.name, i.format, i.extent, {}},
+                                          state_of(Access::SampledFragment),
+                                          state_of(Access::SampledFragment));
+  }
+  VkClearValue transparent{};
   VkClearValue far_depth{};
   far_depth.depthStencil = {1.0f, 0};
-  // The host states the output's real states per frame; these are overridden in record().
-  output = graph.import_image({"output", info.color_format, extent, sky_clear}, ResourceState{},
-                              state_of(Access::SampledFragment));
-  scene.color = output;
-  scene.depth = graph.create_image({"depth", kDepthFormat, extent, far_depth});
 
-  // Every frame's flow texture and particle aux data go through the slot's staging block.
+  // upload: this frame's flow texture and particle aux data, through the slot's staging block.
   const FlowTextureLayout& layout = simulation.layout();
   const VkExtent2D flow_extent{layout.flow_extent.x, layout.flow_extent.y};
   const VkExtent2D aux_extent{layout.aux_extent.x, layout.aux_extent.y};
   frame_staging = graph.import_buffer({"frame staging", 0}, ResourceState{});
-  flow_texture = graph.create_persistent_image({"flow texture", kFlowTextureFormat, flow_extent, {}});
-  particle_aux = graph.create_persistent_image({"particle aux", kParticleAuxFormat, aux_extent, {}});
+  const ImageHandle flow_texture = frame_image(
+      graph.create_persistent_image({"flow texture", kFlowTextureFormat, flow_extent, {}}), true);
+  const ImageHandle particle_aux = frame_image(
+      graph.create_persistent_image({"particle aux", kParticleAuxFormat, aux_extent, {}}), true);
   frame_uploads.buffers.clear();
-  frame_uploads.images = {{0, flow_texture, flow_extent}, {0, particle_aux, aux_extent}};
+  frame_uploads.images = {{0, flow_texture, flow_extent, 0}, {0, particle_aux, aux_extent, 0}};
   add_upload_pass(graph, frame_staging, &frame_uploads);
-  scene_pass.declare(graph, &constants, scene_index_count, &scene);
+
+  // reflection: the scene mirrored about the water plane, clipped below it.
+  ScenePass::Handles mirrored;
+  mirrored.color = frame_image(graph.create_image({"reflection", info.color_format, reflection_extent, transparent}));
+  mirrored.depth = frame_image(graph.create_image({"reflection depth", kDepthFormat, reflection_extent, far_depth}));
+  mirrored.vertices = static_buffers[kSceneVertices].in_frame_graph;
+  mirrored.indices = static_buffers[kSceneIndices].in_frame_graph;
+  mirrored.detail = static_images[kDetail].in_frame_graph;
+  scene_pass.declare(graph, "reflection", &reflection_constants, scene_index_count, &mirrored);
+
+  // scene: sky, terrain, riverbed and objects into the host's output.
+  // The host states the output's real states per frame; these are overridden in record().
+  output = graph.import_image({"output", info.color_format, extent, transparent}, ResourceState{},
+                              state_of(Access::SampledFragment));
+  ScenePass::Handles scene;
+  scene.color = output;
+  scene.depth = frame_image(graph.create_image({"depth", kDepthFormat, extent, far_depth}));
+  scene.vertices = static_buffers[kSceneVertices].in_frame_graph;
+  scene.indices = static_buffers[kSceneIndices].in_frame_graph;
+  scene.detail = static_images[kDetail].in_frame_graph;
+  scene_pass.declare(graph, "scene", &constants, scene_index_count, &scene);
+
+  // flow: the water material over the scene.
+  FlowPass::Handles water;
+  water.color = scene.color;
+  water.depth = scene.depth;
+  water.flow = frame_uploads.images[0].destination;
+  water.aux = frame_uploads.images[1].destination;
+  water.reflection = mirrored.color;
+  water.normal_map = static_images[kNormalMap].in_frame_graph;
+  water.vertices = static_buffers[kRiverVertices].in_frame_graph;
+  water.depths = static_buffers[kRiverDepths].in_frame_graph;
+  water.indices = static_buffers[kRiverIndices].in_frame_graph;
+  if (info.enable_readback) {
+    water.mask = frame_image(graph.create_image({"water mask", FlowPass::kMaskFormat, extent, transparent}));
+    water.normal = frame_image(graph.create_image({"water normal", FlowPass::kNormalFormat, extent, transparent}));
+    water.reflection_sample = frame_image(
+        graph.create_image({"reflection sample", FlowPass::kReflectionFormat, extent, transparent}));
+  }
+  flow_pass.declare(graph, &flow_constants, river_index_count, &water);
 
   if (info.enable_readback) {
-    WaterMaskPass::Handles water;
-    water.mask = graph.create_image({"water mask", WaterMaskPass::kFormat, extent, {}});
-    water.depth = scene.depth;
-    water.vertices = static_buffers[kRiverVertices].in_frame_graph;
-    water.indices = static_buffers[kRiverIndices].in_frame_graph;
-    water_mask_pass.declare(graph, &constants, river_index_count, &water);
-    water_mask = water.mask;
-    const ImageHandle images[kReadbackImageCount] = {scene.color, scene.depth, water.mask,
-                                                     frame_uploads.images[0].destination,
-                                                     frame_uploads.images[1].destination};
+    const ImageHandle images[kReadbackImageCount] = {
+        water.color, scene.depth, water.mask, frame_uploads.images[0].destination,
+        frame_uploads.images[1].destination, water.normal, water.reflection_sample};
     readbacks.clear();
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
       const BufferHandle buffer = graph.import_buffer(
@@ -295,35 +379,72 @@ Status Renderer::Impl::declare_graph() {
     add_readback_pass(graph, &readbacks);
   }
   SIVIFLOW_TRY(graph.compile());
-  SIVIFLOW_TRY(create_image(gpu, kFlowTextureFormat, flow_extent, graph.image_usage(flow_texture),
-                            "flow texture", &flow_image));
-  SIVIFLOW_TRY(create_image(gpu, kParticleAuxFormat, aux_extent, graph.image_usage(particle_aux),
-                            "particle aux", &aux_image));
-  flow_images_new = true;
-  if (info.enable_readback) {
-    SIVIFLOW_TRY(create_image(gpu, WaterMaskPass::kFormat, extent, graph.image_usage(water_mask),
-                              "water mask", &water_mask_image));
+  SIVIFLOW_TRY(create_frame_images());
+
+  FlowPass::Textures textures;
+  textures.flow = find_frame_image(flow_texture)->view;
+  textures.aux = find_frame_image(particle_aux)->view;
+  textures.reflection = find_frame_image(mirrored.color)->view;
+  textures.normal_map = static_images[kNormalMap].image.view;
+  return flow_pass.bind_textures(gpu, textures, [this](VkDescriptorPool pool) {
+    ring.defer_deletion_until_all_slots([gpu_context = gpu, pool] {
+      gpu_context.table->vkDestroyDescriptorPool(gpu_context.table->device, pool,
+                                                 gpu_context.allocation_callbacks);
+    });
+  });
+}
+
+Status Renderer::Impl::create_frame_images() {
+  for (FrameImage& f : frame_images) {
+    const ImageDesc* desc = graph.image_desc(f.handle);
+    const VkImageUsageFlags usage = graph.image_usage(f.handle);
+    if (usage == 0) continue;  // no surviving pass uses it
+    SIVIFLOW_TRY(create_image(gpu, desc->format, desc->extent, usage, desc->name.c_str(), &f.image));
   }
-  return create_image(gpu, kDepthFormat, extent, graph.image_usage(scene.depth), "depth",
-                      &depth_image);
+  frame_images_new = true;
+  return Status::success();
+}
+
+const Image* Renderer::Impl::find_frame_image(ImageHandle handle) const {
+  for (const FrameImage& f : frame_images) {
+    if (f.handle.id == handle.id) return &f.image;
+  }
+  return nullptr;
+}
+
+void Renderer::Impl::retire_frame_images() {
+  // Frames of any slot still in flight may use them: free them once every slot came round.
+  for (FrameImage& f : frame_images) {
+    ring.defer_deletion_until_all_slots(
+        [gpu_context = gpu, retired = f.image]() mutable { destroy_image(gpu_context, &retired); });
+  }
+  frame_images.clear();
 }
 
 Status Renderer::Impl::stage_static_data() {
-  VkDeviceSize total = detail_pixels.texels.size();
+  VkDeviceSize total = 0;
+  for (const StaticImage& i : static_images) total += i.texels.size();
   for (const StaticBuffer& b : static_buffers) total += b.bytes.size();
   SIVIFLOW_TRY(create_buffer(gpu, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true,
                              "static staging", &static_staging_buffer));
   auto* bytes = static_cast<uint8_t*>(static_staging_buffer.mapped);
-  // Detail texels first: their copy offset must be a multiple of the texel size.
-  std::memcpy(bytes, detail_pixels.texels.data(), detail_pixels.texels.size());
-  static_uploads.images[0].staging_offset = 0;
-  VkDeviceSize offset = detail_pixels.texels.size();
-  for (size_t i = 0; i < static_buffers.size(); ++i) {
-    std::vector<uint8_t>& source = static_buffers[i].bytes;
+  // Images first: every copy offset into them stays a multiple of their 4-byte texels.
+  VkDeviceSize offset = 0;
+  size_t upload = 0;
+  for (StaticImage& i : static_images) {
+    std::memcpy(bytes + offset, i.texels.data(), i.texels.size());
+    for (size_t level = 0; level < i.mip_offsets.size(); ++level) {
+      static_uploads.images[upload++].staging_offset = offset + i.mip_offsets[level];
+    }
+    offset += i.texels.size();
+    i.texels = std::vector<uint8_t>();  // the staging copy is the only one needed from now on
+  }
+  for (size_t n = 0; n < static_buffers.size(); ++n) {
+    std::vector<uint8_t>& source = static_buffers[n].bytes;
     std::memcpy(bytes + offset, source.data(), source.size());
-    static_uploads.buffers[i].staging_offset = offset;
+    static_uploads.buffers[n].staging_offset = offset;
     offset += source.size();
-    source = std::vector<uint8_t>();  // the staging copy is the only one needed from now on
+    source = std::vector<uint8_t>();
   }
   return Status::success();
 }
@@ -331,11 +452,14 @@ Status Renderer::Impl::stage_static_data() {
 Status Renderer::Impl::record_static_upload(VkCommandBuffer cmd) {
   FrameBindings static_bindings;
   static_bindings.bind_buffer(static_staging, static_staging_buffer.buffer);
-  for (size_t i = 0; i < static_buffers.size(); ++i) {
-    static_bindings.bind_buffer(static_uploads.buffers[i].destination, static_buffers[i].buffer.buffer);
+  for (size_t n = 0; n < static_buffers.size(); ++n) {
+    static_bindings.bind_buffer(static_uploads.buffers[n].destination, static_buffers[n].buffer.buffer);
   }
-  static_bindings.bind_image(static_uploads.images[0].destination, detail_image.image,
-                             detail_image.view);
+  size_t upload = 0;
+  for (const StaticImage& i : static_images) {
+    static_bindings.bind_image(static_uploads.images[upload].destination, i.image.image, i.image.view);
+    upload += i.mip_offsets.size();
+  }
   SIVIFLOW_TRY(static_graph.execute(table, cmd, static_bindings));
   // The GPU reads the staging buffer until this slot's frame completes; free it after that.
   Buffer retired = static_staging_buffer;
@@ -347,12 +471,9 @@ Status Renderer::Impl::record_static_upload(VkCommandBuffer cmd) {
 void Renderer::Impl::destroy() {
   if (gpu.table == nullptr) return;  // failed before any Vulkan object existed
   scene_pass.destroy(gpu);
-  water_mask_pass.destroy(gpu);
-  destroy_image(gpu, &depth_image);
-  destroy_image(gpu, &water_mask_image);
-  destroy_image(gpu, &flow_image);
-  destroy_image(gpu, &aux_image);
-  destroy_image(gpu, &detail_image);
+  flow_pass.destroy(gpu);
+  for (FrameImage& f : frame_images) destroy_image(gpu, &f.image);
+  for (StaticImage& i : static_images) destroy_image(gpu, &i.image);
   for (StaticBuffer& b : static_buffers) destroy_buffer(gpu, &b.buffer);
   destroy_buffer(gpu, &static_staging_buffer);
   ring.destroy();
@@ -397,11 +518,37 @@ Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
                                                camera.near_plane, camera.far_plane);
   projection[1][1] *= -1.0f;  // Vulkan's clip space has +Y down
   const glm::mat4 view = glm::lookAtRH(camera.position, camera.target, glm::vec3(0.0f, 1.0f, 0.0f));
+  const glm::vec4 sun(glm::normalize(look.sun_direction), look.sun_disc_intensity);
+  const glm::vec4 fog(look.fog_density, look.fog_height_falloff, 0.0f, 0.0f);
   constants.view_proj = projection * view;
   constants.camera_position = glm::vec4(camera.position, 1.0f);
-  constants.sun_direction = glm::vec4(glm::normalize(look.sun_direction), look.sun_disc_intensity);
+  constants.sun_direction = sun;
   constants.clip_plane = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // main view: nothing clipped
-  constants.fog = glm::vec4(look.fog_density, look.fog_height_falloff, 0.0f, 0.0f);
+  constants.fog = fog;
+
+  // The reflection renders the scene mirrored about the water plane y = h from the real camera,
+  // so the flow pass samples it at its own screen position; only what is above the water stays.
+  // The default river is level: the visible reach's plane is the water level itself.
+  const float h = river.water_level();
+  glm::mat4 mirror(1.0f);
+  mirror[1][1] = -1.0f;
+  mirror[3][1] = 2.0f * h;
+  reflection_constants = constants;
+  reflection_constants.view_proj = constants.view_proj * mirror;
+  reflection_constants.camera_position = glm::vec4(camera.position.x, 2.0f * h - camera.position.y,
+                                                   camera.position.z, 1.0f);
+  reflection_constants.clip_plane = glm::vec4(0.0f, 1.0f, 0.0f, -h + kReflectionClipBias);
+
+  const FlowTextureLayout& layout = simulation.layout();
+  flow_constants.view_proj = constants.view_proj;
+  flow_constants.camera_position =
+      glm::vec4(camera.position, static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
+  flow_constants.sun_direction = sun;
+  flow_constants.water = glm::vec4(h, kReflectionDistortion, kTdfTileMetres,
+                                   static_cast<float>(layout.texel_px));
+  flow_constants.screen = glm::vec4(info.extent.width, info.extent.height,
+                                    1.0f / static_cast<float>(info.extent.width),
+                                    1.0f / static_cast<float>(info.extent.height));
   SIVIFLOW_TRY(simulation.simulate(constants.view_proj, dt));
   last_time = time_seconds;
   return Status::success();
@@ -439,43 +586,36 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   if (inputs.output.final.layout == VK_IMAGE_LAYOUT_UNDEFINED) {
     return Status::error("Renderer::record: FrameInputs::output.final.layout must not be UNDEFINED");
   }
-  if (r.info.enable_readback) {
-    for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
-      if (inputs.readback.buffers[i] == VK_NULL_HANDLE) {
-        return Status::error(std::string("Renderer::record: readback is enabled but FrameInputs::readback has no ") +
-                             readback_image_name(static_cast<ReadbackImage>(i)) + " buffer");
-      }
+  for (uint32_t i = 0; i < r.readbacks.size(); ++i) {
+    if (inputs.readback.buffers[i] == VK_NULL_HANDLE) {
+      return Status::error(std::string("Renderer::record: readback is enabled but FrameInputs::readback has no ") +
+                           readback_image_name(static_cast<ReadbackImage>(i)) + " buffer");
     }
   }
   if (!r.static_data_uploaded) SIVIFLOW_TRY(r.record_static_upload(cmd));
   FrameBindings& b = r.bindings;
   b.reset();
   for (const Impl::StaticBuffer& sb : r.static_buffers) b.bind_buffer(sb.in_frame_graph, sb.buffer.buffer);
-  b.bind_image(r.scene.detail, r.detail_image.image, r.detail_image.view);
+  for (const Impl::StaticImage& si : r.static_images) b.bind_image(si.in_frame_graph, si.image.image, si.image.view);
+  for (const Impl::FrameImage& f : r.frame_images) {
+    b.bind_image(f.handle, f.image.image, f.image.view);
+    // Persistent images start without contents (only the upload writes them, whole).
+    if (r.frame_images_new && f.persistent) b.set_incoming(f.handle, ResourceState{});
+  }
   b.bind_image(r.output, inputs.output.image, inputs.output.view);
-  b.bind_image(r.scene.depth, r.depth_image.image, r.depth_image.view);
   b.set_incoming(r.output, {inputs.output.current.stage, inputs.output.current.access,
                             inputs.output.current.layout});
   b.set_outgoing(r.output, {inputs.output.final.stage, inputs.output.final.access,
                             inputs.output.final.layout});
-  for (uint32_t i = 0; i < r.readbacks.size(); ++i) {
-    b.bind_buffer(r.readbacks[i].buffer, inputs.readback.buffers[i]);
-  }
-  if (r.info.enable_readback) b.bind_image(r.water_mask, r.water_mask_image.image, r.water_mask_image.view);
   b.bind_buffer(r.frame_staging, r.ring.staging_buffer());
-  b.bind_image(r.flow_texture, r.flow_image.image, r.flow_image.view);
-  b.bind_image(r.particle_aux, r.aux_image.image, r.aux_image.view);
-  if (r.flow_images_new) {
-    b.set_incoming(r.flow_texture, ResourceState{});
-    b.set_incoming(r.particle_aux, ResourceState{});
-  }
+  for (uint32_t i = 0; i < r.readbacks.size(); ++i) b.bind_buffer(r.readbacks[i].buffer, inputs.readback.buffers[i]);
   const Status status = r.graph.execute(r.table, cmd, b);
   if (!status.ok()) {
     if (r.info.log != nullptr) r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
     return status;
   }
   r.static_data_uploaded = true;
-  r.flow_images_new = false;
+  r.frame_images_new = false;
   r.frame_begun = false;
   r.frame_updated = false;
   return Status::success();
@@ -493,13 +633,7 @@ Status Renderer::resize(VkExtent2D extent) {
                    std::to_string(extent.height) + " exceeds the device limit of " +
                    std::to_string(limit));
   }
-  // Frames of any slot still in flight may use the old images: free them once all came round.
-  for (Image* image : {&r.depth_image, &r.water_mask_image, &r.flow_image, &r.aux_image}) {
-    Image retired = *image;
-    *image = Image{};
-    r.ring.defer_deletion_until_all_slots(
-        [gpu_context = r.gpu, retired]() mutable { destroy_image(gpu_context, &retired); });
-  }
+  r.retire_frame_images();
   r.info.extent = extent;
   // The particles live in screen space: a new viewport starts them afresh at frame 0.
   SIVIFLOW_TRY(r.simulation.create(r.river, kDefaultSceneDischarge, r.info.seed,
@@ -525,6 +659,9 @@ VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
       return impl_->simulation.layout().flow_bytes;
     case ReadbackImage::kParticleAux:
       return impl_->simulation.layout().aux_bytes;
+    case ReadbackImage::kNormal:
+    case ReadbackImage::kReflection:
+      return pixels * 4 * sizeof(float);
   }
   return 0;
 }
@@ -541,6 +678,10 @@ const char* readback_image_name(ReadbackImage image) {
       return "readback flow texture";
     case ReadbackImage::kParticleAux:
       return "readback particle aux";
+    case ReadbackImage::kNormal:
+      return "readback water normal";
+    case ReadbackImage::kReflection:
+      return "readback reflection sample";
   }
   return "readback";
 }

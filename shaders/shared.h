@@ -89,7 +89,30 @@ static_assert(offsetof(ParticleAux, slope) == 8);
 static_assert(offsetof(ParticleAux, fade) == 12);
 #endif
 
+// Push constants of the flow pass (the water material).
+struct FlowConstants {
+  mat4 view_proj;        // world -> clip of the main view
+  vec4 camera_position;  // xyz world position; w scene time in seconds mod SIVIFLOW_TDF_TIME_PERIOD
+  vec4 sun_direction;    // xyz unit vector towards the sun
+  vec4 water;            // x water level (m), y reflection distortion (uv per unit normal tilt),
+                         // z TDF tile size (m), w flow texel size (pixels)
+  vec4 screen;           // xy output size (pixels), zw 1 / size
+};
+
+// Scene time reaches the water material wrapped to [0, this period) seconds (wrapped on the CPU
+// in double): floats keep sub-millisecond steps, and every TDF scroll rate makes whole cycles per
+// period, so the wrap is seamless.
+#define SIVIFLOW_TDF_TIME_PERIOD 64.0
+
+// Vertex input of the flow pass: the river surface positions (binding 0) and water depth per
+// vertex (binding 1, one float).
+#define SIVIFLOW_ATTR_WATER_DEPTH 1
+
 #ifdef __cplusplus
+static_assert(sizeof(FlowConstants) == 128);
+static_assert(offsetof(FlowConstants, camera_position) == 64);
+static_assert(offsetof(FlowConstants, water) == 96);
+static_assert(offsetof(FlowConstants, screen) == 112);
 static_assert(sizeof(SceneConstants) == 128);
 static_assert(offsetof(SceneConstants, camera_position) == 64);
 static_assert(offsetof(SceneConstants, sun_direction) == 80);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -28,7 +29,8 @@ struct BufferUpload {
 struct ImageUpload {
   VkDeviceSize staging_offset = 0;
   ImageHandle destination;
-  VkExtent2D extent{};
+  VkExtent2D extent{};  // of this mip level
+  uint32_t mip_level = 0;
 };
 
 // What the upload pass copies; filled on the CPU before the pass records.
@@ -42,7 +44,8 @@ struct UploadList {
 };
 
 // Declares the pass: it writes every destination of `list` (their handles are replaced by the
-// written versions) from the imported staging buffer. `list` is read again when the pass records.
+// written versions; the levels of one image must be listed one after another) from the
+// imported staging buffer. `list` is read again when the pass records.
 void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list);
 
 // ---- scene: sky, terrain, riverbed and objects ----
@@ -62,9 +65,10 @@ class ScenePass {
     BufferHandle indices;
     ImageHandle detail;
   };
-  // Declares the pass; the new versions of colour and depth are written back into `handles`.
-  void declare(FrameGraph& graph, const gpu::SceneConstants* constants, uint32_t index_count,
-               Handles* handles);
+  // Declares a pass drawing the scene with `constants` (the main view as "scene", the mirrored
+  // view as "reflection"); the new versions of colour and depth are written back into `handles`.
+  void declare(FrameGraph& graph, const char* pass_name, const gpu::SceneConstants* constants,
+               uint32_t index_count, Handles* handles);
 
  private:
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
@@ -76,26 +80,61 @@ class ScenePass {
   VkPipeline scene_pipeline_ = VK_NULL_HANDLE;
 };
 
-// ---- water mask: 1 where the river surface is the nearest thing on screen ----
+// ---- flow: the water material of Algorithm 3, drawn over the scene ----
 
-class WaterMaskPass {
+// Draws the river surface: per fragment the particle flow (flow texture, aux data by slot), the
+// Tiled Directional Flow normal, the reflection sampled with that normal, depth colour and shore
+// fade, blended over the scene's colour. With AOVs it also writes the water mask, the normal
+// and the reflection sample, unblended.
+class FlowPass {
  public:
-  static constexpr VkFormat kFormat = VK_FORMAT_R32_SFLOAT;
-  Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat depth_format);
+  static constexpr VkFormat kMaskFormat = VK_FORMAT_R32_SFLOAT;
+  static constexpr VkFormat kNormalFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+  static constexpr VkFormat kReflectionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+
+  Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
+                VkFormat depth_format, bool with_aovs);
   void destroy(const GpuContext& gpu);
 
-  struct Handles {
-    ImageHandle mask;        // written (cleared to 0, 1 on visible water)
-    ImageHandle depth;       // the scene's depth, tested against, not written
-    BufferHandle vertices;   // river surface positions (vec3)
-    BufferHandle indices;
+  struct Textures {
+    VkImageView flow = VK_NULL_HANDLE;        // R16G16B16A16_UINT, shaders/shared.h
+    VkImageView aux = VK_NULL_HANDLE;         // R32G32B32A32_SFLOAT, shaders/shared.h
+    VkImageView reflection = VK_NULL_HANDLE;  // the mirrored scene
+    VkImageLayout reflection_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    VkImageView normal_map = VK_NULL_HANDLE;  // tileable, mipmapped
   };
-  void declare(FrameGraph& graph, const gpu::SceneConstants* constants, uint32_t index_count,
+  // Points a fresh descriptor set at the textures of this configuration. The previous pool is
+  // handed to `retire`, to be destroyed once no frame in flight uses it.
+  Status bind_textures(const GpuContext& gpu, const Textures& textures,
+                       const std::function<void(VkDescriptorPool)>& retire);
+
+  struct Handles {
+    ImageHandle color;       // the scene colour: loaded, blended over
+    ImageHandle depth;       // the scene depth: tested, not written
+    ImageHandle flow;
+    ImageHandle aux;
+    ImageHandle reflection;
+    ImageHandle normal_map;
+    BufferHandle vertices;   // river surface positions (vec3)
+    BufferHandle depths;     // water depth per vertex (float)
+    BufferHandle indices;
+    ImageHandle mask;        // AOVs, written when created with_aovs
+    ImageHandle normal;
+    ImageHandle reflection_sample;
+  };
+  void declare(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
                Handles* handles);
 
  private:
+  bool with_aovs_ = false;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkSampler nearest_ = VK_NULL_HANDLE;  // flow and aux: texelFetch only, integer formats
+  VkSampler linear_clamp_ = VK_NULL_HANDLE;
+  VkSampler linear_repeat_ = VK_NULL_HANDLE;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
 };
 
 // ---- readback: images -> host buffers (tools and tests only) ----

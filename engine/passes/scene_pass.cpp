@@ -112,9 +112,10 @@ void ScenePass::set_detail_texture(const GpuContext& gpu, VkImageView view) {
   gpu.table->vkUpdateDescriptorSets(gpu.table->device, 1, &write, 0, nullptr);
 }
 
-void ScenePass::declare(FrameGraph& graph, const gpu::SceneConstants* constants,
-                        uint32_t index_count, Handles* handles) {
-  PassBuilder pass = graph.add_pass("scene", PassKind::Graphics);
+void ScenePass::declare(FrameGraph& graph, const char* pass_name,
+                        const gpu::SceneConstants* constants, uint32_t index_count,
+                        Handles* handles) {
+  PassBuilder pass = graph.add_pass(pass_name, PassKind::Graphics);
   handles->color = pass.color_write(handles->color, LoadOp::Clear);
   handles->depth = pass.depth_write(handles->depth, LoadOp::Clear);
   pass.vertex_read(handles->vertices);

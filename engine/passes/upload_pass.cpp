@@ -8,7 +8,16 @@ void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list) 
   PassBuilder pass = graph.add_pass("upload", PassKind::Transfer);
   pass.transfer_read(staging);
   for (BufferUpload& upload : list->buffers) upload.destination = pass.transfer_write(upload.destination);
-  for (ImageUpload& upload : list->images) upload.destination = pass.transfer_write(upload.destination);
+  // One write per image, whatever the number of mip levels copied into it.
+  for (size_t i = 0; i < list->images.size(); ++i) {
+    ImageUpload& upload = list->images[i];
+    const ImageHandle declared = upload.destination;
+    upload.destination = pass.transfer_write(declared);
+    for (size_t j = i + 1; j < list->images.size() && list->images[j].destination == declared; ++j) {
+      list->images[j].destination = upload.destination;
+      i = j;
+    }
+  }
   // Lookups in the pass context go by resource, so the written versions name the same images.
   pass.record([list, staging](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
@@ -23,7 +32,7 @@ void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list) 
       const ImageHandle target = upload.destination;
       VkBufferImageCopy region{};
       region.bufferOffset = source_base + upload.staging_offset;
-      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+      region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, upload.mip_level, 0, 1};
       region.imageExtent = {upload.extent.width, upload.extent.height, 1};
       vk.vkCmdCopyBufferToImage(ctx.cmd(), source, ctx.image(target), ctx.layout(target), 1, &region);
     }

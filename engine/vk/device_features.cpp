@@ -10,6 +10,7 @@ namespace {
 
 struct FeatureSet {
   bool shader_clip_distance = false;
+  bool independent_blend = false;
   bool dynamic_rendering = false;
   bool synchronization2 = false;
 };
@@ -20,6 +21,7 @@ FeatureSet read_chain(const VkPhysicalDeviceFeatures2* features) {
   FeatureSet set;
   if (features == nullptr) return set;
   set.shader_clip_distance = features->features.shaderClipDistance == VK_TRUE;
+  set.independent_blend = features->features.independentBlend == VK_TRUE;
   for (auto* node = static_cast<const VkBaseInStructure*>(features->pNext); node != nullptr;
        node = node->pNext) {
     switch (node->sType) {
@@ -50,6 +52,7 @@ RequiredDeviceFeatures required_device_features() {
   RequiredDeviceFeatures required;
   required.features2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
   required.features2.features.shaderClipDistance = VK_TRUE;  // reflection clip plane
+  required.features2.features.independentBlend = VK_TRUE;    // water blends, its AOVs do not
   required.vulkan13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
   required.vulkan13.dynamicRendering = VK_TRUE;   // every pass renders without render passes
   required.vulkan13.synchronization2 = VK_TRUE;   // every barrier is a VkDependencyInfo
@@ -58,13 +61,13 @@ RequiredDeviceFeatures required_device_features() {
 }
 
 std::vector<std::string> required_device_feature_names() {
-  return {"shaderClipDistance", "dynamicRendering", "synchronization2"};
+  return {"shaderClipDistance", "independentBlend", "dynamicRendering", "synchronization2"};
 }
 
 std::vector<std::string> missing_device_features(const VkPhysicalDeviceFeatures2* features) {
   const FeatureSet set = read_chain(features);
-  const std::array<bool, 3> present = {set.shader_clip_distance, set.dynamic_rendering,
-                                       set.synchronization2};
+  const std::array<bool, 4> present = {set.shader_clip_distance, set.independent_blend,
+                                       set.dynamic_rendering, set.synchronization2};
   const std::vector<std::string> names = required_device_feature_names();
   std::vector<std::string> missing;
   for (size_t i = 0; i < names.size(); ++i) {

@@ -101,14 +101,15 @@ void destroy_buffer(const GpuContext& gpu, Buffer* buffer) {
 }
 
 Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,
-                    VkImageUsageFlags usage, const char* debug_name, Image* out) {
+                    VkImageUsageFlags usage, const char* debug_name, Image* out,
+                    uint32_t mip_levels) {
   const DeviceTable& vk = *gpu.table;
   *out = Image{};
   VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   info.imageType = VK_IMAGE_TYPE_2D;
   info.format = format;
   info.extent = {extent.width, extent.height, 1};
-  info.mipLevels = 1;
+  info.mipLevels = mip_levels;
   info.arrayLayers = 1;
   info.samples = VK_SAMPLE_COUNT_1_BIT;
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
@@ -136,7 +137,7 @@ Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,
     view.image = out->image;
     view.viewType = VK_IMAGE_VIEW_TYPE_2D;
     view.format = format;
-    view.subresourceRange = {aspect_of(format), 0, 1, 0, 1};
+    view.subresourceRange = {aspect_of(format), 0, mip_levels, 0, 1};
     result = vk.vkCreateImageView(vk.device, &view, gpu.allocation_callbacks, &out->view);
     if (result != VK_SUCCESS) status = vk_failure("vkCreateImageView", debug_name, result);
   }

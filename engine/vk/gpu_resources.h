@@ -39,7 +39,8 @@ Status create_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlag
 void destroy_buffer(const GpuContext& gpu, Buffer* buffer);
 
 Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,
-                    VkImageUsageFlags usage, const char* debug_name, Image* out);
+                    VkImageUsageFlags usage, const char* debug_name, Image* out,
+                    uint32_t mip_levels = 1);
 void destroy_image(const GpuContext& gpu, Image* image);
 
 }  // namespace siviflow

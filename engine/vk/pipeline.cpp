@@ -90,9 +90,15 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
       blend_attachment.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
       blend_attachment.alphaBlendOp = VK_BLEND_OP_ADD;
     }
+    std::vector<VkPipelineColorBlendAttachmentState> blend_attachments(
+        1 + desc.extra_color_formats.size(), VkPipelineColorBlendAttachmentState{});
+    blend_attachments[0] = blend_attachment;
+    for (size_t i = 1; i < blend_attachments.size(); ++i) {
+      blend_attachments[i].colorWriteMask = blend_attachment.colorWriteMask;
+    }
     VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    blend.attachmentCount = 1;
-    blend.pAttachments = &blend_attachment;
+    blend.attachmentCount = static_cast<uint32_t>(blend_attachments.size());
+    blend.pAttachments = blend_attachments.data();
 
     const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
@@ -100,8 +106,11 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
     dynamic.pDynamicStates = dynamic_states;
 
     VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-    rendering.colorAttachmentCount = 1;
-    rendering.pColorAttachmentFormats = &desc.color_format;
+    std::vector<VkFormat> color_formats{desc.color_format};
+    color_formats.insert(color_formats.end(), desc.extra_color_formats.begin(),
+                         desc.extra_color_formats.end());
+    rendering.colorAttachmentCount = static_cast<uint32_t>(color_formats.size());
+    rendering.pColorAttachmentFormats = color_formats.data();
     rendering.depthAttachmentFormat = desc.depth_format;
 
     VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};

@@ -101,8 +101,10 @@ enum class ReadbackImage : uint32_t {
   kWaterMask,  // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
   kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h), flow_texture_layout()
   kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)
+  kNormal,       // RGBA32F: the final water normal in world space (xyz) on water, 0 elsewhere
+  kReflection,   // RGBA32F: the reflection sample of the water material before blending
 };
-inline constexpr uint32_t kReadbackImageCount = 5;
+inline constexpr uint32_t kReadbackImageCount = 7;
 const char* readback_image_name(ReadbackImage image);
 
 struct ReadbackTargets {

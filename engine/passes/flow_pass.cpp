@@ -1,0 +1,172 @@
+#include "passes/passes.h"
+
+#include <array>
+#include <string>
+
+#include "vk/device_table.h"
+#include "vk/pipeline.h"
+
+namespace siviflow {
+namespace {
+
+constexpr uint32_t kBindingFlow = 0;
+constexpr uint32_t kBindingAux = 1;
+constexpr uint32_t kBindingReflection = 2;
+constexpr uint32_t kBindingNormalMap = 3;
+constexpr uint32_t kBindingCount = 4;
+
+Status check(VkResult result, const char* call) {
+  if (result == VK_SUCCESS) return Status::success();
+  return Status::error(std::string("flow pass: ") + call + " failed: " + result_name(result), result);
+}
+
+Status make_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMode address,
+                    bool mipmapped, VkSampler* out) {
+  VkSamplerCreateInfo info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  info.magFilter = filter;
+  info.minFilter = filter;
+  info.mipmapMode = mipmapped ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  info.addressModeU = address;
+  info.addressModeV = address;
+  info.addressModeW = address;
+  info.maxLod = mipmapped ? VK_LOD_CLAMP_NONE : 0.0f;
+  return check(gpu.table->vkCreateSampler(gpu.table->device, &info, gpu.allocation_callbacks, out),
+               "vkCreateSampler");
+}
+
+}  // namespace
+
+Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
+                        VkFormat depth_format, bool with_aovs) {
+  const DeviceTable& vk = *gpu.table;
+  with_aovs_ = with_aovs;
+  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
+  for (uint32_t i = 0; i < kBindingCount; ++i) {
+    bindings[i] = {i, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+  }
+  VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  set_info.bindingCount = kBindingCount;
+  set_info.pBindings = bindings.data();
+  SIVIFLOW_TRY(check(vk.vkCreateDescriptorSetLayout(vk.device, &set_info, gpu.allocation_callbacks,
+                                                     &set_layout_),
+                     "vkCreateDescriptorSetLayout"));
+  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                            sizeof(gpu::FlowConstants)};
+  VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  layout_info.setLayoutCount = 1;
+  layout_info.pSetLayouts = &set_layout_;
+  layout_info.pushConstantRangeCount = 1;
+  layout_info.pPushConstantRanges = &range;
+  SIVIFLOW_TRY(check(vk.vkCreatePipelineLayout(vk.device, &layout_info, gpu.allocation_callbacks, &layout_),
+                     "vkCreatePipelineLayout"));
+  SIVIFLOW_TRY(make_sampler(gpu, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &nearest_));
+  SIVIFLOW_TRY(make_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &linear_clamp_));
+  SIVIFLOW_TRY(make_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, true, &linear_repeat_));
+
+  GraphicsPipelineDesc desc;
+  desc.vertex_shader = "flow.vert";
+  desc.fragment_shader = with_aovs ? "flow_aovs.frag" : "flow.frag";
+  desc.layout = layout_;
+  desc.color_format = color_format;
+  if (with_aovs) desc.extra_color_formats = {kMaskFormat, kNormalFormat, kReflectionFormat};
+  desc.depth_format = depth_format;
+  desc.depth_write = false;
+  desc.depth_compare = VK_COMPARE_OP_LESS_OR_EQUAL;
+  desc.alpha_blend = true;
+  desc.bindings = {{0, sizeof(float) * 3, VK_VERTEX_INPUT_RATE_VERTEX},
+                   {1, sizeof(float), VK_VERTEX_INPUT_RATE_VERTEX}};
+  desc.attributes = {{SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                     {SIVIFLOW_ATTR_WATER_DEPTH, 1, VK_FORMAT_R32_SFLOAT, 0}};
+  return create_graphics_pipeline(gpu, cache, desc, &pipeline_);
+}
+
+void FlowPass::destroy(const GpuContext& gpu) {
+  const DeviceTable& vk = *gpu.table;
+  const VkAllocationCallbacks* callbacks = gpu.allocation_callbacks;
+  if (pipeline_ != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline_, callbacks);
+  if (pool_ != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool_, callbacks);
+  for (VkSampler sampler : {nearest_, linear_clamp_, linear_repeat_}) {
+    if (sampler != VK_NULL_HANDLE) vk.vkDestroySampler(vk.device, sampler, callbacks);
+  }
+  if (layout_ != VK_NULL_HANDLE) vk.vkDestroyPipelineLayout(vk.device, layout_, callbacks);
+  if (set_layout_ != VK_NULL_HANDLE) vk.vkDestroyDescriptorSetLayout(vk.device, set_layout_, callbacks);
+  *this = FlowPass{};
+}
+
+Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
+                               const std::function<void(VkDescriptorPool)>& retire) {
+  const DeviceTable& vk = *gpu.table;
+  if (pool_ != VK_NULL_HANDLE) retire(pool_);
+  pool_ = VK_NULL_HANDLE;
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kBindingCount};
+  VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 1;
+  pool_info.pPoolSizes = &size;
+  SIVIFLOW_TRY(check(vk.vkCreateDescriptorPool(vk.device, &pool_info, gpu.allocation_callbacks, &pool_),
+                     "vkCreateDescriptorPool"));
+  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc.descriptorPool = pool_;
+  alloc.descriptorSetCount = 1;
+  alloc.pSetLayouts = &set_layout_;
+  SIVIFLOW_TRY(check(vk.vkAllocateDescriptorSets(vk.device, &alloc, &set_), "vkAllocateDescriptorSets"));
+  const VkImageLayout read = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  const std::array<VkDescriptorImageInfo, kBindingCount> images{{
+      {nearest_, textures.flow, read},
+      {nearest_, textures.aux, read},
+      {linear_clamp_, textures.reflection, textures.reflection_layout},
+      {linear_repeat_, textures.normal_map, read}}};
+  std::array<VkWriteDescriptorSet, kBindingCount> writes{};
+  for (uint32_t i = 0; i < kBindingCount; ++i) {
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set_;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    writes[i].pImageInfo = &images[i];
+  }
+  vk.vkUpdateDescriptorSets(vk.device, kBindingCount, writes.data(), 0, nullptr);
+  return Status::success();
+}
+
+void FlowPass::declare(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
+                       Handles* handles) {
+  PassBuilder pass = graph.add_pass("flow", PassKind::Graphics);
+  handles->color = pass.color_write(handles->color, LoadOp::Load);
+  if (with_aovs_) {
+    handles->mask = pass.color_write(handles->mask, LoadOp::Clear);
+    handles->normal = pass.color_write(handles->normal, LoadOp::Clear);
+    handles->reflection_sample = pass.color_write(handles->reflection_sample, LoadOp::Clear);
+  }
+  pass.depth_read(handles->depth);
+  pass.sampled_fragment(handles->flow);
+  pass.sampled_fragment(handles->aux);
+  pass.sampled_fragment(handles->reflection);
+  pass.sampled_fragment(handles->normal_map);
+  pass.vertex_read(handles->vertices);
+  pass.vertex_read(handles->depths);
+  pass.index_read(handles->indices);
+  const Handles h = *handles;
+  pass.record([this, h, constants, index_count](const PassContext& ctx) {
+    const DeviceTable& vk = ctx.table();
+    const VkCommandBuffer cmd = ctx.cmd();
+    const VkExtent2D extent = ctx.extent(h.color);
+    const VkViewport viewport{0.0f, 0.0f, static_cast<float>(extent.width),
+                              static_cast<float>(extent.height), 0.0f, 1.0f};
+    const VkRect2D scissor{{0, 0}, extent};
+    vk.vkCmdSetViewport(cmd, 0, 1, &viewport);
+    vk.vkCmdSetScissor(cmd, 0, 1, &scissor);
+    vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &set_, 0, nullptr);
+    vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                          0, sizeof(gpu::FlowConstants), constants);
+    vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
+    const VkBuffer streams[2] = {ctx.buffer(h.vertices), ctx.buffer(h.depths)};
+    const VkDeviceSize offsets[2] = {0, 0};
+    vk.vkCmdBindVertexBuffers(cmd, 0, 2, streams, offsets);
+    vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
+    vk.vkCmdDrawIndexed(cmd, index_count, 1, 0, 0, 0);
+    return Status::success();
+  });
+}
+
+}  // namespace siviflow
