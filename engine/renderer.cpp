@@ -246,6 +246,9 @@ Status Renderer::Impl::create_static_resources() {
   static_images[kNormalMap].texels = std::move(normal_map.texels);
   static_images[kNormalMap].mip_offsets = std::move(normal_map.mip_offsets);
 
+  // Every frame's flow textures must fit a slot's staging block.
+  info.staging_bytes_per_slot = std::max(info.staging_bytes_per_slot,
+                                         VkDeviceSize{simulation.layout().total_bytes} + kStagingAlignment);
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
   for (StaticBuffer& b : static_buffers) {
     SIVIFLOW_TRY(create_buffer(gpu, b.bytes.size(), b.usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -563,10 +566,11 @@ Status Renderer::update(const Camera& camera, double time_seconds) {
   Impl& r = *impl_;
   if (!r.frame_begun) return Status::error("Renderer::update called before begin_frame");
   if (r.frame_updated) return Status::error("Renderer::update called twice for one frame");
-  SIVIFLOW_TRY(r.simulate(camera, time_seconds));
+  // Staging first: a failure there must not leave the particles one frame ahead.
   const FlowTextureLayout& layout = r.simulation.layout();
   StagingAllocation staging;
   SIVIFLOW_TRY(r.ring.allocate_staging(layout.total_bytes, kStagingAlignment, &staging));
+  SIVIFLOW_TRY(r.simulate(camera, time_seconds));
   SIVIFLOW_TRY(r.simulation.pack({static_cast<std::byte*>(staging.data), layout.total_bytes}));
   r.frame_uploads.images[0].staging_offset = staging.offset + layout.flow_offset;
   r.frame_uploads.images[1].staging_offset = staging.offset + layout.aux_offset;
@@ -633,11 +637,12 @@ Status Renderer::resize(VkExtent2D extent) {
                    std::to_string(extent.height) + " exceeds the device limit of " +
                    std::to_string(limit));
   }
+  // The particles live in screen space: a new viewport starts them afresh at frame 0. This can
+  // fail (a size the particles cannot cover); nothing has changed then.
+  SIVIFLOW_TRY(r.simulation.resize({extent.width, extent.height}));
+  SIVIFLOW_TRY(r.ring.ensure_staging_capacity(r.simulation.layout().total_bytes + kStagingAlignment));
   r.retire_frame_images();
   r.info.extent = extent;
-  // The particles live in screen space: a new viewport starts them afresh at frame 0.
-  SIVIFLOW_TRY(r.simulation.create(r.river, kDefaultSceneDischarge, r.info.seed,
-                                   {extent.width, extent.height}));
   r.graph = FrameGraph{};
   r.bindings.reset();
   return r.declare_graph();

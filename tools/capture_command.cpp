@@ -44,6 +44,8 @@ struct CaptureOptions {
   bool depth_aov = false;
   bool flow_aov = false;       // flow.X/Y/Z and water.mask
   bool particles_aov = false;  // particle.id and frame_NNNNN.particles.csv
+  bool normal_aov = false;     // normal.X/Y/Z
+  bool reflection_aov = false; // reflection.R/G/B
 };
 
 void print_help() {
@@ -65,6 +67,9 @@ void print_help() {
       "                            pixel, on visible water (-1 elsewhere); and beside each frame\n"
       "                            frame_NNNNN.particles.csv: id,state,sx,sy,wx,wy,wz,fx,fy,fz,\n"
       "                            speed,depth,slope,fade\n"
+      "                 normal     normal.X/Y/Z: the final water normal in world space (0 off water)\n"
+      "                 reflection reflection.R/G/B: the reflection sample of the water before\n"
+      "                            blending (0 off water)\n"
       "  --preview      also write DIR/frame_NNNNN.png (sRGB, clamped)\n"
       "  --validation   run with the Khronos validation layer; any error fails the capture\n");
 }
@@ -108,8 +113,13 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
           options->flow_aov = true;
         } else if (aov == "particles") {
           options->particles_aov = true;
+        } else if (aov == "normal") {
+          options->normal_aov = true;
+        } else if (aov == "reflection") {
+          options->reflection_aov = true;
         } else {
-          return Status::error("--aov: unknown AOV '" + aov + "' (available: depth, flow, particles)");
+          return Status::error("--aov: unknown AOV '" + aov +
+                               "' (available: depth, flow, particles, normal, reflection)");
         }
       }
     } else if (arg == "--preview") {
@@ -139,6 +149,8 @@ Status check_output_dir(const std::string& dir) {
   return Status::success();
 }
 
+constexpr uint32_t index_of(ReadbackImage image) { return static_cast<uint32_t>(image); }
+
 // Window depth (0 near .. 1 far, glm::perspectiveRH_ZO) to distance along the view axis.
 float linear_depth(float window_depth, float near_plane, float far_plane) {
   if (window_depth >= 1.0f) return std::numeric_limits<float>::infinity();
@@ -165,6 +177,8 @@ struct FinishedFrame {
   std::vector<float> window_depth;
   std::vector<float> water_mask;
   std::vector<std::byte> flow_texture;  // as uploaded: shaders/shared.h FlowTexel per texel
+  std::vector<float> normal;            // RGBA per pixel
+  std::vector<float> reflection;        // RGBA per pixel
   std::vector<Particle> particles;
 };
 
@@ -193,6 +207,8 @@ class Capture {
   std::vector<float> depth_;
   std::vector<float> flow_[3];
   std::vector<float> particle_id_;
+  std::vector<float> normal_[3];
+  std::vector<float> reflection_[3];
 };
 
 Status Capture::run() {
@@ -290,14 +306,18 @@ void Capture::copy_out(const SlotTargets& slot) {
   const size_t pixels = size_t{options_.size.width} * options_.size.height;
   finished_.frame = slot.frame;
   finished_.camera = slot.camera;
-  const auto* halves = static_cast<const uint16_t*>(slot.readback[0].data);
+  const auto* halves = static_cast<const uint16_t*>(slot.readback[index_of(ReadbackImage::kColor)].data);
   finished_.color_halves.assign(halves, halves + pixels * 4);
-  const auto* depth = static_cast<const float*>(slot.readback[1].data);
+  const auto* depth = static_cast<const float*>(slot.readback[index_of(ReadbackImage::kDepth)].data);
   finished_.window_depth.assign(depth, depth + pixels);
-  const auto* mask = static_cast<const float*>(slot.readback[2].data);
+  const auto* mask = static_cast<const float*>(slot.readback[index_of(ReadbackImage::kWaterMask)].data);
   finished_.water_mask.assign(mask, mask + pixels);
-  const auto* flow = static_cast<const std::byte*>(slot.readback[3].data);
+  const auto* flow = static_cast<const std::byte*>(slot.readback[index_of(ReadbackImage::kFlowTexture)].data);
   finished_.flow_texture.assign(flow, flow + renderer_->readback_bytes(ReadbackImage::kFlowTexture));
+  const auto* normal = static_cast<const float*>(slot.readback[index_of(ReadbackImage::kNormal)].data);
+  finished_.normal.assign(normal, normal + pixels * 4);
+  const auto* reflection = static_cast<const float*>(slot.readback[index_of(ReadbackImage::kReflection)].data);
+  finished_.reflection.assign(reflection, reflection + pixels * 4);
   finished_.particles = slot.particles;
 }
 
@@ -355,6 +375,23 @@ Status Capture::write_frame() {
     }
     frame.channels.push_back({"particle.id", particle_id_.data()});
   }
+  // RGBA planes of the read-back AOV images, split into the EXR's named channels.
+  const auto add_planes = [&](const std::vector<float>& rgba, std::vector<float>* planes,
+                              const char* const names[3]) {
+    for (int c = 0; c < 3; ++c) {
+      planes[c].resize(pixels);
+      for (size_t i = 0; i < pixels; ++i) planes[c][i] = rgba[i * 4 + c];
+      frame.channels.push_back({names[c], planes[c].data()});
+    }
+  };
+  if (options_.normal_aov) {
+    static const char* const kNames[3] = {"normal.X", "normal.Y", "normal.Z"};
+    add_planes(finished_.normal, normal_, kNames);
+  }
+  if (options_.reflection_aov) {
+    static const char* const kNames[3] = {"reflection.R", "reflection.G", "reflection.B"};
+    add_planes(finished_.reflection, reflection_, kNames);
+  }
   frame.metadata.scene = "default";
   frame.metadata.frame = static_cast<int>(finished_.frame);
   frame.metadata.time_seconds = static_cast<float>(finished_.frame / options_.fps);
@@ -364,8 +401,14 @@ Status Capture::write_frame() {
   char name[32];
   std::snprintf(name, sizeof(name), "frame_%05u", finished_.frame);
   const std::string base = options_.out_dir + "/" + name;
-  if (options_.particles_aov) SIVIFLOW_TRY(write_particles_csv(base + ".particles.csv"));
   SIVIFLOW_TRY(write_exr(base + ".exr", frame));
+  if (options_.particles_aov) {
+    const Status csv = write_particles_csv(base + ".particles.csv");
+    if (!csv.ok()) {
+      std::remove((base + ".exr").c_str());  // a frame is its EXR and its CSV, or nothing
+      return csv;
+    }
+  }
   if (options_.preview) {
     SIVIFLOW_TRY(write_png(base + ".png", frame.width, frame.height, rgba_.data(), PngChannels::kRgb));
   }

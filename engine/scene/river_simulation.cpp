@@ -48,6 +48,19 @@ Status RiverSimulation::create(const ProceduralRiver& river, float discharge, ui
   return FlowTextures::create(particles_, kDefaultFlowTexelPx, &flow_textures_);
 }
 
+Status RiverSimulation::resize(glm::uvec2 viewport) {
+  ParticleParams params = particles_.params();
+  params.viewport = viewport;
+  ParticleField particles;
+  SIVIFLOW_TRY(ParticleField::create(particles_.river(), particles_.shared_bvh(), params, &particles));
+  FlowTextures textures;
+  SIVIFLOW_TRY(FlowTextures::create(particles, kDefaultFlowTexelPx, &textures));
+  particles_ = std::move(particles);
+  flow_textures_ = std::move(textures);
+  viewport_ = viewport;
+  return Status::success();
+}
+
 Status RiverSimulation::simulate(const glm::mat4& view_proj, float dt_seconds) {
   return particles_.update(ScreenCamera{view_proj, viewport_}, particles_.next_frame(), dt_seconds);
 }

@@ -26,6 +26,10 @@ class RiverSimulation {
   // into this object's per-vertex arrays.
   Status create(const ProceduralRiver& river, float discharge, uint64_t seed, glm::uvec2 viewport);
 
+  // A new viewport: new particles (from frame 0) and flow textures, on the same river, flow and
+  // ray-cast structure. On failure nothing changes.
+  Status resize(glm::uvec2 viewport);
+
   // One frame of Algorithm 2. Frames must come in order from 0; dt is the time since the last.
   Status simulate(const glm::mat4& view_proj, float dt_seconds);
   // Packs this frame's flow texture and auxiliary data into `staging` (layout().total_bytes).

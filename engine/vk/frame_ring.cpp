@@ -32,6 +32,23 @@ Status FrameRing::init(const GpuContext& gpu, uint32_t slot_count,
   return Status::success();
 }
 
+Status FrameRing::ensure_staging_capacity(VkDeviceSize bytes) {
+  for (uint32_t i = 0; i < slots_.size(); ++i) {
+    Slot& slot = slots_[i];
+    if (slot.allocator.capacity() >= bytes) continue;
+    // Frames in flight may still read the old block: retire it once every slot came round.
+    Buffer larger;
+    const std::string name = "staging slot " + std::to_string(i);
+    SIVIFLOW_TRY(create_buffer(gpu_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true,
+                               name.c_str(), &larger));
+    defer_deletion_until_all_slots(
+        [gpu_context = gpu_, retired = slot.staging]() mutable { destroy_buffer(gpu_context, &retired); });
+    slot.staging = larger;
+    slot.allocator = LinearAllocator(bytes);
+  }
+  return Status::success();
+}
+
 void FrameRing::destroy() {
   for (Slot& slot : slots_) {
     slot.deletions.run_all();

@@ -50,6 +50,9 @@ class FrameRing {
  public:
   Status init(const GpuContext& gpu, uint32_t slot_count, VkDeviceSize staging_bytes_per_slot);
   void destroy();  // runs every pending deletion; the GPU must be idle for this ring
+  // Grows every slot's staging block to at least `bytes`, between frames (not between a slot's
+  // begin and the end of its recording); old blocks are freed once every slot came round.
+  Status ensure_staging_capacity(VkDeviceSize bytes);
 
   uint32_t slot_count() const { return static_cast<uint32_t>(slots_.size()); }
   uint32_t current_slot() const { return current_; }

@@ -26,6 +26,7 @@ struct Frame {
   std::vector<float> water_mask;
   std::vector<std::byte> flow_texture;  // as uploaded and read back
   std::vector<std::byte> particle_aux;
+  std::vector<float> normal;  // RGBA per pixel: xyz the water normal, 0 off water
 
   const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * width + x) * 4]; }
 };
@@ -38,7 +39,7 @@ class RenderTest : public GpuTest {
                             uint32_t height = kHeight) {
     std::vector<Frame> frames;
     if (renderer_ == nullptr) {
-      const Status status = Renderer::create(make_create_info(kWidth, kHeight), &renderer_);
+      const Status status = Renderer::create(make_create_info(width, height), &renderer_);
       EXPECT_TRUE(status.ok()) << status.message();
       if (!status.ok()) return frames;
     }
@@ -70,6 +71,8 @@ class RenderTest : public GpuTest {
       out.flow_texture.assign(flow, flow + renderer_->readback_bytes(ReadbackImage::kFlowTexture));
       const auto* aux = static_cast<const std::byte*>(slot.readback[4].data);
       out.particle_aux.assign(aux, aux + renderer_->readback_bytes(ReadbackImage::kParticleAux));
+      const auto* normal = static_cast<const float*>(slot.readback[5].data);
+      out.normal.assign(normal, normal + size_t{width} * height * 4);
       frames.push_back(std::move(out));
       slot.pending = false;
     };
@@ -158,6 +161,37 @@ TEST_F(RenderTest, WaterMaskCoversTheRiverOnly) {
   EXPECT_LT(water, size_t{kWidth} * kHeight / 2);
 }
 
+TEST_F(RenderTest, WaterNormalIsUnitAndItsTiltDoesNotPulse) {
+  constexpr uint32_t kW = 160;
+  constexpr uint32_t kH = 90;
+  const std::vector<Frame> frames = render(0, 60, kW, kH);
+  ASSERT_EQ(frames.size(), 60u);
+  std::vector<double> mean_tilt;
+  for (const Frame& f : frames) {
+    double tilt = 0.0;
+    size_t water = 0;
+    for (size_t i = 0; i < f.water_mask.size(); ++i) {
+      if (f.water_mask[i] != 1.0f) continue;
+      const float* n = &f.normal[i * 4];
+      ASSERT_NEAR(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1.0, 1e-3) << "pixel " << i;
+      ASSERT_GT(n[1], 0.0f) << "the water normal points up";
+      tilt += std::sqrt(n[0] * n[0] + n[2] * n[2]);
+      ++water;
+    }
+    ASSERT_GT(water, 100u);
+    mean_tilt.push_back(tilt / static_cast<double>(water));
+  }
+  // After the particles faded in (0.25 s), the mean tilt stays steady: no two-phase pulsing.
+  double lo = 1e9;
+  double hi = 0.0;
+  for (size_t i = 15; i < mean_tilt.size(); ++i) {
+    lo = std::min(lo, mean_tilt[i]);
+    hi = std::max(hi, mean_tilt[i]);
+  }
+  EXPECT_GT(lo, 0.01) << "the water shows ripples";
+  EXPECT_LT((hi - lo) / hi, 0.15) << "mean tilt varies from " << lo << " to " << hi;
+}
+
 TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
   // Two frames: the second reuses the images and the other staging slot.
   const std::vector<Frame> frames = render(0, 2);
@@ -217,6 +251,8 @@ TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {
   ASSERT_EQ(shard.size(), 1u);
   EXPECT_EQ(std::memcmp(run[3].rgba.data(), shard[0].rgba.data(), run[3].rgba.size() * sizeof(float)), 0);
   EXPECT_EQ(run[3].depth, shard[0].depth);
+  EXPECT_EQ(run[3].flow_texture, shard[0].flow_texture) << "the particles differ";
+  EXPECT_EQ(run[3].particle_aux, shard[0].particle_aux);
   EXPECT_NE(run[0].rgba, run[3].rgba) << "the camera moves: frames must differ";
 }
 

@@ -130,7 +130,9 @@ class Renderer {
   // The host has waited until the GPU finished the commands last recorded for this slot.
   Status begin_frame(uint32_t slot);
   // CPU only: camera and simulation time for the frame being prepared: advances the river's
-  // particles one frame and packs the flow textures into the slot's staging block.
+  // particles one frame (frame next_frame()) and packs the flow textures into the slot's staging
+  // block. The particles carry state from frame to frame: to start at frame N and get the same
+  // pixels as a run from frame 0, simulate() frames 0..N-1 first.
   Status update(const Camera& camera, double time_seconds);
   // CPU only, outside begin_frame/record: advances the particles one frame without rendering,
   // so that a capture starting at frame N gets the same frame N as one starting at 0.
