@@ -56,6 +56,18 @@ uint32_t texel_bytes(VkFormat format) {
   }
 }
 
+constexpr size_t kMovingObstacle = 1;  // default_scene_obstacles(): the moving boulder is last
+
+// The constants that draw a model placed at `offset` with the scene shaders, which work in the
+// model's coordinates: clip and fog see the same distances as for the translated model.
+gpu::SceneConstants translated(const gpu::SceneConstants& constants, glm::vec3 offset) {
+  gpu::SceneConstants moved = constants;
+  moved.view_proj = constants.view_proj * glm::translate(glm::mat4(1.0f), offset);
+  moved.camera_position = constants.camera_position - glm::vec4(offset, 0.0f);
+  moved.clip_plane.w += glm::dot(glm::vec3(constants.clip_plane), offset);
+  return moved;
+}
+
 Status invalid(const std::string& message) {
   return Status::error("siviflow::Renderer: " + message, VK_ERROR_INITIALIZATION_FAILED);
 }
@@ -106,7 +118,10 @@ struct Renderer::Impl {
   std::array<StaticImage, kStaticImageCount> static_images{{
       {"ground detail", kDetailFormat, {}, {}, {}, {}, {}},
       {"water normal map", kNormalMapFormat, {}, {}, {}, {}, {}}}};
-  uint32_t scene_index_count = 0;
+  // What the scene and reflection passes draw: the static scene, and the moving boulder with
+  // its own constants (translated to where its obstacle is this frame).
+  std::vector<SceneDraw> scene_draws;
+  std::vector<SceneDraw> reflection_draws;
   uint32_t river_index_count = 0;
   ScenePass scene_pass;
   FlowPass flow_pass;
@@ -133,6 +148,8 @@ struct Renderer::Impl {
   FrameBindings bindings;
   gpu::SceneConstants constants{};
   gpu::SceneConstants reflection_constants{};
+  gpu::SceneConstants moving_constants{};
+  gpu::SceneConstants moving_reflection_constants{};
   gpu::FlowConstants flow_constants{};
 
   bool static_data_uploaded = false;
@@ -226,11 +243,17 @@ Status Renderer::Impl::create_static_resources() {
     return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
   };
   const SceneGeometry geometry = build_default_scene_geometry(river);
-  scene_index_count = static_cast<uint32_t>(geometry.indices.size());
+  scene_draws = {{0, geometry.static_index_count, &constants},
+                 {geometry.moving_first_index,
+                  static_cast<uint32_t>(geometry.indices.size()) - geometry.moving_first_index,
+                  &moving_constants}};
+  reflection_draws = {{0, geometry.static_index_count, &reflection_constants},
+                      {geometry.moving_first_index, scene_draws[1].index_count,
+                       &moving_reflection_constants}};
   static_buffers[kSceneVertices].bytes = bytes_of(geometry.vertices);
   static_buffers[kSceneIndices].bytes = bytes_of(geometry.indices);
-  SIVIFLOW_TRY(simulation.create(river, kDefaultSceneDischarge, info.seed,
-                                 {info.extent.width, info.extent.height}));
+  SIVIFLOW_TRY(simulation.create(river, kDefaultSceneDischarge, default_scene_obstacles(river),
+                                 info.seed, {info.extent.width, info.extent.height}));
   const RiverMesh& river_mesh = simulation.mesh();
   river_index_count = static_cast<uint32_t>(river_mesh.indices.size());
   static_buffers[kRiverVertices].bytes = bytes_of(river_mesh.positions);
@@ -335,7 +358,7 @@ Status Renderer::Impl::declare_graph() {
   mirrored.vertices = static_buffers[kSceneVertices].in_frame_graph;
   mirrored.indices = static_buffers[kSceneIndices].in_frame_graph;
   mirrored.detail = static_images[kDetail].in_frame_graph;
-  scene_pass.declare(graph, "reflection", &reflection_constants, scene_index_count, &mirrored);
+  scene_pass.declare(graph, "reflection", &reflection_draws, &mirrored);
 
   // scene: sky, terrain, riverbed and objects into the host's output.
   // The host states the output's real states per frame; these are overridden in record().
@@ -347,7 +370,7 @@ Status Renderer::Impl::declare_graph() {
   scene.vertices = static_buffers[kSceneVertices].in_frame_graph;
   scene.indices = static_buffers[kSceneIndices].in_frame_graph;
   scene.detail = static_images[kDetail].in_frame_graph;
-  scene_pass.declare(graph, "scene", &constants, scene_index_count, &scene);
+  scene_pass.declare(graph, "scene", &scene_draws, &scene);
 
   // flow: the water material over the scene.
   FlowPass::Handles water;
@@ -552,6 +575,11 @@ Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
   flow_constants.screen = glm::vec4(info.extent.width, info.extent.height,
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
+  // The moving boulder: its obstacle's centre this frame, drawn as a translated instance.
+  SIVIFLOW_TRY(simulation.set_time(time_seconds));
+  const glm::vec3 offset = simulation.obstacle_centre(kMovingObstacle);
+  moving_constants = translated(constants, offset);
+  moving_reflection_constants = translated(reflection_constants, offset);
   SIVIFLOW_TRY(simulation.simulate(constants.view_proj, dt));
   last_time = time_seconds;
   return Status::success();

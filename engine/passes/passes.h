@@ -50,6 +50,13 @@ void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list);
 
 // ---- scene: sky, terrain, riverbed and objects ----
 
+// One indexed draw of the scene pipeline with its own push constants.
+struct SceneDraw {
+  uint32_t first_index = 0;
+  uint32_t index_count = 0;
+  const gpu::SceneConstants* constants = nullptr;  // read when the pass records
+};
+
 class ScenePass {
  public:
   Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
@@ -65,10 +72,10 @@ class ScenePass {
     BufferHandle indices;
     ImageHandle detail;
   };
-  // Declares a pass drawing the scene with `constants` (the main view as "scene", the mirrored
-  // view as "reflection"); the new versions of colour and depth are written back into `handles`.
-  void declare(FrameGraph& graph, const char* pass_name, const gpu::SceneConstants* constants,
-               uint32_t index_count, Handles* handles);
+  // Declares a pass drawing the scene's `draws` then the sky (the main view as "scene", the
+  // mirrored view as "reflection"); the new versions of colour and depth go back into `handles`.
+  void declare(FrameGraph& graph, const char* pass_name, const std::vector<SceneDraw>* draws,
+               Handles* handles);
 
  private:
   VkPipelineLayout layout_ = VK_NULL_HANDLE;

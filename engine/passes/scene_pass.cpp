@@ -113,8 +113,7 @@ void ScenePass::set_detail_texture(const GpuContext& gpu, VkImageView view) {
 }
 
 void ScenePass::declare(FrameGraph& graph, const char* pass_name,
-                        const gpu::SceneConstants* constants, uint32_t index_count,
-                        Handles* handles) {
+                        const std::vector<SceneDraw>* draws, Handles* handles) {
   PassBuilder pass = graph.add_pass(pass_name, PassKind::Graphics);
   handles->color = pass.color_write(handles->color, LoadOp::Clear);
   handles->depth = pass.depth_write(handles->depth, LoadOp::Clear);
@@ -122,25 +121,29 @@ void ScenePass::declare(FrameGraph& graph, const char* pass_name,
   pass.index_read(handles->indices);
   pass.sampled_fragment(handles->detail);
   const Handles h = *handles;
-  pass.record([this, h, constants, index_count](const PassContext& ctx) {
+  pass.record([this, h, draws](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
     const VkCommandBuffer cmd = ctx.cmd();
     const VkExtent2D extent = ctx.extent(h.color);
     const VkViewport viewport{0.0f, 0.0f, static_cast<float>(extent.width),
                               static_cast<float>(extent.height), 0.0f, 1.0f};
     const VkRect2D scissor{{0, 0}, extent};
+    constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
     vk.vkCmdSetViewport(cmd, 0, 1, &viewport);
     vk.vkCmdSetScissor(cmd, 0, 1, &scissor);
     vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &set_, 0, nullptr);
-    vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
-                          0, sizeof(gpu::SceneConstants), constants);
     // Terrain and objects first, so the sky's fragments are depth-tested away behind them.
     vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, scene_pipeline_);
     const VkBuffer vertices = ctx.buffer(h.vertices);
     const VkDeviceSize offset = 0;
     vk.vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
     vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
-    vk.vkCmdDrawIndexed(cmd, index_count, 1, 0, 0, 0);
+    for (const SceneDraw& draw : *draws) {
+      vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), draw.constants);
+      vk.vkCmdDrawIndexed(cmd, draw.index_count, 1, draw.first_index, 0, 0);
+    }
+    // The sky with the view's own constants: those of the first, untranslated draw.
+    vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), draws->front().constants);
     vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, sky_pipeline_);
     vk.vkCmdDraw(cmd, 3, 1, 0, 0);
     return Status::success();

@@ -10,6 +10,7 @@
 
 #include "shared.h"
 #include "siviflow/renderer.h"
+#include "sim/obstacle.h"
 #include "sim/procedural_river.h"
 
 namespace siviflow {
@@ -19,7 +20,15 @@ using gpu::SceneVertex;
 struct SceneGeometry {
   std::vector<SceneVertex> vertices;
   std::vector<uint32_t> indices;  // triangle list, counter-clockwise seen from outside
+  uint32_t static_index_count = 0;  // indices [0, this) never move
+  // The moving boulder, modelled around the origin: indices [this, indices.size()), drawn
+  // translated to the obstacle's centre of each frame.
+  uint32_t moving_first_index = 0;
 };
+
+// The objects in the water, as obstacles for the flow: the boulder in mid-river, and the one that
+// rolls in from the right bank (the moving one, keyed, last in the list).
+std::vector<Obstacle> default_scene_obstacles(const ProceduralRiver& river);
 
 // Tunables of the look of the default scene, in one place.
 struct SceneLook {

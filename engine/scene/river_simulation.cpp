@@ -14,21 +14,22 @@ constexpr float kSlopeStep = 0.5f;         // metres: finite-difference step of 
 
 }  // namespace
 
-Status RiverSimulation::create(const ProceduralRiver& river, float discharge, uint64_t seed,
-                               glm::uvec2 viewport) {
+Status RiverSimulation::create(const ProceduralRiver& river, float discharge,
+                               std::vector<Obstacle> obstacles, uint64_t seed, glm::uvec2 viewport) {
   viewport_ = viewport;
   SIVIFLOW_TRY(river.generate_mesh(&mesh_));
   RiverSurface surface;
   SIVIFLOW_TRY(RiverSurface::build(mesh_.positions, mesh_.indices, RiverSurfaceOptions{}, &surface));
   SIVIFLOW_TRY(StreamFunction::create(std::move(surface), FlowParams{discharge, kShepardPower, 0.0f},
                                       &flow_));
+  for (const Obstacle& obstacle : obstacles) has_keys_ = has_keys_ || !obstacle.keys.empty();
+  SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
   const size_t count = mesh_.positions.size();
   velocity_.resize(count);
   speed_.resize(count);
   slope_.resize(count);
+  refresh_velocity();
   for (size_t v = 0; v < count; ++v) {
-    velocity_[v] = flow_.velocity(v);
-    speed_[v] = glm::length(velocity_[v]);
     const glm::vec3& p = mesh_.positions[v];
     const float dx = river.terrain_height(p.x + kSlopeStep, p.z) - river.terrain_height(p.x - kSlopeStep, p.z);
     const float dz = river.terrain_height(p.x, p.z + kSlopeStep) - river.terrain_height(p.x, p.z - kSlopeStep);
@@ -46,6 +47,21 @@ Status RiverSimulation::create(const ProceduralRiver& river, float discharge, ui
   params.viewport = viewport;
   SIVIFLOW_TRY(ParticleField::create(field, params, &particles_));
   return FlowTextures::create(particles_, kDefaultFlowTexelPx, &flow_textures_);
+}
+
+void RiverSimulation::refresh_velocity() {
+  for (size_t v = 0; v < velocity_.size(); ++v) {
+    velocity_[v] = flow_.velocity(v);
+    speed_[v] = glm::length(velocity_[v]);
+  }
+}
+
+Status RiverSimulation::set_time(double time_seconds) {
+  if (!has_keys_) return Status::success();
+  SIVIFLOW_TRY(flow_.set_time(time_seconds));
+  // A few thousand vertices: re-reading them all costs less than tracking which changed.
+  refresh_velocity();
+  return Status::success();
 }
 
 Status RiverSimulation::resize(glm::uvec2 viewport) {

@@ -14,6 +14,7 @@
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "sim/procedural_river.h"
+#include "sim/obstacle.h"
 #include "sim/status.h"
 #include "sim/stream_function.h"
 
@@ -24,7 +25,13 @@ class RiverSimulation {
   // Builds the river's surface mesh, solves its flow (discharge in m^2/s) and sizes the particles
   // and flow textures for `viewport`. Must not be moved after create(): the particles keep spans
   // into this object's per-vertex arrays.
-  Status create(const ProceduralRiver& river, float discharge, uint64_t seed, glm::uvec2 viewport);
+  Status create(const ProceduralRiver& river, float discharge, std::vector<Obstacle> obstacles,
+                uint64_t seed, glm::uvec2 viewport);
+
+  // Places the keyframed obstacles at `time_seconds` and re-solves the flow near those that
+  // moved, so the next simulate() hands the particles the new course.
+  Status set_time(double time_seconds);
+  glm::vec3 obstacle_centre(size_t index) const { return flow_.obstacle_centre(index); }
 
   // A new viewport: new particles (from frame 0) and flow textures, on the same river, flow and
   // ray-cast structure. On failure nothing changes.
@@ -46,6 +53,9 @@ class RiverSimulation {
   std::vector<glm::vec3> velocity_;  // per vertex, m/s
   std::vector<float> speed_;
   std::vector<float> slope_;         // riverbed slope under the vertex (rise over run)
+  bool has_keys_ = false;            // some obstacle moves: re-solve as time goes
+
+  void refresh_velocity();
   ParticleField particles_;
   FlowTextures flow_textures_;
   glm::uvec2 viewport_{0u};
