@@ -1,5 +1,6 @@
 #include "siviflow/scene_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -276,20 +277,103 @@ Status parse_flow(const Reader& r, const Json& v, FlowParams* out) {
   return Status::success();
 }
 
+double cross2(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
+
+// Whether the closed segments ab and cd share a point (touching and collinear overlap count).
+bool segments_touch(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c, glm::dvec2 d) {
+  const auto side = [](glm::dvec2 p, glm::dvec2 q, glm::dvec2 x) {
+    const double turn = cross2(q - p, x - p);
+    return (turn > 0.0) - (turn < 0.0);
+  };
+  const auto within = [](glm::dvec2 p, glm::dvec2 q, glm::dvec2 x) {
+    return std::min(p.x, q.x) <= x.x && x.x <= std::max(p.x, q.x) && std::min(p.y, q.y) <= x.y &&
+           x.y <= std::max(p.y, q.y);
+  };
+  const int d1 = side(a, b, c), d2 = side(a, b, d), d3 = side(c, d, a), d4 = side(c, d, b);
+  if (d1 * d2 < 0 && d3 * d4 < 0) return true;
+  return (d1 == 0 && within(a, b, c)) || (d2 == 0 && within(a, b, d)) ||
+         (d3 == 0 && within(c, d, a)) || (d4 == 0 && within(c, d, b));
+}
+
+// Why the closed polygon `p` (>= 3 finite points) is not simple, or empty when it is. Stricter
+// than validate_obstacle: hand-typed points that touch or double back are named here too.
+std::string polygon_problem(const std::vector<glm::vec2>& p) {
+  const size_t n = p.size();
+  for (size_t i = 0; i < n; ++i) {
+    const glm::dvec2 a(p[i]), b(p[(i + 1) % n]), c(p[(i + 2) % n]);
+    if (a == b) {
+      return (i + 1) % n == 0
+                 ? text_format("point %zu repeats point 0 (the polygon closes by itself: do not "
+                               "repeat the first point)", i)
+                 : text_format("point %zu repeats point %zu", (i + 1) % n, i);
+    }
+    if (n > 3 && cross2(b - a, c - b) == 0.0 && glm::dot(b - a, c - b) < 0.0) {
+      return text_format("the outline doubles back on itself at point %zu", (i + 1) % n);
+    }
+  }
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // neighbouring edges share a point
+      if (segments_touch(glm::dvec2(p[i]), glm::dvec2(p[(i + 1) % n]), glm::dvec2(p[j]),
+                         glm::dvec2(p[(j + 1) % n]))) {
+        return text_format("is not a simple polygon: edges %zu and %zu cross or touch", i, j);
+      }
+    }
+  }
+  return {};
+}
+
+// A footprint polygon: [[x, z], ...] offsets from the centre, >= 3 points, simple, either winding.
+Status parse_polygon(const Reader& r, const Json& v, const std::string& path,
+                     std::vector<glm::vec2>* out) {
+  SIVIFLOW_TRY(r.array(v, path, kMaxPolygonPoints));
+  if (v.size() < 3) {
+    return r.fail(path,
+                  text_format("has %zu points; a footprint polygon needs at least 3", v.size()));
+  }
+  std::vector<glm::vec2> points(v.size());
+  for (size_t i = 0; i < v.size(); ++i) {
+    float xz[2];
+    SIVIFLOW_TRY(r.floats(v[i], element(path, i), 2, xz));
+    points[i] = glm::vec2(xz[0], xz[1]);
+  }
+  if (const std::string problem = polygon_problem(points); !problem.empty())
+    return r.fail(path, problem);
+  // The sim's own check (zero area, ...); its "obstacle N: " prefix is what our path says.
+  Obstacle probe;
+  probe.polygon = points;
+  const Status valid = validate_obstacle(probe, 0);
+  if (!valid.ok()) {
+    std::string message = valid.message();
+    constexpr std::string_view kPrefix = "obstacle 0: ";
+    if (message.rfind(kPrefix, 0) == 0) message.erase(0, kPrefix.size());
+    return r.fail(path, message);
+  }
+  *out = std::move(points);
+  return Status::success();
+}
+
 Status parse_obstacles(const Reader& r, const Json& v, std::vector<Obstacle>* out) {
   SIVIFLOW_TRY(r.array(v, "obstacles", kMaxObstacles));
   for (size_t i = 0; i < v.size(); ++i) {
     const std::string path = element("obstacles", i);
     const Json& o = v[i];
     SIVIFLOW_TRY(r.object(o, path));
-    SIVIFLOW_TRY(r.keys(o, path, {"center", "radius", "keys"}));
+    SIVIFLOW_TRY(r.keys(o, path, {"center", "radius", "polygon", "keys"}));
     Obstacle obstacle;
     const Json* center = find(o, "center");
     const Json* radius = find(o, "radius");
+    const Json* polygon = find(o, "polygon");
     if (!center) return r.fail(path, "missing required key 'center'");
-    if (!radius) return r.fail(path, "missing required key 'radius'");
+    if (radius && polygon) {
+      return r.fail(path, "give either 'radius' (a circle) or 'polygon' (a footprint), not both");
+    }
+    if (!radius && !polygon) {
+      return r.fail(path, "needs 'radius' (a circle) or 'polygon' (a footprint of [x, z] points)");
+    }
     SIVIFLOW_TRY(r.vec3(*center, join(path, "center"), &obstacle.centre));
-    SIVIFLOW_TRY(r.positive(*radius, join(path, "radius"), &obstacle.radius));
+    if (radius) SIVIFLOW_TRY(r.positive(*radius, join(path, "radius"), &obstacle.radius));
+    if (polygon) SIVIFLOW_TRY(parse_polygon(r, *polygon, join(path, "polygon"), &obstacle.polygon));
     if (const Json* keys = find(o, "keys")) {
       const std::string keys_path = join(path, "keys");
       SIVIFLOW_TRY(r.array(*keys, keys_path, kMaxObstacleKeys));

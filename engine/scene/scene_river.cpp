@@ -1,10 +1,20 @@
 #include "siviflow/scene_river.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <memory>
+#include <utility>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
 
 #include "scene/gltf_import.h"
 #include "sim/procedural_river.h"
 #include "sim/river_surface.h"
+#include "sim/river_tuning.h"
+#include "sim/spatial_grid.h"
+#include "sim/text_format.h"
 
 namespace siviflow {
 namespace {
@@ -13,7 +23,170 @@ Status in_scene(const SceneFile& scene, const Status& status) {
   return Status::error(scene.path + ": " + status.message(), status.code());
 }
 
+double cross2(glm::dvec2 o, glm::dvec2 a, glm::dvec2 b) {
+  return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+// Andrew's monotone chain: the convex hull, counter-clockwise in (x, z), collinear points dropped.
+std::vector<glm::dvec2> convex_hull(std::vector<glm::dvec2> points) {
+  std::sort(points.begin(), points.end(),
+            [](glm::dvec2 a, glm::dvec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  if (points.size() < 3) return points;
+  std::vector<glm::dvec2> hull(2 * points.size());
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && cross2(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+    while (k >= lower && cross2(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);  // the last point repeats the first
+  return hull;
+}
+
+// The river's vertices in an XZ grid, for the water level under an object without a full scan.
+class WaterLevel {
+ public:
+  explicit WaterLevel(std::span<const glm::vec3> river) : river_(river) {
+    glm::dvec2 lo(river[0].x, river[0].z), hi = lo;
+    for (const glm::vec3& p : river) {
+      lo = glm::min(lo, glm::dvec2(p.x, p.z));
+      hi = glm::max(hi, glm::dvec2(p.x, p.z));
+    }
+    const double area = std::max((hi.x - lo.x) * (hi.y - lo.y), 1e-12);
+    grid_.init(lo, hi, 2.0 * std::sqrt(area / static_cast<double>(river.size())), river.size());
+    grid_.insert_points(river);
+  }
+
+  // The highest river vertex inside [lo, hi] (the most of the object counts as wet), else the
+  // height of the river vertex nearest the box's centre (widening the search ring by ring).
+  float under(glm::dvec2 lo, glm::dvec2 hi) const {
+    bool found = false;
+    float top = 0.0f;
+    grid_.for_each_in(lo, hi, [&](uint32_t v) {
+      const glm::vec3& p = river_[v];
+      if (p.x >= lo.x && p.x <= hi.x && p.z >= lo.y && p.z <= hi.y) {
+        top = found ? std::max(top, p.y) : p.y;
+        found = true;
+      }
+    });
+    if (found) return top;
+    const glm::dvec2 centre = 0.5 * (lo + hi);
+    double best = -1.0;
+    for (double grow = grid_.cell_size(); best < 0.0; grow *= 2.0) {
+      grid_.for_each_in(lo - grow, hi + grow, [&](uint32_t v) {
+        const glm::vec3& p = river_[v];
+        const double d = glm::length(glm::dvec2(p.x, p.z) - centre);
+        if (best < 0.0 || d < best) {
+          best = d;
+          top = p.y;
+        }
+      });
+    }
+    return top;
+  }
+
+ private:
+  std::span<const glm::vec3> river_;
+  XzGrid grid_;
+};
+
+// The footprint obstacle of one object (positions and bounds in world space): the XZ hull of the
+// mesh where it is below `water` (vertices and edge crossings), or all of it when not crossing.
+Status footprint_obstacle(const GltfObject& object, float water, Obstacle* out) {
+  const bool crosses = object.bounds_min.y <= water && object.bounds_max.y > water;
+  std::vector<glm::dvec2> points;
+  for (const GltfPrimitive& primitive : object.primitives) {
+    for (const glm::vec3& p : primitive.positions) {
+      if (!crosses || p.y <= water) points.emplace_back(p.x, p.z);
+    }
+    if (!crosses) continue;
+    // Where an edge pierces the water plane, so a sparse mesh still gets its waterline outline.
+    for (size_t t = 0; t + 2 < primitive.indices.size(); t += 3) {
+      for (int e = 0; e < 3; ++e) {
+        const glm::dvec3 a(primitive.positions[primitive.indices[t + e]]);
+        const glm::dvec3 b(primitive.positions[primitive.indices[t + (e + 1) % 3]]);
+        if ((a.y <= water) == (b.y <= water)) continue;
+        const double u = (double{water} - a.y) / (b.y - a.y);
+        points.emplace_back(a.x + u * (b.x - a.x), a.z + u * (b.z - a.z));
+      }
+    }
+  }
+  std::vector<glm::dvec2> hull = convex_hull(std::move(points));
+  if (hull.size() > kMaxObjectFootprintPoints) {
+    // A subset of a convex polygon's corners is convex: keep evenly spaced ones.
+    std::vector<glm::dvec2> fewer(kMaxObjectFootprintPoints);
+    for (size_t i = 0; i < fewer.size(); ++i) fewer[i] = hull[i * hull.size() / fewer.size()];
+    hull = std::move(fewer);
+  }
+  double area2 = 0.0;
+  glm::dvec2 centroid(0.0);
+  for (size_t i = 0; i < hull.size(); ++i) {
+    const glm::dvec2 a = hull[i], b = hull[(i + 1) % hull.size()];
+    const double c = a.x * b.y - a.y * b.x;
+    area2 += c;
+    centroid += (a + b) * c;
+  }
+  if (hull.size() < 3 || !(area2 > 0.0) || !std::isfinite(area2)) {
+    return Status::error(
+        "its footprint on the water plane has no area (the mesh is flat seen from above)");
+  }
+  centroid /= 3.0 * area2;
+  Obstacle obstacle;
+  obstacle.centre =
+      glm::vec3(static_cast<float>(centroid.x), water, static_cast<float>(centroid.y));
+  const glm::dvec2 centre(obstacle.centre.x, obstacle.centre.z);  // offsets from the stored centre
+  for (const glm::dvec2& p : hull) obstacle.polygon.emplace_back(p - centre);
+  const Status valid = validate_obstacle(obstacle, 0);
+  if (!valid.ok()) return Status::error("its footprint is not usable: " + valid.message());
+  *out = std::move(obstacle);
+  return Status::success();
+}
+
 }  // namespace
+
+Status scene_object_obstacles(const SceneFile& scene, std::span<const glm::vec3> river_positions,
+                              std::vector<Obstacle>* out) {
+  std::vector<Obstacle> obstacles;
+  if (river_positions.empty()) {
+    *out = std::move(obstacles);
+    return Status::success();
+  }
+  std::unique_ptr<WaterLevel> water;  // built on the first obstacle object only
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const SceneObject& so = scene.objects[i];
+    if (!so.obstacle) continue;
+    const std::string what = text_format("objects[%zu] (%s): ", i, so.gltf.c_str());
+    GltfObject object;
+    const Status loaded = load_gltf_object(so.gltf, &object);  // its message starts with the file
+    if (!loaded.ok()) {
+      return Status::error(scene.path + text_format(": objects[%zu]: ", i) + loaded.message());
+    }
+    glm::vec3 lo(0.0f), hi(0.0f);
+    bool first = true;
+    for (GltfPrimitive& primitive : object.primitives) {
+      for (glm::vec3& p : primitive.positions) {
+        p = so.translation + so.rotation * (so.scale * p);  // glTF order: scale, rotate, translate
+        lo = first ? p : glm::min(lo, p);
+        hi = first ? p : glm::max(hi, p);
+        first = false;
+      }
+    }
+    object.bounds_min = lo;
+    object.bounds_max = hi;
+    if (!water) water = std::make_unique<WaterLevel>(river_positions);
+    const float level = water->under(glm::dvec2(lo.x, lo.z), glm::dvec2(hi.x, hi.z));
+    Obstacle obstacle;
+    const Status footprint = footprint_obstacle(object, level, &obstacle);
+    if (!footprint.ok()) return Status::error(scene.path + ": " + what + footprint.message());
+    obstacles.push_back(std::move(obstacle));
+  }
+  *out = std::move(obstacles);
+  return Status::success();
+}
 
 Status build_scene_river_flow(const SceneFile& scene, double time_seconds, SceneRiverFlow* out) {
   std::vector<uint32_t> indices;
@@ -36,7 +209,11 @@ Status build_scene_river_flow(const SceneFile& scene, double time_seconds, Scene
   if (!status.ok()) return in_scene(scene, status);
   status = StreamFunction::create(std::move(surface), scene.flow, &out->flow);
   if (!status.ok()) return in_scene(scene, status);
-  status = out->flow.set_obstacles(scene.obstacles, time_seconds);
+  std::vector<Obstacle> obstacles = scene.obstacles;
+  std::vector<Obstacle> from_objects;
+  SIVIFLOW_TRY(scene_object_obstacles(scene, out->positions, &from_objects));
+  for (Obstacle& o : from_objects) obstacles.push_back(std::move(o));
+  status = out->flow.set_obstacles(std::move(obstacles), time_seconds);
   if (!status.ok()) return in_scene(scene, status);
   return Status::success();
 }

@@ -141,6 +141,63 @@ TEST(SceneFile, RotationIsReadXyzw) {
   EXPECT_EQ(scene.objects[0].rotation.w, 0.0f);
 }
 
+TEST(SceneFile, PolygonObstacleParses) {
+  SceneFile scene;
+  const Status status = parse(with({{"obstacles",
+                                     {{{"center", {1, 0.5, 2}},
+                                       {"polygon", {{-1, -1}, {2, -1}, {2, 0}, {0, 0}, {0, 1.5}}},
+                                       {"keys", {{{"t", 0}, {"center", {1, 0.5, 2}}}}}}}}}),
+                              &scene);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(scene.obstacles.size(), 1u);
+  const Obstacle& o = scene.obstacles[0];
+  EXPECT_EQ(o.centre, glm::vec3(1, 0.5f, 2));
+  EXPECT_EQ(o.radius, 0.0f) << "a polygon footprint has no radius";
+  ASSERT_EQ(o.polygon.size(), 5u);
+  EXPECT_EQ(o.polygon[0], glm::vec2(-1, -1));
+  EXPECT_EQ(o.polygon[4], glm::vec2(0, 1.5f));
+  EXPECT_EQ(o.keys.size(), 1u);
+  // Either winding is accepted (a clockwise triangle).
+  ASSERT_TRUE(parse(with({{"obstacles", {{{"center", {0, 0, 0}},
+                                          {"polygon", {{0, 0}, {0, 1}, {1, 0}}}}}}}),
+                    &scene)
+                  .ok());
+}
+
+TEST(SceneFile, ObstacleNeedsExactlyOneOfRadiusAndPolygon) {
+  expect_error(with({{"obstacles", {{{"center", {0, 0, 0}}, {"radius", 1},
+                                     {"polygon", {{0, 0}, {1, 0}, {0, 1}}}}}}}),
+               {"obstacles[0]: ", "either 'radius'", "'polygon'", "not both"});
+  expect_error(with({{"obstacles", {{{"center", {0, 0, 0}}, {"radius", 1}},
+                                    {{"center", {0, 0, 0}}}}}}),
+               {"obstacles[1]: needs 'radius'", "'polygon'"});
+}
+
+TEST(SceneFile, BadPolygonsNameThePath) {
+  const auto polygon = [](const Json& points) {
+    return with({{"obstacles", {{{"center", {0, 0, 0}}, {"polygon", points}}}}});
+  };
+  expect_error(polygon(Json::array()), {"obstacles[0].polygon: has 0 points", "at least 3"});
+  expect_error(polygon({{0, 0}, {1, 0}}), {"obstacles[0].polygon: has 2 points", "at least 3"});
+  expect_error(polygon({{0, 0}, {1e39, 0}, {0, 1}}),
+               {"obstacles[0].polygon[1][0]: ", "not a finite 32-bit float"});
+  expect_error(polygon({{0, 0}, {1, 0}, {0, nullptr}}),
+               {"obstacles[0].polygon[2][1]: must be a number, not null"});
+  // JSON has no NaN; an overflowing literal is the nearest a file can get to one.
+  expect_error(R"({"version":1,"river":{"procedural":{}},
+                  "obstacles":[{"center":[0,0,0],"polygon":[[0,0],[1e400,0],[0,1]]}]})",
+               {"not valid JSON"});
+  expect_error(polygon({{0, 0, 0}, {1, 0}, {0, 1}}),
+               {"obstacles[0].polygon[0]: must be an array of 2 numbers, not 3"});
+  expect_error(polygon({{0, 0}, {1, 0}, {2, 0}}), {"obstacles[0].polygon: ", "zero area"});
+  expect_error(polygon({{0, 0}, {1, 1}, {1, 0}, {0, 1}}),
+               {"obstacles[0].polygon: is not a simple polygon: edges 0 and 2"});
+  expect_error(polygon({{0, 0}, {1, 0}, {1, 1}, {0, 0}}),
+               {"obstacles[0].polygon: point 3 repeats point 0", "do not repeat the first point"});
+  expect_error(polygon({{0, 0}, {2, 0}, {1, 0}, {1, 1}}),
+               {"obstacles[0].polygon: the outline doubles back on itself at point 1"});
+}
+
 TEST(SceneFile, DefaultsWhenOptionalPartsAreAbsent) {
   SceneFile scene;
   const Status status = parse(R"({"version": 1, "river": {"procedural": {}}})", &scene);
@@ -452,6 +509,14 @@ TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {
     EXPECT_TRUE(top.contains(key)) << key;
   }
   EXPECT_EQ(top.size(), 8u) << "a top-level key the parser does not know";
+  // Obstacles: a circle or a polygon, exactly one (oneOf), and every listed key parses.
+  const Json& obstacle = top["obstacles"]["items"];
+  std::set<std::string> obstacle_keys;
+  for (const auto& item : obstacle["properties"].items()) obstacle_keys.insert(item.key());
+  EXPECT_EQ(obstacle_keys, (std::set<std::string>{"center", "radius", "polygon", "keys"}));
+  EXPECT_EQ(obstacle["required"], Json({"center"}));
+  ASSERT_EQ(obstacle["oneOf"].size(), 2u);
+  EXPECT_EQ(obstacle["properties"]["polygon"]["minItems"].get<int>(), 3);
 }
 
 }  // namespace

@@ -7,7 +7,8 @@
 //     "river": { "gltf": "river.glb", "mesh": "River" }   required: a glTF river (mesh optional:
 //            | { "procedural": { ...params..., "seed": 7 } }        first mesh), or the generator
 //     "flow":      { "discharge": 20.0, "p": 1.5, "search_radius": 30.0 },
-//     "obstacles": [ { "center": [x,y,z], "radius": 1.5,
+//     "obstacles": [ { "center": [x,y,z], "radius": 1.5,            a circle, or a footprint:
+//                      | "polygon": [[x,z], [x,z], [x,z], ...],      offsets around center
 //                      "keys": [ { "t": 0.0, "center": [..] } ] } ],
 //     "objects":   [ { "gltf": "duck.glb", "translation": [..], "rotation": [x,y,z,w],
 //                      "scale": [..], "obstacle": true } ],
@@ -22,8 +23,14 @@
 //   flow.p                  kDefaultShepardPower (1.5)
 //   flow.search_radius      absent: 3 x the widest section (FlowParams::search_radius = 0)
 //   obstacles               none; keys: none (the obstacle stays at `center`)
+//   obstacles[].radius | polygon   exactly one is required. polygon: 3 .. kMaxPolygonPoints
+//                           [x, z] offsets in metres from `center` in the XZ plane, either
+//                           winding, convex or not, but simple (no crossing or touching edges,
+//                           no repeated points; the outline closes by itself)
 //   objects[].translation   [0, 0, 0];  rotation [0, 0, 0, 1] (normalised on load);
-//   objects[].scale         [1, 1, 1];  obstacle false
+//   objects[].scale         [1, 1, 1];  obstacle false. An obstacle object is static (no keys):
+//                           its footprint is the XZ convex hull of its transformed mesh where it
+//                           dips below the water (see scene_river.h)
 //   camera.fov_y_deg        kDefaultCameraFovYDeg (50)
 //   camera.keys             none: the built-in camera that glides down the river
 //   render.size             [1280, 720];  fps 30;  seed 1
@@ -104,7 +111,7 @@ struct SceneFile {
   std::string folder;  // absolute folder that relative paths were resolved against
   SceneRiver river;
   FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
-  std::vector<Obstacle> obstacles;  // circles (radius > 0), keys optional
+  std::vector<Obstacle> obstacles;  // circles (radius > 0) or polygons, keys optional
   std::vector<SceneObject> objects;
   SceneCamera camera;
   SceneRender render;

@@ -2,12 +2,15 @@
 // and a stream-function flow with the scene's obstacles placed at a given time.
 #pragma once
 
+#include <cstddef>
+#include <span>
 #include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "siviflow/scene_file.h"
+#include "sim/obstacle.h"
 #include "sim/status.h"
 #include "sim/stream_function.h"
 
@@ -18,9 +21,24 @@ struct SceneRiverFlow {
   StreamFunction flow;               // per input vertex: surface data, psi, velocity, wet
 };
 
+// An object's footprint keeps at most this many hull corners: the flow's distance queries cost
+// one segment test per corner, and a few hundred outline any mesh's waterline closely enough.
+inline constexpr size_t kMaxObjectFootprintPoints = 256;
+
 // Loads the river mesh of `scene`, builds its surface and solves the flow with the scene's
-// obstacles at `time_seconds`. Errors name the scene file (and the glTF file where it is the cause).
+// obstacles at `time_seconds`: first `scene.obstacles`, then one per object marked `obstacle`
+// (scene_object_obstacles). Errors name the scene file (and the glTF file where it is the cause).
 Status build_scene_river_flow(const SceneFile& scene, double time_seconds, SceneRiverFlow* out);
+
+// One static polygon obstacle per object marked `obstacle`, in the order of `scene.objects`.
+// The object (load_gltf_object) is placed by its translation, rotation and scale; the water
+// level under it is the highest river vertex inside its XZ bounds (else the nearest river
+// vertex). Its footprint is the XZ convex hull of the mesh below that level (vertices and the
+// points where edges pierce it), or of the whole mesh when it lies wholly above or below: an
+// object marked obstacle cuts the river. The obstacle is centred at the hull's centroid, y at
+// the water level. Errors name the scene file, the object and its glTF file.
+Status scene_object_obstacles(const SceneFile& scene, std::span<const glm::vec3> river_positions,
+                              std::vector<Obstacle>* out);
 
 // The solved field as CSV: header `vertex,x,y,z,section,bank,width,d_left,d_right,psi,vx,vy,vz,wet`
 // and one row per vertex in accessor order (bank -1 left, +1 right, 0 interior; wet 0 when dry).
