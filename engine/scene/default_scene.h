@@ -8,7 +8,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "shared.h"
+#include "shaders/shared.h"
 #include "siviflow/renderer.h"
 #include "sim/obstacle.h"
 #include "sim/procedural_river.h"

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "gpu_test.h"
+#include "scene/default_scene.h"
 #include "shaders/shared.h"
 #include "sim/flow_textures.h"
 
@@ -190,6 +191,43 @@ TEST_F(RenderTest, WaterNormalIsUnitAndItsTiltDoesNotPulse) {
   }
   EXPECT_GT(lo, 0.01) << "the water shows ripples";
   EXPECT_LT((hi - lo) / hi, 0.15) << "mean tilt varies from " << lo << " to " << hi;
+}
+
+TEST_F(RenderTest, MovingObstacleReroutesTheParticlesFlow) {
+  const ProceduralRiver river(default_river_params());
+  const Obstacle moving = default_scene_obstacles(river).back();
+  const glm::vec3 in_water = moving.keys.back().centre;  // where it ends, in the river
+  RiverMesh mesh;
+  ASSERT_TRUE(river.generate_mesh(&mesh).ok());
+  ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
+  // A camera above the spot, so that particles are dense there (a few per metre).
+  Camera above;
+  above.position = in_water + glm::vec3(0.0f, 6.0f, -4.0f);
+  above.target = in_water;
+  // The mean flow of particles whose river vertex lies where the boulder ends up, at frame `last`.
+  const auto flow_at_destination = [&](uint32_t last, size_t* count) {
+    while (renderer_->next_frame() <= last) {
+      const double t = static_cast<double>(renderer_->next_frame()) / 30.0;
+      EXPECT_TRUE(renderer_->simulate(above, t).ok());
+    }
+    double speed = 0.0;
+    *count = 0;
+    for (const Particle& p : renderer_->particle_field().particles()) {
+      const glm::vec3& v = mesh.positions[p.vertex];
+      if (glm::length(glm::vec2(v.x - in_water.x, v.z - in_water.z)) > 0.9f * moving.radius) continue;
+      speed += glm::length(p.flow);
+      ++*count;
+    }
+    return *count == 0 ? 0.0 : speed / static_cast<double>(*count);
+  };
+  size_t before_count = 0;
+  const double before = flow_at_destination(15, &before_count);  // t = 0.5 s: still on the bank
+  size_t after_count = 0;
+  const double after = flow_at_destination(135, &after_count);   // t = 4.5 s: in the river
+  ASSERT_GT(before_count, 0u) << "the camera sees the water there";
+  EXPECT_GT(before, 0.3) << "open water flows";
+  ASSERT_GT(after_count, 0u);
+  EXPECT_EQ(after, 0.0) << "inside the obstacle the water is dry: velocity 0";
 }
 
 TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
