@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 namespace siviflow {
 
@@ -27,6 +28,12 @@ inline constexpr float kMovingCoverFactor = 1.1f;
 // from every particle, tried in this many steps.
 inline constexpr float kGapDeepening = 0.9f;
 inline constexpr int kGapDeepeningSteps = 9;
+
+// The camera counts as still while its matrix stays within this relative rounding (8 float
+// epsilons of each column's largest entry) of the one its epoch began with: the same camera
+// recomputed by another code path (constant folding, FMA, libm) differs by a few ulps, which
+// moves no particle more than the re-projection's own rounding does.
+inline constexpr float kStillCameraEpsilon = 8.0f * std::numeric_limits<float>::epsilon();
 
 // --- Screen margins, as multiples of the minimum distance ----------------------------------
 // New particles are made up to this far outside the viewport, so a pan brings in particles

@@ -73,6 +73,20 @@ bool project(const glm::mat4& vp, const glm::vec2& size, const glm::vec3& w, glm
   return std::isfinite(s->x) && std::isfinite(s->y);
 }
 
+// Whether `a` is `b` up to float rounding: every entry within kStillCameraEpsilon of its column's
+// largest (a column scales one world coordinate, so rounding is relative to it, not to the entry).
+bool same_camera(const glm::mat4& a, const glm::mat4& b) {
+  for (int c = 0; c < 4; ++c) {
+    float scale = 0.0f, diff = 0.0f;
+    for (int r = 0; r < 4; ++r) {
+      scale = std::max({scale, std::fabs(a[c][r]), std::fabs(b[c][r])});
+      diff = std::max(diff, std::fabs(a[c][r] - b[c][r]));
+    }
+    if (!(diff <= kStillCameraEpsilon * scale)) return false;
+  }
+  return true;
+}
+
 float dist2(const glm::vec2& a, const glm::vec2& b) {
   const glm::vec2 e = a - b;
   return e.x * e.x + e.y * e.y;
@@ -175,6 +189,18 @@ const char* to_string(ParticleState state) {
 
 namespace {
 
+// The smallest spacing whose slot bound (slots_for in check_inputs) fits kMaxParticleSlots on
+// viewport vp, up to rounding: with k = kSlotsPerLiveBound * 2 / sqrt(3) and the cull region
+// (w + c d) x (h + c d), solves k (w + c d)(h + c d) = n d^2 for d, n leaving room for the ceils.
+float min_spacing_for_slots(glm::uvec2 vp) {
+  const double k = kSlotsPerLiveBound * 2.0 / std::sqrt(3.0);
+  const double c = 2.0 * kCullMarginFactor + 1.0;
+  const double w = vp.x, h = vp.y, n = kMaxParticleSlots - 2.0 * kSlotsPerLiveBound;
+  const double qa = n - k * c * c, qb = -k * c * (w + h), qc = -k * w * h;  // qa d^2 + qb d + qc
+  if (!(qa > 0.0)) return std::numeric_limits<float>::infinity();
+  return static_cast<float>((-qb + std::sqrt(qb * qb - 4.0 * qa * qc)) / (2.0 * qa));
+}
+
 // Everything create() can refuse before building anything; the spacing and slot count.
 Status check_inputs(const RiverFlowField& river, const ParticleParams& params, float* min_distance,
                     uint32_t* slot_count) {
@@ -216,9 +242,23 @@ Status check_inputs(const RiverFlowField& river, const ParticleParams& params, f
   if (!std::isfinite(params.min_distance_px) || params.min_distance_px < 0.0f) {
     return Status::error("particles: min_distance_px must be finite and >= 0 (0: default)");
   }
-  const float d = params.min_distance_px > 0.0f
-                      ? params.min_distance_px
-                      : kDefaultMinDistancePx * static_cast<float>(vp.y) / kDefaultMinDistanceHeight;
+  // Slots for spacing d: kSlotsPerLiveBound x the densest packing of discs of diameter d centred
+  // in the culled region (live particles are pairwise >= d apart, so there are never more).
+  const auto slots_for = [vp](double d) {
+    const double cull_margin = kCullMarginFactor * d;
+    const double a = static_cast<double>(vp.x) + 2.0 * cull_margin + d;
+    const double b = static_cast<double>(vp.y) + 2.0 * cull_margin + d;
+    const double live_bound = std::ceil(a * b * (2.0 / std::sqrt(3.0)) / (d * d));
+    return std::ceil(live_bound * kSlotsPerLiveBound);
+  };
+  float d = params.min_distance_px;
+  if (d == 0.0f) {
+    // Automatic: scaled with the height, but at least 1 px and sparse enough for 16-bit ids, so
+    // tiny and very wide outputs work (an explicit spacing is refused instead).
+    d = std::max(1.0f, kDefaultMinDistancePx * static_cast<float>(vp.y) / kDefaultMinDistanceHeight);
+    d = std::max(d, min_spacing_for_slots(vp));
+    while (slots_for(d) > kMaxParticleSlots) d *= 1.0001f;  // the closed form's rounding
+  }
   if (d < 1.0f) return Status::error("particles: min_distance_px below 1 pixel");
   if (!(params.fill_spacing >= 1.0f && params.fill_spacing <= 2.0f)) {
     return Status::error("particles: fill_spacing must be in [1, 2]");
@@ -234,14 +274,8 @@ Status check_inputs(const RiverFlowField& river, const ParticleParams& params, f
     return Status::error("particles: advection_scale must be finite");
   }
 
-  const float cull_margin = kCullMarginFactor * d;
-  // Densest packing of discs of diameter d centred in the culled region: live particles are
-  // pairwise >= d apart, so there can never be more of them.
-  const double a = static_cast<double>(vp.x) + 2.0 * cull_margin + d;
-  const double b = static_cast<double>(vp.y) + 2.0 * cull_margin + d;
-  const double live_bound = std::ceil(a * b * (2.0 / std::sqrt(3.0)) / (double(d) * d));
-  const double slots = std::ceil(live_bound * kSlotsPerLiveBound);
-  if (slots > kMaxParticleSlots) {
+  const double slots = slots_for(d);
+  if (!(slots <= kMaxParticleSlots)) {
     return Status::error("particles: min_distance_px " + std::to_string(d) + " is too small for a " +
                          std::to_string(vp.x) + "x" + std::to_string(vp.y) + " viewport (needs " +
                          std::to_string(static_cast<uint64_t>(slots)) + " particle slots, at most " +
@@ -331,7 +365,7 @@ void ParticleField::clear_state() {
   next_id_ = 1;
   next_frame_ = 0;
   camera_epoch_ = 0;
-  last_view_proj_ = glm::mat4(0.0f);
+  epoch_view_proj_ = glm::mat4(0.0f);
   stats_ = {};
 }
 
@@ -788,9 +822,14 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
 
   stats_ = {};
   // Advection moves the particles on screen just as a camera move does.
-  f.camera_changed = next_frame_ == 0 || f.vp != last_view_proj_ ||
+  // Compared with the camera the epoch began with, not last frame's, so a drift within the
+  // tolerance cannot add up; exact equality would call a recomputed matrix's rounding a move.
+  f.camera_changed = next_frame_ == 0 || !same_camera(f.vp, epoch_view_proj_) ||
                      (params_.advect && dt_seconds > 0.0f);
-  if (f.camera_changed) ++camera_epoch_;
+  if (f.camera_changed) {
+    ++camera_epoch_;
+    epoch_view_proj_ = f.vp;
+  }
 
   advance_fades(dt_seconds);
   if (params_.advect && dt_seconds > 0.0f) advect(dt_seconds);
@@ -820,7 +859,6 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
       stats_.fading_out++;
     }
   }
-  last_view_proj_ = f.vp;
   ++next_frame_;
   return Status::success();
 }

@@ -15,7 +15,8 @@
 //      left, each filler pushed to the point of its gap farthest from every particle. With the
 //      camera still (and on a cut) the fill closes every gap wider than the minimum distance;
 //      while it moves, only those wider than kMovingCoverFactor x it, so the fillers have room
-//      to survive the motion instead of being thinned again the next frame (churn);
+//      to survive the motion instead of being thinned again the next frame (churn). "Still":
+//      the matrix equals the one the camera last settled on up to rounding (kStillCameraEpsilon);
 //   6. conversion: a new particle's pixel ray is cast into the river (BVH); a miss makes none.
 // Fill method: Dunbar & Humphreys boundary sampling, not Bridson's dart throwing. It only works
 // at the boundary of the covered region (cost scales with the gap, not the screen), it yields
@@ -77,7 +78,8 @@ struct ParticleParams {
   uint64_t seed = 0;
   glm::uvec2 viewport{1280u, 720u};
   // Minimum screen distance between live particles; 0: kDefaultMinDistancePx scaled from 720
-  // lines to the viewport height.
+  // lines to the viewport height, raised to at least 1 px and to what fits kMaxParticleSlots
+  // (tiny or very wide outputs). An explicit value below 1 px or needing more slots is refused.
   float min_distance_px = 0.0f;
   // New particles are placed this multiple of min_distance_px apart where there is room (>= 1);
   // the gaps left are then filled at the minimum distance, so the cover stays within it.
@@ -239,8 +241,8 @@ class ParticleField {
 
   uint32_t next_id_ = 1;
   uint64_t next_frame_ = 0;
-  uint32_t camera_epoch_ = 0;  // bumps whenever the camera changes
-  glm::mat4 last_view_proj_{0.0f};
+  uint32_t camera_epoch_ = 0;  // bumps whenever the camera changes (moves beyond float noise)
+  glm::mat4 epoch_view_proj_{0.0f};  // the camera the current epoch began with
   ParticleStats stats_;
 };
 

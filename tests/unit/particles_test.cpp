@@ -313,6 +313,47 @@ TEST(Particles, CoverLoosensWhileMovingAndIsExactOnceStill) {
   expect_min_distance(field);
 }
 
+// The same camera recomputed by another code path (constant folding, FMA, libm) differs by a few
+// ulps; that must count as still, or the still frame keeps the moving cover's gaps.
+TEST(Particles, StillCameraRecomputedWithRoundingGetsTheExactCover) {
+  const float width = 60.0f, length = 400.0f;
+  const GridRiver r = test::straight_channel(width, length, 31, 201);
+  ParticleField field = make_field(r, small_params());
+  const auto cam_at = [](int f) {
+    return test::look_at({5.0f + 0.1f * f, 12.0f, -8.0f + 0.25f * f}, {0.2f * f, 0.0f, 40.0f + 0.3f * f},
+                         kSmall);
+  };
+  int f = 0;
+  for (; f < 30; ++f) ASSERT_TRUE(field.update(cam_at(f), f, kDt).ok());
+  const ScreenCamera still = cam_at(f - 1);
+  // Two ulps on most entries, in either direction, alternating frame by frame.
+  const auto nudged = [&still](int dir) {
+    ScreenCamera c = still;
+    for (int i = 0; i < 16; ++i) {
+      float& e = c.view_proj[i / 4][i % 4];
+      const float to = (i % 3 == 0 ? -dir : dir) * std::numeric_limits<float>::max();
+      if (e != 0.0f && i % 5 != 4) e = std::nextafter(std::nextafter(e, to), to);
+    }
+    return c;
+  };
+  ASSERT_TRUE(field.update(nudged(1), f++, kDt).ok());
+  EXPECT_LE(worst_gap(field, still, width, length), field.cover_radius_px() * 1.0005f);
+  expect_min_distance(field);
+  // Rounding noise from then on is no motion: no circle is recomputed, nothing born or thinned.
+  const std::vector<Particle> settled(field.particles().begin(), field.particles().end());
+  for (int k = 0; k < 4; ++k, ++f) {
+    ASSERT_TRUE(field.update(k % 2 ? still : nudged(k % 4 == 0 ? -1 : 1), f, kDt).ok());
+    EXPECT_EQ(field.stats().born, 0u);
+    EXPECT_EQ(field.stats().thinned, 0u);
+    EXPECT_LE(field.stats().arc_checks, settled.size() / 20);  // dry-sector rechecks only
+  }
+  ASSERT_EQ(field.particles().size(), settled.size());
+  for (size_t i = 0; i < settled.size(); ++i) EXPECT_EQ(field.particles()[i].id, settled[i].id);
+  // A real move, however slow, is still seen once it outgrows the rounding.
+  ASSERT_TRUE(field.update(cam_at(f - 1), f, kDt).ok());
+  EXPECT_GT(field.stats().arc_checks, 0u);
+}
+
 // Screen-space distance from particles to the screen edge, for "interior" checks.
 bool interior(const glm::vec2& s, glm::uvec2 vp, float margin) {
   return s.x >= margin && s.y >= margin && s.x <= vp.x - margin && s.y <= vp.y - margin;
@@ -574,6 +615,61 @@ TEST(Particles, AllWaterViewStaysBounded) {
   }
   // And the screen is covered: at least the count of a loose packing of the viewport.
   EXPECT_GT(field.stats().live, 0.5 * kSmall.x * kSmall.y / (4.0 * d * d));
+}
+
+// Automatic spacing on tiny, odd and very wide outputs: at least 1 px and within the 16-bit ids.
+TEST(Particles, AutomaticSpacingFitsTinyAndVeryWideOutputs) {
+  const GridRiver r = test::plane(200.0f, 41);
+  const glm::uvec2 sizes[] = {{64u, 16u}, {16u, 16u}, {1u, 1u}, {8192u, 200u}};
+  for (const glm::uvec2 vp : sizes) {
+    SCOPED_TRACE(std::to_string(vp.x) + "x" + std::to_string(vp.y));
+    ParticleParams params;
+    params.seed = 3;
+    params.viewport = vp;
+    ParticleField field;
+    const Status s = ParticleField::create(r.field(), params, &field);
+    ASSERT_TRUE(s.ok()) << s.message();
+    EXPECT_GE(field.min_distance_px(), 1.0f);
+    EXPECT_LE(field.slot_count(), kMaxParticleSlots);
+    for (uint64_t f = 0; f < 4; ++f) {
+      ASSERT_TRUE(field.update(test::top_down(0.5f * f, 0.0f, 40.0f, vp), f, kDt).ok());
+      std::set<uint16_t> slots;
+      uint32_t last_id = 0;
+      for (const Particle& p : field.particles()) {
+        EXPECT_GT(p.id, last_id);  // unique, in id order
+        last_id = p.id;
+        EXPECT_GE(p.slot, 1u);
+        EXPECT_LE(p.slot, field.slot_count());
+        EXPECT_TRUE(slots.insert(p.slot).second) << "slot " << p.slot << " used twice";
+      }
+    }
+    expect_min_distance(field);
+    EXPECT_GT(field.stats().live, 0u);  // the plane fills every one of these views
+    FlowTextures textures;
+    ASSERT_TRUE(FlowTextures::create(field, kDefaultFlowTexelPx, &textures).ok());
+    std::vector<std::byte> staging(textures.layout().total_bytes);
+    const Status packed = textures.pack(field, staging);
+    EXPECT_TRUE(packed.ok()) << packed.message();
+  }
+  // The default scale is unchanged where it fits.
+  ParticleField hd;
+  ASSERT_TRUE(ParticleField::create(r.field(), ParticleParams{}, &hd).ok());
+  EXPECT_EQ(hd.min_distance_px(), kDefaultMinDistancePx * 720.0f / kDefaultMinDistanceHeight);
+  // The wide output needs a wider spacing than the height alone gives.
+  ParticleParams wide;
+  wide.viewport = {8192u, 200u};
+  ParticleField w;
+  ASSERT_TRUE(ParticleField::create(r.field(), wide, &w).ok());
+  EXPECT_GT(w.min_distance_px(), kDefaultMinDistancePx * 200.0f / kDefaultMinDistanceHeight);
+  // An explicit spacing that cannot work is still refused, with the reason.
+  ParticleParams explicit_small;
+  explicit_small.viewport = {64u, 16u};
+  explicit_small.min_distance_px = 0.5f;
+  const Status sub_pixel = ParticleField::create(r.field(), explicit_small, &w);
+  EXPECT_NE(sub_pixel.message().find("below 1 pixel"), std::string::npos) << sub_pixel.message();
+  wide.min_distance_px = 2.0f;
+  const Status too_many = ParticleField::create(r.field(), wide, &w);
+  EXPECT_NE(too_many.message().find("65535"), std::string::npos) << too_many.message();
 }
 
 TEST(Particles, SeedsWaterNotConnectedOnScreen) {
