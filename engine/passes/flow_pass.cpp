@@ -9,59 +9,20 @@
 namespace siviflow {
 namespace {
 
-constexpr uint32_t kBindingFlow = 0;
-constexpr uint32_t kBindingAux = 1;
-constexpr uint32_t kBindingReflection = 2;
-constexpr uint32_t kBindingNormalMap = 3;
+// Bindings 0..3 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
+// normal map.
 constexpr uint32_t kBindingCount = 4;
-
-Status check(VkResult result, const char* call) {
-  if (result == VK_SUCCESS) return Status::success();
-  return Status::error(std::string("flow pass: ") + call + " failed: " + result_name(result), result);
-}
-
-Status make_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMode address,
-                    bool mipmapped, VkSampler* out) {
-  VkSamplerCreateInfo info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-  info.magFilter = filter;
-  info.minFilter = filter;
-  info.mipmapMode = mipmapped ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
-  info.addressModeU = address;
-  info.addressModeV = address;
-  info.addressModeW = address;
-  info.maxLod = mipmapped ? VK_LOD_CLAMP_NONE : 0.0f;
-  return check(gpu.table->vkCreateSampler(gpu.table->device, &info, gpu.allocation_callbacks, out),
-               "vkCreateSampler");
-}
 
 }  // namespace
 
 Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
                         VkFormat depth_format, bool with_aovs) {
-  const DeviceTable& vk = *gpu.table;
   with_aovs_ = with_aovs;
-  std::array<VkDescriptorSetLayoutBinding, kBindingCount> bindings{};
-  for (uint32_t i = 0; i < kBindingCount; ++i) {
-    bindings[i] = {i, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
-  }
-  VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  set_info.bindingCount = kBindingCount;
-  set_info.pBindings = bindings.data();
-  SIVIFLOW_TRY(check(vk.vkCreateDescriptorSetLayout(vk.device, &set_info, gpu.allocation_callbacks,
-                                                     &set_layout_),
-                     "vkCreateDescriptorSetLayout"));
-  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                            sizeof(gpu::FlowConstants)};
-  VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  layout_info.setLayoutCount = 1;
-  layout_info.pSetLayouts = &set_layout_;
-  layout_info.pushConstantRangeCount = 1;
-  layout_info.pPushConstantRanges = &range;
-  SIVIFLOW_TRY(check(vk.vkCreatePipelineLayout(vk.device, &layout_info, gpu.allocation_callbacks, &layout_),
-                     "vkCreatePipelineLayout"));
-  SIVIFLOW_TRY(make_sampler(gpu, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &nearest_));
-  SIVIFLOW_TRY(make_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &linear_clamp_));
-  SIVIFLOW_TRY(make_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, true, &linear_repeat_));
+  SIVIFLOW_TRY(create_pass_layout(gpu, kBindingCount, sizeof(gpu::FlowConstants), &set_layout_, &layout_));
+  // Flow and aux are integer or exact data read with texelFetch: nearest, never filtered.
+  SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &nearest_));
+  SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &linear_clamp_));
+  SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, true, &linear_repeat_));
 
   GraphicsPipelineDesc desc;
   desc.vertex_shader = "flow.vert";
@@ -98,18 +59,7 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   const DeviceTable& vk = *gpu.table;
   if (pool_ != VK_NULL_HANDLE) retire(pool_);
   pool_ = VK_NULL_HANDLE;
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kBindingCount};
-  VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = 1;
-  pool_info.poolSizeCount = 1;
-  pool_info.pPoolSizes = &size;
-  SIVIFLOW_TRY(check(vk.vkCreateDescriptorPool(vk.device, &pool_info, gpu.allocation_callbacks, &pool_),
-                     "vkCreateDescriptorPool"));
-  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  alloc.descriptorPool = pool_;
-  alloc.descriptorSetCount = 1;
-  alloc.pSetLayouts = &set_layout_;
-  SIVIFLOW_TRY(check(vk.vkAllocateDescriptorSets(vk.device, &alloc, &set_), "vkAllocateDescriptorSets"));
+  SIVIFLOW_TRY(allocate_sampler_set(gpu, set_layout_, kBindingCount, &pool_, &set_));
   const VkImageLayout read = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   const std::array<VkDescriptorImageInfo, kBindingCount> images{{
       {nearest_, textures.flow, read},
@@ -150,12 +100,7 @@ void FlowPass::declare(FrameGraph& graph, const gpu::FlowConstants* constants, u
   pass.record([this, h, constants, index_count](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
     const VkCommandBuffer cmd = ctx.cmd();
-    const VkExtent2D extent = ctx.extent(h.color);
-    const VkViewport viewport{0.0f, 0.0f, static_cast<float>(extent.width),
-                              static_cast<float>(extent.height), 0.0f, 1.0f};
-    const VkRect2D scissor{{0, 0}, extent};
-    vk.vkCmdSetViewport(cmd, 0, 1, &viewport);
-    vk.vkCmdSetScissor(cmd, 0, 1, &scissor);
+    set_viewport(vk, cmd, ctx.extent(h.color));
     vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &set_, 0, nullptr);
     vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                           0, sizeof(gpu::FlowConstants), constants);

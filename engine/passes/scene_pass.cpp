@@ -6,63 +6,13 @@
 #include "vk/pipeline.h"
 
 namespace siviflow {
-namespace {
-
-Status check(VkResult result, const char* call) {
-  if (result == VK_SUCCESS) return Status::success();
-  return Status::error(std::string("scene pass: ") + call + " failed: " + result_name(result), result);
-}
-
-}  // namespace
 
 Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
                          VkFormat depth_format) {
-  const DeviceTable& vk = *gpu.table;
-  const VkAllocationCallbacks* callbacks = gpu.allocation_callbacks;
-
-  VkDescriptorSetLayoutBinding binding{};
-  binding.binding = 0;
-  binding.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  binding.descriptorCount = 1;
-  binding.stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT;
-  VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  set_info.bindingCount = 1;
-  set_info.pBindings = &binding;
-  SIVIFLOW_TRY(check(vk.vkCreateDescriptorSetLayout(vk.device, &set_info, callbacks, &set_layout_),
-                     "vkCreateDescriptorSetLayout"));
-
-  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                            sizeof(gpu::SceneConstants)};
-  VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  layout_info.setLayoutCount = 1;
-  layout_info.pSetLayouts = &set_layout_;
-  layout_info.pushConstantRangeCount = 1;
-  layout_info.pPushConstantRanges = &range;
-  SIVIFLOW_TRY(check(vk.vkCreatePipelineLayout(vk.device, &layout_info, callbacks, &layout_),
-                     "vkCreatePipelineLayout"));
-
-  VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
-  VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = 1;
-  pool_info.poolSizeCount = 1;
-  pool_info.pPoolSizes = &pool_size;
-  SIVIFLOW_TRY(check(vk.vkCreateDescriptorPool(vk.device, &pool_info, callbacks, &pool_),
-                     "vkCreateDescriptorPool"));
-  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  alloc.descriptorPool = pool_;
-  alloc.descriptorSetCount = 1;
-  alloc.pSetLayouts = &set_layout_;
-  SIVIFLOW_TRY(check(vk.vkAllocateDescriptorSets(vk.device, &alloc, &set_), "vkAllocateDescriptorSets"));
-
-  VkSamplerCreateInfo sampler_info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-  sampler_info.magFilter = VK_FILTER_LINEAR;
-  sampler_info.minFilter = VK_FILTER_LINEAR;
-  sampler_info.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
-  sampler_info.addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT;
-  sampler_info.addressModeV = VK_SAMPLER_ADDRESS_MODE_REPEAT;
-  sampler_info.addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT;
-  sampler_info.maxLod = 0.0f;
-  SIVIFLOW_TRY(check(vk.vkCreateSampler(vk.device, &sampler_info, callbacks, &sampler_), "vkCreateSampler"));
+  SIVIFLOW_TRY(create_pass_layout(gpu, 1, sizeof(gpu::SceneConstants), &set_layout_, &layout_));
+  SIVIFLOW_TRY(allocate_sampler_set(gpu, set_layout_, 1, &pool_, &set_));
+  // The detail texture has one level: linear filtering, repeated over the terrain.
+  SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, false, &sampler_));
 
   GraphicsPipelineDesc sky;
   sky.vertex_shader = "sky.vert";
@@ -124,13 +74,8 @@ void ScenePass::declare(FrameGraph& graph, const char* pass_name,
   pass.record([this, h, draws](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
     const VkCommandBuffer cmd = ctx.cmd();
-    const VkExtent2D extent = ctx.extent(h.color);
-    const VkViewport viewport{0.0f, 0.0f, static_cast<float>(extent.width),
-                              static_cast<float>(extent.height), 0.0f, 1.0f};
-    const VkRect2D scissor{{0, 0}, extent};
     constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-    vk.vkCmdSetViewport(cmd, 0, 1, &viewport);
-    vk.vkCmdSetScissor(cmd, 0, 1, &scissor);
+    set_viewport(vk, cmd, ctx.extent(h.color));
     vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &set_, 0, nullptr);
     // Terrain and objects first, so the sky's fragments are depth-tested away behind them.
     vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, scene_pipeline_);

@@ -141,4 +141,71 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
   return status;
 }
 
+Status vk_status(VkResult result, const char* call) {
+  if (result == VK_SUCCESS) return Status::success();
+  return Status::error(std::string(call) + " failed: " + result_name(result), result);
+}
+
+Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_t push_constant_bytes,
+                          VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout) {
+  const DeviceTable& vk = *gpu.table;
+  std::vector<VkDescriptorSetLayoutBinding> bindings(sampler_count);
+  for (uint32_t i = 0; i < sampler_count; ++i) {
+    bindings[i] = {i, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+  }
+  VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  set_info.bindingCount = sampler_count;
+  set_info.pBindings = bindings.data();
+  SIVIFLOW_TRY(vk_status(vk.vkCreateDescriptorSetLayout(vk.device, &set_info, gpu.allocation_callbacks, set_layout),
+                         "vkCreateDescriptorSetLayout"));
+  const VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                  push_constant_bytes};
+  VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  layout_info.setLayoutCount = 1;
+  layout_info.pSetLayouts = set_layout;
+  layout_info.pushConstantRangeCount = 1;
+  layout_info.pPushConstantRanges = &range;
+  return vk_status(vk.vkCreatePipelineLayout(vk.device, &layout_info, gpu.allocation_callbacks, layout),
+                   "vkCreatePipelineLayout");
+}
+
+Status allocate_sampler_set(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
+                            uint32_t sampler_count, VkDescriptorPool* pool, VkDescriptorSet* set) {
+  const DeviceTable& vk = *gpu.table;
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, sampler_count};
+  VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 1;
+  pool_info.pPoolSizes = &size;
+  SIVIFLOW_TRY(vk_status(vk.vkCreateDescriptorPool(vk.device, &pool_info, gpu.allocation_callbacks, pool),
+                         "vkCreateDescriptorPool"));
+  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc.descriptorPool = *pool;
+  alloc.descriptorSetCount = 1;
+  alloc.pSetLayouts = &set_layout;
+  return vk_status(vk.vkAllocateDescriptorSets(vk.device, &alloc, set), "vkAllocateDescriptorSets");
+}
+
+Status create_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMode address,
+                      bool mipmapped, VkSampler* out) {
+  VkSamplerCreateInfo info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  info.magFilter = filter;
+  info.minFilter = filter;
+  info.mipmapMode = mipmapped ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  info.addressModeU = address;
+  info.addressModeV = address;
+  info.addressModeW = address;
+  info.maxLod = mipmapped ? VK_LOD_CLAMP_NONE : 0.0f;
+  return vk_status(gpu.table->vkCreateSampler(gpu.table->device, &info, gpu.allocation_callbacks, out),
+                   "vkCreateSampler");
+}
+
+void set_viewport(const DeviceTable& vk, VkCommandBuffer cmd, VkExtent2D extent) {
+  const VkViewport viewport{0.0f, 0.0f, static_cast<float>(extent.width),
+                            static_cast<float>(extent.height), 0.0f, 1.0f};
+  const VkRect2D scissor{{0, 0}, extent};
+  vk.vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vk.vkCmdSetScissor(cmd, 0, 1, &scissor);
+}
+
 }  // namespace siviflow

@@ -1,4 +1,5 @@
-// Graphics pipelines for dynamic rendering, built from the SPIR-V embedded at build time.
+// Graphics pipelines for dynamic rendering, built from the SPIR-V embedded at build time, and the
+// small objects every pass creates with them: layouts, samplers, descriptor sets.
 #pragma once
 
 #include <cstdint>
@@ -31,5 +32,23 @@ struct GraphicsPipelineDesc {
 
 Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
                                 const GraphicsPipelineDesc& desc, VkPipeline* out);
+
+// The result of a Vulkan call as a Status naming the call: "vkCreateSampler failed: ...".
+Status vk_status(VkResult result, const char* call);
+
+// A set layout of `sampler_count` combined image samplers (bindings 0..n-1, fragment stage) and
+// a pipeline layout with that set and one push-constant range for the vertex and fragment stages.
+Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_t push_constant_bytes,
+                          VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout);
+
+// One set of that layout from a pool of its own (destroy the pool to free it).
+Status allocate_sampler_set(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
+                            uint32_t sampler_count, VkDescriptorPool* pool, VkDescriptorSet* set);
+
+Status create_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMode address,
+                      bool mipmapped, VkSampler* out);
+
+// Viewport and scissor covering `extent` (the passes' pipelines keep both dynamic).
+void set_viewport(const DeviceTable& vk, VkCommandBuffer cmd, VkExtent2D extent);
 
 }  // namespace siviflow
