@@ -18,6 +18,7 @@
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
 #include "vk/gpu_resources.h"
+#include "vk/pipeline.h"
 
 namespace siviflow {
 namespace {
@@ -33,7 +34,8 @@ constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
 constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kNormalMapFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr VkFormat kDetailFormat = VK_FORMAT_R8G8B8A8_UNORM;
-constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the output
+constexpr float kDefaultReflectionScale = 0.5f;
+constexpr uint32_t kMaxTimedPasses = 16;  // reflection target size relative to the output
 
 // Tunables of the water's look, in one place.
 constexpr float kReflectionDistortion = 0.04f;    // screen uv offset per unit of normal tilt
@@ -152,6 +154,12 @@ struct Renderer::Impl {
   gpu::SceneConstants moving_reflection_constants{};
   gpu::FlowConstants flow_constants{};
 
+  // With CreateInfo::enable_timing: per slot, two timestamps around each pass of the graph.
+  std::vector<VkQueryPool> query_pools;
+  std::vector<uint32_t> timed_passes;  // per slot: passes recorded with timestamps
+  uint32_t current_slot = 0;
+  float timestamp_period_ns = 1.0f;
+
   bool static_data_uploaded = false;
   bool frame_begun = false;
   bool frame_updated = false;
@@ -166,6 +174,7 @@ struct Renderer::Impl {
   Status stage_static_data();
   Status simulate(const Camera& camera, double time_seconds);
   Status record_static_upload(VkCommandBuffer cmd);
+  Status create_query_pools();
   void retire_frame_images();
   void destroy();
 };
@@ -309,7 +318,7 @@ Status Renderer::Impl::declare_static_graph() {
   }
   SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
   SIVIFLOW_TRY(flow_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat,
-                                info.enable_readback));
+                                info.enable_readback, info.enable_timing));
   scene_pass.set_detail_texture(gpu, static_images[kDetail].image.view);
   return Status::success();
 }
@@ -390,6 +399,10 @@ Status Renderer::Impl::declare_graph() {
         graph.create_image({"reflection sample", FlowPass::kReflectionFormat, extent, transparent}));
   }
   flow_pass.declare(graph, &flow_constants, river_index_count, &water);
+  if (info.enable_timing) {
+    const ImageHandle floor = frame_image(graph.create_image({"flow floor", FlowPass::kFloorFormat, extent, {}}));
+    flow_pass.declare_floor(graph, &flow_constants, river_index_count, water, floor);
+  }
 
   if (info.enable_readback) {
     const ImageHandle images[kReadbackImageCount] = {
@@ -502,7 +515,24 @@ void Renderer::Impl::destroy() {
   for (StaticImage& i : static_images) destroy_image(gpu, &i.image);
   for (StaticBuffer& b : static_buffers) destroy_buffer(gpu, &b.buffer);
   destroy_buffer(gpu, &static_staging_buffer);
+  for (VkQueryPool pool : query_pools) table.vkDestroyQueryPool(table.device, pool, gpu.allocation_callbacks);
   ring.destroy();
+}
+
+Status Renderer::Impl::create_query_pools() {
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  table.vkGetPhysicalDeviceProperties2(info.physical_device, &props);
+  timestamp_period_ns = props.properties.limits.timestampPeriod;
+  VkQueryPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  pool_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  pool_info.queryCount = 2 * kMaxTimedPasses;
+  query_pools.assign(info.frames_in_flight, VK_NULL_HANDLE);
+  timed_passes.assign(info.frames_in_flight, 0);
+  for (VkQueryPool& pool : query_pools) {
+    SIVIFLOW_TRY(vk_status(table.vkCreateQueryPool(table.device, &pool_info, gpu.allocation_callbacks, &pool),
+                           "vkCreateQueryPool"));
+  }
+  return Status::success();
 }
 
 Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) {
@@ -511,6 +541,7 @@ Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) 
   if (status.ok()) status = impl->create_static_resources();
   if (status.ok()) status = impl->declare_static_graph();
   if (status.ok()) status = impl->declare_graph();
+  if (status.ok() && info.enable_timing) status = impl->create_query_pools();
   if (!status.ok()) {
     if (info.log != nullptr) info.log(LogLevel::kError, status.message().c_str(), info.log_user);
     impl->destroy();
@@ -526,6 +557,7 @@ Renderer::~Renderer() { impl_->destroy(); }
 Status Renderer::begin_frame(uint32_t slot) {
   Impl& r = *impl_;
   SIVIFLOW_TRY(r.ring.begin_slot(slot));
+  r.current_slot = slot;
   r.frame_begun = true;
   r.frame_updated = false;
   return Status::success();
@@ -641,7 +673,15 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
                             inputs.output.final.layout});
   b.bind_buffer(r.frame_staging, r.ring.staging_buffer());
   for (uint32_t i = 0; i < r.readbacks.size(); ++i) b.bind_buffer(r.readbacks[i].buffer, inputs.readback.buffers[i]);
-  const Status status = r.graph.execute(r.table, cmd, b);
+  FrameGraph::Timestamps timestamps;
+  if (!r.query_pools.empty()) {
+    const uint32_t passes = static_cast<uint32_t>(r.graph.pass_order().size());
+    if (passes > kMaxTimedPasses) return Status::error("Renderer::record: too many passes to time");
+    timestamps.pool = r.query_pools[r.current_slot];
+    r.table.vkCmdResetQueryPool(cmd, timestamps.pool, 0, 2 * passes);
+    r.timed_passes[r.current_slot] = passes;
+  }
+  const Status status = r.graph.execute(r.table, cmd, b, r.query_pools.empty() ? nullptr : &timestamps);
   if (!status.ok()) {
     if (r.info.log != nullptr) r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
     return status;
@@ -722,6 +762,27 @@ const char* readback_image_name(ReadbackImage image) {
 const ParticleField& Renderer::particle_field() const { return impl_->simulation.particle_field(); }
 const FlowTextureLayout& Renderer::flow_texture_layout() const { return impl_->simulation.layout(); }
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
+
+Status Renderer::pass_times(uint32_t slot, std::vector<PassTime>* out) const {
+  const Impl& r = *impl_;
+  out->clear();
+  if (r.query_pools.empty()) return Status::error("Renderer::pass_times needs CreateInfo::enable_timing");
+  if (slot >= r.query_pools.size()) return Status::error("Renderer::pass_times: slot out of range");
+  const uint32_t passes = r.timed_passes[slot];
+  if (passes == 0) return Status::success();
+  std::vector<uint64_t> ticks(2 * passes);
+  SIVIFLOW_TRY(vk_status(r.table.vkGetQueryPoolResults(r.table.device, r.query_pools[slot], 0, 2 * passes,
+                                                       ticks.size() * sizeof(uint64_t), ticks.data(),
+                                                       sizeof(uint64_t), VK_QUERY_RESULT_64_BIT),
+                         "vkGetQueryPoolResults"));
+  const std::vector<std::string> names = r.graph.pass_order();
+  for (uint32_t i = 0; i < passes && i < names.size(); ++i) {
+    const double begin_ns = static_cast<double>(ticks[2 * i] - ticks[0]) * r.timestamp_period_ns;
+    const double ns = static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) * r.timestamp_period_ns;
+    out->push_back({names[i], begin_ns * 1e-6, ns * 1e-6});
+  }
+  return Status::success();
+}
 
 std::string Renderer::dump_frame_graph() const { return impl_->graph.dump_text(); }
 std::string Renderer::dump_frame_graph_graphviz() const { return impl_->graph.dump_graphviz(); }

@@ -1,9 +1,14 @@
 #version 460
-// Full-screen triangle; the fragment shader reconstructs the view ray per pixel.
-layout(location = 0) out vec2 out_ndc;
+#extension GL_GOOGLE_include_directive : require
+#include "shared.h"
+// Full-screen triangle on the far plane. The far-plane point of a pixel, before the divide by w,
+// is linear in screen position: unprojected here for the three vertices only and interpolated,
+// so the fragment shader needs no matrix inverse.
+layout(push_constant) uniform Push { SceneConstants scene; };
+layout(location = 0) out vec4 out_far_point;
 
 void main() {
   vec2 ndc = vec2(float((gl_VertexIndex << 1) & 2), float(gl_VertexIndex & 2)) * 2.0 - 1.0;
-  out_ndc = ndc;
+  out_far_point = inverse(scene.view_proj) * vec4(ndc, 1.0, 1.0);
   gl_Position = vec4(ndc, 1.0, 1.0);  // on the far plane: only where no terrain was drawn first
 }

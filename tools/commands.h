@@ -6,5 +6,6 @@ namespace siviflow {
 int run_info(int argc, char** argv);
 int run_capture(int argc, char** argv);
 int run_flow(int argc, char** argv);
+int run_bench(int argc, char** argv);
 
 }  // namespace siviflow

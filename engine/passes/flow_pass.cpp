@@ -16,7 +16,7 @@ constexpr uint32_t kBindingCount = 4;
 }  // namespace
 
 Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
-                        VkFormat depth_format, bool with_aovs) {
+                        VkFormat depth_format, bool with_aovs, bool with_floor) {
   with_aovs_ = with_aovs;
   SIVIFLOW_TRY(create_pass_layout(gpu, kBindingCount, sizeof(gpu::FlowConstants), &set_layout_, &layout_));
   // Flow and aux are integer or exact data read with texelFetch: nearest, never filtered.
@@ -38,13 +38,22 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
                    {1, sizeof(float), VK_VERTEX_INPUT_RATE_VERTEX}};
   desc.attributes = {{SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                      {SIVIFLOW_ATTR_WATER_DEPTH, 1, VK_FORMAT_R32_SFLOAT, 0}};
-  return create_graphics_pipeline(gpu, cache, desc, &pipeline_);
+  SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, desc, &pipeline_));
+  if (!with_floor) return Status::success();
+  // The same geometry and depth test as the water, so the floor shades exactly its pixels.
+  GraphicsPipelineDesc floor = desc;
+  floor.fragment_shader = "flow_floor.frag";
+  floor.color_format = kFloorFormat;
+  floor.extra_color_formats.clear();
+  floor.alpha_blend = false;
+  return create_graphics_pipeline(gpu, cache, floor, &floor_pipeline_);
 }
 
 void FlowPass::destroy(const GpuContext& gpu) {
   const DeviceTable& vk = *gpu.table;
   const VkAllocationCallbacks* callbacks = gpu.allocation_callbacks;
   if (pipeline_ != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline_, callbacks);
+  if (floor_pipeline_ != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, floor_pipeline_, callbacks);
   if (pool_ != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool_, callbacks);
   for (VkSampler sampler : {nearest_, linear_clamp_, linear_repeat_}) {
     if (sampler != VK_NULL_HANDLE) vk.vkDestroySampler(vk.device, sampler, callbacks);
@@ -98,20 +107,46 @@ void FlowPass::declare(FrameGraph& graph, const gpu::FlowConstants* constants, u
   pass.index_read(handles->indices);
   const Handles h = *handles;
   pass.record([this, h, constants, index_count](const PassContext& ctx) {
-    const DeviceTable& vk = ctx.table();
-    const VkCommandBuffer cmd = ctx.cmd();
-    set_viewport(vk, cmd, ctx.extent(h.color));
-    vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &set_, 0, nullptr);
-    vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
-                          0, sizeof(gpu::FlowConstants), constants);
-    vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
-    const VkBuffer streams[2] = {ctx.buffer(h.vertices), ctx.buffer(h.depths)};
-    const VkDeviceSize offsets[2] = {0, 0};
-    vk.vkCmdBindVertexBuffers(cmd, 0, 2, streams, offsets);
-    vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
-    vk.vkCmdDrawIndexed(cmd, index_count, 1, 0, 0, 0);
+    draw_river(ctx, pipeline_, h, ctx.extent(h.color), constants, index_count);
     return Status::success();
   });
+}
+
+void FlowPass::declare_floor(FrameGraph& graph, const gpu::FlowConstants* constants,
+                             uint32_t index_count, const Handles& inputs, ImageHandle target) {
+  PassBuilder pass = graph.add_pass("flow floor", PassKind::Graphics);
+  const ImageHandle written = pass.color_write(target, LoadOp::DontCare);
+  pass.depth_read(inputs.depth);
+  pass.sampled_fragment(inputs.flow);
+  pass.sampled_fragment(inputs.aux);
+  pass.sampled_fragment(inputs.reflection);
+  pass.sampled_fragment(inputs.normal_map);
+  pass.vertex_read(inputs.vertices);
+  pass.vertex_read(inputs.depths);
+  pass.index_read(inputs.indices);
+  pass.side_effect();
+  const Handles h = inputs;
+  pass.record([this, h, written, constants, index_count](const PassContext& ctx) {
+    draw_river(ctx, floor_pipeline_, h, ctx.extent(written), constants, index_count);
+    return Status::success();
+  });
+}
+
+void FlowPass::draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h,
+                          VkExtent2D extent, const gpu::FlowConstants* constants,
+                          uint32_t index_count) const {
+  const DeviceTable& vk = ctx.table();
+  const VkCommandBuffer cmd = ctx.cmd();
+  set_viewport(vk, cmd, extent);
+  vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &set_, 0, nullptr);
+  vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                        sizeof(gpu::FlowConstants), constants);
+  vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+  const VkBuffer streams[2] = {ctx.buffer(h.vertices), ctx.buffer(h.depths)};
+  const VkDeviceSize offsets[2] = {0, 0};
+  vk.vkCmdBindVertexBuffers(cmd, 0, 2, streams, offsets);
+  vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
+  vk.vkCmdDrawIndexed(cmd, index_count, 1, 0, 0, 0);
 }
 
 }  // namespace siviflow

@@ -99,8 +99,11 @@ class FlowPass {
   static constexpr VkFormat kNormalFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
   static constexpr VkFormat kReflectionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 
+  static constexpr VkFormat kFloorFormat = VK_FORMAT_R8_UNORM;
+
+  // with_floor: also the bench's floor pipeline (declare_floor).
   Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
-                VkFormat depth_format, bool with_aovs);
+                VkFormat depth_format, bool with_aovs, bool with_floor);
   void destroy(const GpuContext& gpu);
 
   struct Textures {
@@ -131,9 +134,18 @@ class FlowPass {
   };
   void declare(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
                Handles* handles);
+  // The floor of the flow pass for benchmarks: the same pixels (river mesh, depth test) making
+  // the same texture reads with next to no arithmetic, into `target` (kFloorFormat); kept
+  // although nothing reads it.
+  void declare_floor(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
+                     const Handles& inputs, ImageHandle target);
 
  private:
+  void draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h, VkExtent2D extent,
+                  const gpu::FlowConstants* constants, uint32_t index_count) const;
+
   bool with_aovs_ = false;
+  VkPipeline floor_pipeline_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;

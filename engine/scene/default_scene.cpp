@@ -9,8 +9,8 @@
 namespace siviflow {
 namespace {
 
-constexpr int kTerrainColumns = 180;   // quads across the valley
-constexpr int kTerrainRows = 240;      // quads along the valley
+constexpr int kTerrainColumns = 120;   // quads across the valley (1.5 m)
+constexpr int kTerrainRows = 160;      // quads along the valley (1.5 m)
 constexpr float kTerrainHalfWidth = 90.0f;
 constexpr glm::vec3 kInRiverRadii{1.3f, 1.3f, 1.2f};  // the boulder in mid-river
 constexpr glm::vec3 kMovingRadii{1.1f, 1.0f, 1.0f};   // the boulder that rolls into the river

@@ -59,7 +59,12 @@ namespace siviflow {
   X(vkCmdDrawIndexed)                  \
   X(vkCmdCopyBuffer)                   \
   X(vkCmdCopyBufferToImage)            \
-  X(vkCmdCopyImageToBuffer)
+  X(vkCmdCopyImageToBuffer)            \
+  X(vkCreateQueryPool)                 \
+  X(vkDestroyQueryPool)                \
+  X(vkCmdResetQueryPool)               \
+  X(vkCmdWriteTimestamp2)              \
+  X(vkGetQueryPoolResults)
 
 // VK_EXT_debug_utils labels: loaded only when the host says it enabled the extension (a loader
 // may hand out entry points of extensions that are not enabled, and calling them crashes).

@@ -683,7 +683,7 @@ void FrameGraph::emit_barriers(const DeviceTable& table, VkCommandBuffer cmd,
 }
 
 Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
-                           const FrameBindings& bindings) const {
+                           const FrameBindings& bindings, const Timestamps* timestamps) const {
   if (!compiled_) return Status::error("frame graph: execute() needs a successful compile()");
   if (cmd == VK_NULL_HANDLE || table.vkCmdPipelineBarrier2 == nullptr ||
       table.vkCmdBeginRendering == nullptr || table.vkCmdEndRendering == nullptr) {
@@ -729,6 +729,11 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
       table.vkCmdBeginDebugUtilsLabelEXT(cmd, &label);
     }
     emit_barriers(table, cmd, bindings, barriers->steps[s]);
+    // After the pass's barriers, so the time is the pass's own, not its wait for earlier ones.
+    if (timestamps != nullptr) {
+      table.vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps->pool,
+                                 timestamps->first_query + 2 * static_cast<uint32_t>(s));
+    }
     if (pass.kind == PassKind::Graphics) {
       auto attachment_info = [&](const Attachment& a) {
         VkRenderingAttachmentInfo info{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
@@ -755,6 +760,10 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
     const Status status =
         pass.record ? pass.record(PassContext(*this, bindings, table, cmd, step.pass)) : Status();
     if (pass.kind == PassKind::Graphics) table.vkCmdEndRendering(cmd);
+    if (timestamps != nullptr) {
+      table.vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps->pool,
+                                 timestamps->first_query + 2 * static_cast<uint32_t>(s) + 1);
+    }
     if (labels) table.vkCmdEndDebugUtilsLabelEXT(cmd);
     if (!status.ok()) {
       return Status::error("frame graph: pass '" + pass.name + "': " + status.message(),

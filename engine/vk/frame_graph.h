@@ -213,8 +213,14 @@ class FrameGraph {
   // Records every surviving pass into cmd, then the transitions to the outgoing states. Every
   // resource a surviving pass uses must be bound (attachments with a view); checked first.
   // Const for callers, but it keeps caches (barriers per override set, scratch arrays).
-  Status execute(const DeviceTable& table, VkCommandBuffer cmd,
-                 const FrameBindings& bindings) const;
+  // With `timestamps`, a timestamp is written before and after each surviving pass, at queries
+  // first_query + 2i and + 2i + 1 (pass i of pass_order()); the caller resets them beforehand.
+  struct Timestamps {
+    VkQueryPool pool = VK_NULL_HANDLE;
+    uint32_t first_query = 0;
+  };
+  Status execute(const DeviceTable& table, VkCommandBuffer cmd, const FrameBindings& bindings,
+                 const Timestamps* timestamps = nullptr) const;
 
   // Valid after compile(). Usage is the union over surviving passes.
   VkImageUsageFlags image_usage(ImageHandle image) const;

@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include "run_command.h"
 #include "siviflow/image_files.h"
 
@@ -202,6 +204,24 @@ TEST_F(CliTest, FlowAndParticleAovs) {
   }
   EXPECT_GT(water, ids.size() / 20);
   EXPECT_GE(covered * 100, water * 97) << covered << " of " << water << " water pixels have a particle";
+}
+
+TEST_F(CliTest, BenchReportsEveryPassAsJson) {
+  const RunResult r = run_siviflow("bench --size 96x54 --frames 3 --warmup 1 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json report = nlohmann::json::parse(r.output, nullptr, false);
+  ASSERT_FALSE(report.is_discarded()) << r.output;
+  EXPECT_GT(report.at("frame_ms").get<double>(), 0.0);
+  EXPECT_GT(report.at("floor_ms").get<double>(), 0.0);
+  for (const char* pass : {"upload", "reflection", "scene", "flow"}) {
+    ASSERT_TRUE(report.at("passes").contains(pass)) << pass << "\n" << r.output;
+    const nlohmann::json& stats = report["passes"][pass];
+    EXPECT_LE(stats.at("min_ms").get<double>(), stats.at("median_ms").get<double>()) << pass;
+    EXPECT_LE(stats.at("median_ms").get<double>(), stats.at("max_ms").get<double>()) << pass;
+  }
+  EXPECT_FALSE(report.at("passes").contains("flow floor")) << "the floor is reported apart";
+  EXPECT_GE(report.at("cpu").at("update_ms").get<double>(), 0.0);
+  expect_error(run_siviflow("bench --frames 0"), "--frames");
 }
 
 TEST_F(CliTest, RangeShardsEqualTheFullRun) {

@@ -46,6 +46,8 @@ struct CreateInfo {
   VkExtent2D extent = {0, 0};          // output size in pixels; required
   bool enable_readback = false;        // record copies of the frame's images into host buffers
   uint64_t seed = 0;                   // seed of the river particles' random choices
+  bool enable_timing = false;          // GPU timestamps around every pass (see pass_times()),
+                                       // and the flow pass's floor pass, for benchmarks
   VkDeviceSize staging_bytes_per_slot = 0;  // per-slot staging block; 0 means 8 MiB
   bool debug_utils = false;            // the host enabled VK_EXT_debug_utils: label passes, name objects
   VkPipelineCache pipeline_cache = VK_NULL_HANDLE;         // optional
@@ -120,6 +122,12 @@ struct FrameInputs {
 // "siviflow 0.1.0", as recorded in EXR metadata.
 const char* version_string();
 
+struct PassTime {
+  std::string name;     // the frame graph's pass name: "upload", "reflection", "scene", "flow", ...
+  double begin_ms;      // when the pass started, from the start of the frame's first pass
+  double milliseconds;  // GPU time between the timestamps around the pass
+};
+
 class Renderer {
  public:
   static Status create(const CreateInfo& info, std::unique_ptr<Renderer>* out);
@@ -146,6 +154,10 @@ class Renderer {
 
   // The camera of the scene's own camera path at that time (the default scene glides downstream).
   Camera scene_camera(double time_seconds) const;
+
+  // With CreateInfo::enable_timing: the GPU time of each pass of the frame last recorded in
+  // `slot`. Call only after the host waited for that slot's frame.
+  Status pass_times(uint32_t slot, std::vector<PassTime>* out) const;
 
   // The particles of the last simulated frame (particles() in id order, their parameters).
   const ParticleField& particle_field() const;

@@ -1,0 +1,184 @@
+// `siviflow bench`: GPU time per pass (timestamp queries) and CPU time per stage of the default
+// scene's frames, with the flow pass's floor measured in the same run.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "commands.h"
+#include "siviflow/headless_context.h"
+#include "siviflow/renderer.h"
+
+namespace siviflow {
+namespace {
+
+constexpr const char* kCommand = "bench";
+constexpr const char* kFloorPass = "flow floor";
+constexpr VkFormat kOutputFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+
+struct BenchOptions {
+  cli::Size size{1280, 720};
+  uint32_t frames = 60;
+  uint32_t warmup = 10;
+  bool json = false;
+};
+
+struct Stats {
+  double median = 0.0;
+  double min = 0.0;
+  double max = 0.0;
+};
+
+Stats stats_of(std::vector<double> values) {
+  if (values.empty()) return {};
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  const double median = n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  return {median, values.front(), values.back()};
+}
+
+void print_help() {
+  std::printf(
+      "usage: siviflow bench [--size WxH] [--frames N] [--warmup W] [--json]\n"
+      "  Renders the default scene: W warm-up frames (default 10), then N measured frames\n"
+      "  (default 60), one at a time. Reports per pass the median, min and max GPU time\n"
+      "  (timestamps), the whole frame, the flow pass's floor (a full-screen pass making the same\n"
+      "  texture reads), and the CPU stages' medians. --json prints one JSON object.\n");
+}
+
+Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
+  cli::ArgReader args(argc, argv, 2);
+  std::string_view value;
+  while (!args.done()) {
+    const std::string_view arg = args.next();
+    if (arg == "--help" || arg == "-h") {
+      *help = true;
+    } else if (arg == "--size") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(cli::parse_size(arg, value, &options->size));
+    } else if (arg == "--frames") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->frames));
+      if (options->frames == 0) return Status::error("--frames: must be at least 1");
+    } else if (arg == "--warmup") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->warmup));
+    } else if (arg == "--json") {
+      options->json = true;
+    } else if (!arg.empty() && arg[0] == '-') {
+      return Status::error("unknown option '" + std::string(arg) + "' (see --help)");
+    } else {
+      return Status::error("unexpected argument '" + std::string(arg) +
+                           "': scene files are not supported yet, only the built-in default scene");
+    }
+  }
+  return Status::success();
+}
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+int run_bench(int argc, char** argv) {
+  BenchOptions options;
+  bool help = false;
+  Status status = parse_options(argc, argv, &options, &help);
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  if (help) {
+    print_help();
+    return cli::kExitOk;
+  }
+  std::unique_ptr<HeadlessContext> context;
+  status = HeadlessContext::create(HeadlessContextOptions{}, &context);
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  const VkExtent2D extent{options.size.width, options.size.height};
+  CreateInfo info = context->renderer_create_info(extent, kOutputFormat);
+  info.frames_in_flight = 1;
+  info.enable_timing = true;
+  std::unique_ptr<Renderer> renderer;
+  status = Renderer::create(info, &renderer);
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  HostImage target;
+  status = context->create_target_image(kOutputFormat, extent, &target);
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+
+  std::map<std::string, std::vector<double>> pass_ms;
+  std::vector<double> frame_ms;
+  std::vector<double> update_ms;
+  std::vector<double> record_ms;
+  ImageState state;
+  std::vector<PassTime> times;
+  for (uint32_t frame = 0; frame < options.warmup + options.frames; ++frame) {
+    const double time = frame / 30.0;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    status = context->begin_slot(0, &cmd);
+    if (status.ok()) status = renderer->begin_frame(0);
+    const auto update_start = std::chrono::steady_clock::now();
+    if (status.ok()) status = renderer->update(renderer->scene_camera(time), time);
+    const double update = ms_since(update_start);
+    FrameInputs inputs;
+    inputs.output = {target.image, target.view, state,
+                     {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                      VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+    const auto record_start = std::chrono::steady_clock::now();
+    if (status.ok()) status = renderer->record(cmd, inputs);
+    const double record = ms_since(record_start);
+    state = inputs.output.final;
+    if (status.ok()) status = context->end_slot_and_submit(0);
+    if (status.ok()) status = context->wait_slot(0);
+    if (status.ok()) status = renderer->pass_times(0, &times);
+    if (!status.ok()) return cli::fail(kCommand, status.message());
+    if (frame < options.warmup) continue;
+    update_ms.push_back(update);
+    record_ms.push_back(record);
+    double frame_end = 0.0;
+    for (const PassTime& pass : times) {
+      pass_ms[pass.name].push_back(pass.milliseconds);
+      if (pass.name != kFloorPass) frame_end = std::max(frame_end, pass.begin_ms + pass.milliseconds);
+    }
+    frame_ms.push_back(frame_end);
+  }
+
+  const Stats frame = stats_of(frame_ms);
+  const Stats floor = stats_of(pass_ms[kFloorPass]);
+  const Stats flow = stats_of(pass_ms["flow"]);
+  const Stats update = stats_of(update_ms);
+  const Stats record = stats_of(record_ms);
+  if (options.json) {
+    nlohmann::json out;
+    out["size"] = {options.size.width, options.size.height};
+    out["frames"] = options.frames;
+    out["frame_ms"] = frame.median;
+    out["floor_ms"] = floor.median;
+    for (const auto& [name, values] : pass_ms) {
+      if (name == kFloorPass) continue;
+      const Stats s = stats_of(values);
+      out["passes"][name] = {{"median_ms", s.median}, {"min_ms", s.min}, {"max_ms", s.max}};
+    }
+    out["cpu"] = {{"update_ms", update.median}, {"record_ms", record.median}};
+    std::printf("%s\n", out.dump(2).c_str());
+    return cli::kExitOk;
+  }
+  std::printf("%ux%u, %u frames after %u warm-up (GPU timestamps, lavapipe or not)\n",
+              options.size.width, options.size.height, options.frames, options.warmup);
+  std::printf("%-12s %10s %10s %10s\n", "pass", "median ms", "min ms", "max ms");
+  for (const auto& [name, values] : pass_ms) {
+    const Stats s = stats_of(values);
+    std::printf("%-12s %10.3f %10.3f %10.3f\n", name.c_str(), s.median, s.min, s.max);
+  }
+  std::printf("frame        %10.3f %10.3f %10.3f\n", frame.median, frame.min, frame.max);
+  std::printf("flow / floor: %.2f\n", floor.median > 0.0 ? flow.median / floor.median : 0.0);
+  std::printf("cpu update (particles + packing) %.3f ms, record %.3f ms (medians)\n", update.median,
+              record.median);
+  return cli::kExitOk;
+}
+
+}  // namespace siviflow
