@@ -67,6 +67,7 @@ gpu::SceneConstants translated(const gpu::SceneConstants& constants, glm::vec3 o
   moved.view_proj = constants.view_proj * glm::translate(glm::mat4(1.0f), offset);
   moved.camera_position = constants.camera_position - glm::vec4(offset, 0.0f);
   moved.clip_plane.w += glm::dot(glm::vec3(constants.clip_plane), offset);
+  moved.fog.z += offset.y;  // height fog needs the world height, not the model's
   return moved;
 }
 
@@ -159,8 +160,10 @@ struct Renderer::Impl {
   std::vector<uint32_t> timed_passes;  // per slot: passes recorded with timestamps
   uint32_t current_slot = 0;
   float timestamp_period_ns = 1.0f;
+  uint64_t timestamp_mask = ~uint64_t{0};  // the queue's valid timestamp bits
 
   bool static_data_uploaded = false;
+  bool unusable = false;  // a resize failed half-way
   bool frame_begun = false;
   bool frame_updated = false;
 
@@ -523,6 +526,13 @@ Status Renderer::Impl::create_query_pools() {
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   table.vkGetPhysicalDeviceProperties2(info.physical_device, &props);
   timestamp_period_ns = props.properties.limits.timestampPeriod;
+  uint32_t family_count = 0;
+  table.vkGetPhysicalDeviceQueueFamilyProperties(info.physical_device, &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  table.vkGetPhysicalDeviceQueueFamilyProperties(info.physical_device, &family_count, families.data());
+  const uint32_t bits = families[info.queue_family_index].timestampValidBits;
+  if (bits == 0) return invalid("enable_timing: the queue family has no timestamps");
+  timestamp_mask = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
   VkQueryPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
   pool_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
   pool_info.queryCount = 2 * kMaxTimedPasses;
@@ -556,6 +566,7 @@ Renderer::~Renderer() { impl_->destroy(); }
 
 Status Renderer::begin_frame(uint32_t slot) {
   Impl& r = *impl_;
+  if (r.unusable) return Status::error("Renderer: a resize failed; resize again before rendering");
   SIVIFLOW_TRY(r.ring.begin_slot(slot));
   r.current_slot = slot;
   r.frame_begun = true;
@@ -708,12 +719,18 @@ Status Renderer::resize(VkExtent2D extent) {
   // The particles live in screen space: a new viewport starts them afresh at frame 0. This can
   // fail (a size the particles cannot cover); nothing has changed then.
   SIVIFLOW_TRY(r.simulation.resize({extent.width, extent.height}));
-  SIVIFLOW_TRY(r.ring.ensure_staging_capacity(r.simulation.layout().total_bytes + kStagingAlignment));
-  r.retire_frame_images();
-  r.info.extent = extent;
-  r.graph = FrameGraph{};
-  r.bindings.reset();
-  return r.declare_graph();
+  // Past this point the old configuration is gone: a failure leaves nothing to record with,
+  // until a resize succeeds.
+  Status status = r.ring.ensure_staging_capacity(r.simulation.layout().total_bytes + kStagingAlignment);
+  if (status.ok()) {
+    r.retire_frame_images();
+    r.info.extent = extent;
+    r.graph = FrameGraph{};
+    r.bindings.reset();
+    status = r.declare_graph();
+  }
+  r.unusable = !status.ok();
+  return status;
 }
 
 Camera Renderer::scene_camera(double time_seconds) const {
@@ -773,12 +790,17 @@ Status Renderer::pass_times(uint32_t slot, std::vector<PassTime>* out) const {
   std::vector<uint64_t> ticks(2 * passes);
   SIVIFLOW_TRY(vk_status(r.table.vkGetQueryPoolResults(r.table.device, r.query_pools[slot], 0, 2 * passes,
                                                        ticks.size() * sizeof(uint64_t), ticks.data(),
-                                                       sizeof(uint64_t), VK_QUERY_RESULT_64_BIT),
+                                                       sizeof(uint64_t),
+                                                       VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
                          "vkGetQueryPoolResults"));
   const std::vector<std::string> names = r.graph.pass_order();
   for (uint32_t i = 0; i < passes && i < names.size(); ++i) {
-    const double begin_ns = static_cast<double>(ticks[2 * i] - ticks[0]) * r.timestamp_period_ns;
-    const double ns = static_cast<double>(ticks[2 * i + 1] - ticks[2 * i]) * r.timestamp_period_ns;
+    // Differences modulo the valid bits, so a counter that wrapped still gives the right span.
+    const auto span = [&](uint64_t from, uint64_t to) {
+      return static_cast<double>((to - from) & r.timestamp_mask) * r.timestamp_period_ns;
+    };
+    const double begin_ns = span(ticks[0], ticks[2 * i]);
+    const double ns = span(ticks[2 * i], ticks[2 * i + 1]);
     out->push_back({names[i], begin_ns * 1e-6, ns * 1e-6});
   }
   return Status::success();

@@ -17,7 +17,10 @@ layout(location = 0) out float out_value;
 void main() {
   ivec2 texel = ivec2(gl_FragCoord.xy / flow.water.w);
   uint slots = 0u;
-  for (int i = 0; i < 6; ++i) slots += texelFetch(flow_texture, texel + ivec2(i & 1, i >> 1), 0).r;
+  ivec2 last = textureSize(flow_texture, 0) - 1;
+  for (int i = 0; i < 6; ++i) {
+    slots += texelFetch(flow_texture, clamp(texel + ivec2(i & 1, i >> 1), ivec2(0), last), 0).r;
+  }
   vec4 aux = texelFetch(particle_aux, ivec2(int(slots % SIVIFLOW_AUX_WIDTH), 0), 0);
   vec2 uv = gl_FragCoord.xy * flow.screen.zw;
   vec3 sum = texture(reflection_map, uv).rgb;

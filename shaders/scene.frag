@@ -25,7 +25,7 @@ void main() {
   vec3 to_fragment = in_world - scene.camera_position.xyz;
   float dist = length(to_fragment);
   vec3 direction = to_fragment / max(dist, 1e-4);
-  float fog = 1.0 - exp(-scene.fog.x * dist * exp(-scene.fog.y * max(in_world.y, 0.0)));
+  float fog = 1.0 - exp(-scene.fog.x * dist * exp(-scene.fog.y * max(in_world.y + scene.fog.z, 0.0)));
   vec3 fog_color = sky_radiance(direction, sun, 0.0);
   out_color = vec4(mix(lit, fog_color, clamp(fog, 0.0, 1.0)), 1.0);
 }

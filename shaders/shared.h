@@ -42,7 +42,8 @@ struct SceneConstants {
   vec4 camera_position;     // xyz world position, w unused
   vec4 sun_direction;       // xyz unit vector towards the sun, w sun disc intensity
   vec4 clip_plane;          // world-space plane (n, d): gl_ClipDistance = dot(n, p) + d
-  vec4 fog;                 // x density per metre, y height falloff, zw unused
+  vec4 fog;                 // x density per metre, y height falloff, z height of the model's
+                            // origin (translated instances), w unused
 };
 
 // River particles: flow texture and auxiliary data (paper §3.2; packed by sim/flow_textures.h

@@ -66,9 +66,17 @@ void FlowPass::destroy(const GpuContext& gpu) {
 Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
                                const std::function<void(VkDescriptorPool)>& retire) {
   const DeviceTable& vk = *gpu.table;
+  // A new set first: on failure the current one stays valid.
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  const Status allocated = allocate_sampler_set(gpu, set_layout_, kBindingCount, &pool, &set);
+  if (!allocated.ok()) {
+    if (pool != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool, gpu.allocation_callbacks);
+    return allocated;
+  }
   if (pool_ != VK_NULL_HANDLE) retire(pool_);
-  pool_ = VK_NULL_HANDLE;
-  SIVIFLOW_TRY(allocate_sampler_set(gpu, set_layout_, kBindingCount, &pool_, &set_));
+  pool_ = pool;
+  set_ = set;
   const VkImageLayout read = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
   const std::array<VkDescriptorImageInfo, kBindingCount> images{{
       {nearest_, textures.flow, read},

@@ -40,15 +40,24 @@ inline GoldenResult compare_with_golden(const std::string& rendered, const std::
     result.message = "size differs from the golden";
     return result;
   }
+  const std::vector<float>* channels[2][3] = {{a.find("R"), a.find("G"), a.find("B")},
+                                              {b.find("R"), b.find("G"), b.find("B")}};
+  for (const auto& image : channels) {
+    for (const std::vector<float>* channel : image) {
+      if (channel == nullptr) {
+        result.message = "an image lacks one of the R, G, B channels";
+        return result;
+      }
+    }
+  }
   const size_t pixels = size_t(a.width) * a.height;
   std::vector<float> diff(pixels * 4, 1.0f);
   size_t failing = 0;
   for (size_t i = 0; i < pixels; ++i) {
     bool bad = false;
     for (int c = 0; c < 3; ++c) {
-      const char* name = c == 0 ? "R" : (c == 1 ? "G" : "B");
-      const float va = (*a.find(name))[i];
-      const float vb = (*b.find(name))[i];
+      const float va = (*channels[0][c])[i];
+      const float vb = (*channels[1][c])[i];
       const float d = std::abs(va - vb);
       result.max_diff = std::max(result.max_diff, d);
       bad = bad || !(d <= tol.abs_tol + tol.rel_tol * std::abs(vb));  // NaN fails too
