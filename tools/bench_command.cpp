@@ -71,11 +71,8 @@ Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
       SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->warmup));
     } else if (arg == "--json") {
       options->json = true;
-    } else if (!arg.empty() && arg[0] == '-') {
-      return Status::error("unknown option '" + std::string(arg) + "' (see --help)");
     } else {
-      return Status::error("unexpected argument '" + std::string(arg) +
-                           "': scene files are not supported yet, only the built-in default scene");
+      return cli::unexpected_argument(arg);
     }
   }
   return Status::success();

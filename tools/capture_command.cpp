@@ -126,11 +126,8 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
       options->preview = true;
     } else if (arg == "--validation") {
       options->validation = true;
-    } else if (!arg.empty() && arg[0] == '-') {
-      return Status::error("unknown option '" + std::string(arg) + "' (see --help)");
     } else {
-      return Status::error("unexpected argument '" + std::string(arg) +
-                           "': scene files are not supported yet, only the built-in default scene");
+      return cli::unexpected_argument(arg);
     }
   }
   if (options->out_dir.empty()) return Status::error("--out DIR is required");

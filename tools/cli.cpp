@@ -85,6 +85,14 @@ Status ArgReader::value(std::string_view flag, std::string_view* out) {
   return Status::success();
 }
 
+Status unexpected_argument(std::string_view arg) {
+  if (!arg.empty() && arg[0] == '-') {
+    return Status::error("unknown option '" + std::string(arg) + "' (see --help)");
+  }
+  return Status::error("unexpected argument '" + std::string(arg) +
+                       "': scene files are not supported yet, only the built-in default scene");
+}
+
 int fail(std::string_view command, const std::string& message) {
   std::fprintf(stderr, "siviflow %.*s: %s\n", static_cast<int>(command.size()), command.data(),
                message.c_str());

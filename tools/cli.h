@@ -47,6 +47,10 @@ class ArgReader {
   int next_;
 };
 
+// The error for an argument that no option of capture or bench takes: an unknown option, or a
+// positional argument (a scene file, which they do not read yet).
+Status unexpected_argument(std::string_view arg);
+
 // Prints "siviflow <command>: <message>" to stderr and returns kExitError.
 int fail(std::string_view command, const std::string& message);
 
