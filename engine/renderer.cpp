@@ -178,6 +178,7 @@ struct Renderer::Impl {
   Status simulate(const Camera& camera, double time_seconds);
   Status record_static_upload(VkCommandBuffer cmd);
   Status create_query_pools();
+  void declare_host_reflection(ScenePass::Handles* mirrored);
   void retire_frame_images();
   void destroy();
 };
@@ -370,7 +371,11 @@ Status Renderer::Impl::declare_graph() {
   mirrored.vertices = static_buffers[kSceneVertices].in_frame_graph;
   mirrored.indices = static_buffers[kSceneIndices].in_frame_graph;
   mirrored.detail = static_images[kDetail].in_frame_graph;
-  scene_pass.declare(graph, "reflection", &reflection_draws, &mirrored);
+  if (info.reflection != nullptr) {
+    declare_host_reflection(&mirrored);
+  } else {
+    scene_pass.declare(graph, "reflection", &reflection_draws, &mirrored);
+  }
 
   // scene: sky, terrain, riverbed and objects into the host's output.
   // The host states the output's real states per frame; these are overridden in record().
@@ -433,6 +438,23 @@ Status Renderer::Impl::declare_graph() {
       gpu_context.table->vkDestroyDescriptorPool(gpu_context.table->device, pool,
                                                  gpu_context.allocation_callbacks);
     });
+  });
+}
+
+void Renderer::Impl::declare_host_reflection(ScenePass::Handles* mirrored) {
+  PassBuilder pass = graph.add_pass("reflection", PassKind::Graphics);
+  mirrored->color = pass.color_write(mirrored->color, LoadOp::Clear);
+  mirrored->depth = pass.depth_write(mirrored->depth, LoadOp::Clear);
+  const ImageHandle color = mirrored->color;
+  pass.record([this, color](const PassContext& ctx) {
+    ReflectionView view{};
+    std::memcpy(view.view_proj, &reflection_constants.view_proj[0][0], sizeof(view.view_proj));
+    std::memcpy(view.clip_plane, &reflection_constants.clip_plane[0], sizeof(view.clip_plane));
+    std::memcpy(view.camera_position, &reflection_constants.camera_position[0], sizeof(view.camera_position));
+    view.extent = ctx.extent(color);
+    set_viewport(ctx.table(), ctx.cmd(), view.extent);
+    info.reflection(ctx.cmd(), view, info.reflection_user);
+    return Status::success();
   });
 }
 

@@ -28,6 +28,7 @@ struct Frame {
   std::vector<std::byte> flow_texture;  // as uploaded and read back
   std::vector<std::byte> particle_aux;
   std::vector<float> normal;  // RGBA per pixel: xyz the water normal, 0 off water
+  std::vector<float> reflection;  // RGBA per pixel: the reflection sample, 0 off water
 
   const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * width + x) * 4]; }
 };
@@ -74,6 +75,8 @@ class RenderTest : public GpuTest {
       out.particle_aux.assign(aux, aux + renderer_->readback_bytes(ReadbackImage::kParticleAux));
       const auto* normal = static_cast<const float*>(slot.readback[5].data);
       out.normal.assign(normal, normal + size_t{width} * height * 4);
+      const auto* reflection = static_cast<const float*>(slot.readback[6].data);
+      out.reflection.assign(reflection, reflection + size_t{width} * height * 4);
       frames.push_back(std::move(out));
       slot.pending = false;
     };
@@ -228,6 +231,47 @@ TEST_F(RenderTest, MovingObstacleReroutesTheParticlesFlow) {
   EXPECT_GT(before, 0.3) << "open water flows";
   ASSERT_GT(after_count, 0u);
   EXPECT_EQ(after, 0.0) << "inside the obstacle the water is dry: velocity 0";
+}
+
+struct HostReflectionLog {
+  int calls = 0;
+  ReflectionView last{};
+};
+
+void record_nothing(VkCommandBuffer, const ReflectionView& view, void* user) {
+  auto* log = static_cast<HostReflectionLog*>(user);
+  ++log->calls;
+  log->last = view;
+}
+
+TEST_F(RenderTest, HostCanReplaceWhatTheWaterReflects) {
+  // Our own reflection: the sky and the banks show in the water.
+  const std::vector<Frame> ours = render(0, 1);
+  ASSERT_EQ(ours.size(), 1u);
+  ASSERT_TRUE(context_->wait_idle().ok());
+  renderer_.reset();
+  // A host that draws nothing into the reflection: the water reflects the cleared target only.
+  HostReflectionLog log;
+  CreateInfo info = make_create_info(kWidth, kHeight);
+  info.reflection = &record_nothing;
+  info.reflection_user = &log;
+  ASSERT_TRUE(Renderer::create(info, &renderer_).ok());
+  const std::vector<Frame> host = render(0, 1);
+  ASSERT_EQ(host.size(), 1u);
+  EXPECT_EQ(log.calls, 1);
+  EXPECT_EQ(log.last.extent.width, kWidth / 2);
+  EXPECT_EQ(log.last.extent.height, kHeight / 2);
+  EXPECT_FLOAT_EQ(log.last.clip_plane[1], 1.0f) << "keeps what is above the water";
+  EXPECT_LT(log.last.camera_position[1], 0.0f) << "the mirrored camera is below the water";
+  size_t water = 0;
+  for (size_t i = 0; i < host.front().water_mask.size(); ++i) {
+    if (host.front().water_mask[i] != 1.0f) continue;
+    ++water;
+    EXPECT_EQ(host.front().reflection[i * 4 + 2], 0.0f) << "pixel " << i;
+    EXPECT_GT(ours.front().reflection[i * 4 + 2], 0.05f) << "pixel " << i;
+    if (HasFailure()) break;
+  }
+  EXPECT_GT(water, 100u);
 }
 
 TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {

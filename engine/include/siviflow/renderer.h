@@ -29,6 +29,20 @@
 namespace siviflow {
 
 enum class LogLevel { kInfo, kWarning, kError };
+
+// What a host's own reflection drawing needs: the scene mirrored about the water plane, seen from
+// the real camera, and the plane to clip below (keep dot(plane.xyz, p) + plane.w >= 0).
+struct ReflectionView {
+  float view_proj[16];   // column-major, Vulkan clip space (depth 0..1, +Y down), mirror included
+  float clip_plane[4];   // world space
+  float camera_position[3];  // the mirrored camera, for view-dependent shading
+  VkExtent2D extent;     // of the reflection target
+};
+// Records the host's world into the reflection target. Called inside the reflection pass, with
+// dynamic rendering begun (colour: CreateInfo::color_format, depth: VK_FORMAT_D32_SFLOAT, both
+// cleared) and viewport and scissor set; the host binds its own pipelines (with that rendering
+// format and gl_ClipDistance against clip_plane) and must not end the rendering.
+using ReflectionCallback = void (*)(VkCommandBuffer cmd, const ReflectionView& view, void* user);
 using LogCallback = void (*)(LogLevel level, const char* message, void* user);
 
 struct CreateInfo {
@@ -52,6 +66,8 @@ struct CreateInfo {
   bool debug_utils = false;            // the host enabled VK_EXT_debug_utils: label passes, name objects
   VkPipelineCache pipeline_cache = VK_NULL_HANDLE;         // optional
   const VkAllocationCallbacks* allocation_callbacks = nullptr;  // optional
+  ReflectionCallback reflection = nullptr;  // optional: the host draws the reflection instead
+  void* reflection_user = nullptr;
   LogCallback log = nullptr;           // optional; warnings and errors with context
   void* log_user = nullptr;
 };
