@@ -58,7 +58,6 @@ uint32_t texel_bytes(VkFormat format) {
   }
 }
 
-constexpr size_t kMovingObstacle = 1;  // default_scene_obstacles(): the moving boulder is last
 
 // The constants that draw a model placed at `offset` with the scene shaders, which work in the
 // model's coordinates: clip and fog see the same distances as for the translated model.
@@ -85,6 +84,9 @@ struct Renderer::Impl {
   GpuContext gpu;
   FrameRing ring;
   ProceduralRiver river{default_river_params()};
+  FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
+  std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is this frame
+  SceneCamera camera_path;          // keys empty: the default camera gliding downstream
   SceneLook look = default_scene_look();
   RiverSimulation simulation;  // the river's flow, particles and flow textures, on the CPU
   double last_time = 0.0;
@@ -125,6 +127,8 @@ struct Renderer::Impl {
   // its own constants (translated to where its obstacle is this frame).
   std::vector<SceneDraw> scene_draws;
   std::vector<SceneDraw> reflection_draws;
+  std::vector<glm::vec3> obstacle_offsets;  // this frame's obstacle centres
+  std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main view, then mirrored
   uint32_t river_index_count = 0;
   ScenePass scene_pass;
   FlowPass flow_pass;
@@ -151,8 +155,6 @@ struct Renderer::Impl {
   FrameBindings bindings;
   gpu::SceneConstants constants{};
   gpu::SceneConstants reflection_constants{};
-  gpu::SceneConstants moving_constants{};
-  gpu::SceneConstants moving_reflection_constants{};
   gpu::FlowConstants flow_constants{};
 
   // With CreateInfo::enable_timing: per slot, two timestamps around each pass of the graph.
@@ -168,6 +170,7 @@ struct Renderer::Impl {
   bool frame_updated = false;
 
   Status validate_info(const CreateInfo& create);
+  Status take_scene();
   Status create_static_resources();
   Status declare_static_graph();
   Status declare_graph();
@@ -250,23 +253,41 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
   return Status::success();
 }
 
+Status Renderer::Impl::take_scene() {
+  obstacles = default_scene_obstacles(river);
+  if (info.scene == nullptr) return Status::success();
+  const SceneFile& scene = *info.scene;
+  if (scene.river.source != SceneRiver::Source::kProcedural || !scene.objects.empty()) {
+    return invalid(scene.path + ": rendering a glTF river or glTF objects is not supported yet "
+                   "(siviflow flow solves them); use a procedural river without objects");
+  }
+  SIVIFLOW_TRY(ProceduralRiver::validate(scene.river.procedural));
+  river = ProceduralRiver(scene.river.procedural);
+  flow_params = scene.flow;
+  obstacles = scene.obstacles;
+  camera_path = scene.camera;
+  return Status::success();
+}
+
 Status Renderer::Impl::create_static_resources() {
   const auto bytes_of = [](const auto& items) {
     const auto* first = reinterpret_cast<const uint8_t*>(items.data());
     return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
   };
-  const SceneGeometry geometry = build_default_scene_geometry(river);
-  scene_draws = {{0, geometry.static_index_count, &constants},
-                 {geometry.moving_first_index,
-                  static_cast<uint32_t>(geometry.indices.size()) - geometry.moving_first_index,
-                  &moving_constants}};
-  reflection_draws = {{0, geometry.static_index_count, &reflection_constants},
-                      {geometry.moving_first_index, scene_draws[1].index_count,
-                       &moving_reflection_constants}};
+  const SceneGeometry geometry = build_scene_geometry(river, obstacles);
+  // Sized once: the draws point into it.
+  obstacle_constants.resize(2 * obstacles.size());
+  scene_draws = {{0, geometry.static_index_count, &constants}};
+  reflection_draws = {{0, geometry.static_index_count, &reflection_constants}};
+  for (size_t i = 0; i < geometry.obstacle_boulders.size(); ++i) {
+    const SceneGeometry::Instance& boulder = geometry.obstacle_boulders[i];
+    scene_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i]});
+    reflection_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i + 1]});
+  }
   static_buffers[kSceneVertices].bytes = bytes_of(geometry.vertices);
   static_buffers[kSceneIndices].bytes = bytes_of(geometry.indices);
-  SIVIFLOW_TRY(simulation.create(river, kDefaultSceneDischarge, default_scene_obstacles(river),
-                                 info.seed, {info.extent.width, info.extent.height}));
+  SIVIFLOW_TRY(simulation.create(river, flow_params, obstacles, info.seed,
+                                 {info.extent.width, info.extent.height}));
   const RiverMesh& river_mesh = simulation.mesh();
   river_index_count = static_cast<uint32_t>(river_mesh.indices.size());
   static_buffers[kRiverVertices].bytes = bytes_of(river_mesh.positions);
@@ -570,6 +591,7 @@ Status Renderer::Impl::create_query_pools() {
 Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) {
   auto impl = std::make_unique<Impl>();
   Status status = impl->validate_info(info);
+  if (status.ok()) status = impl->take_scene();
   if (status.ok()) status = impl->create_static_resources();
   if (status.ok()) status = impl->declare_static_graph();
   if (status.ok()) status = impl->declare_graph();
@@ -640,11 +662,13 @@ Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
   flow_constants.screen = glm::vec4(info.extent.width, info.extent.height,
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
-  // The moving boulder: its obstacle's centre this frame, drawn as a translated instance.
+  // The obstacles where they are this frame, each drawn as a translated boulder.
   SIVIFLOW_TRY(simulation.set_time(time_seconds));
-  const glm::vec3 offset = simulation.obstacle_centre(kMovingObstacle);
-  moving_constants = translated(constants, offset);
-  moving_reflection_constants = translated(reflection_constants, offset);
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    const glm::vec3 offset = simulation.obstacle_centre(i);
+    obstacle_constants[2 * i] = translated(constants, offset);
+    obstacle_constants[2 * i + 1] = translated(reflection_constants, offset);
+  }
   SIVIFLOW_TRY(simulation.simulate(constants.view_proj, dt));
   last_time = time_seconds;
   return Status::success();
@@ -756,7 +780,28 @@ Status Renderer::resize(VkExtent2D extent) {
 }
 
 Camera Renderer::scene_camera(double time_seconds) const {
-  return default_camera(impl_->river, time_seconds);
+  const SceneCamera& path = impl_->camera_path;
+  if (path.keys.empty()) {
+    Camera camera = default_camera(impl_->river, time_seconds);
+    if (impl_->info.scene != nullptr) camera.fov_y_deg = path.fov_y_deg;
+    return camera;
+  }
+  // Linear between keys, held before the first and after the last.
+  Camera camera;
+  camera.fov_y_deg = path.fov_y_deg;
+  const auto after = std::find_if(path.keys.begin(), path.keys.end(),
+                                  [&](const CameraKey& key) { return key.t > time_seconds; });
+  if (after == path.keys.begin() || after == path.keys.end()) {
+    const CameraKey& key = after == path.keys.begin() ? path.keys.front() : path.keys.back();
+    camera.position = key.position;
+    camera.target = key.target;
+    return camera;
+  }
+  const CameraKey& a = *(after - 1);
+  const float u = static_cast<float>((time_seconds - a.t) / (after->t - a.t));
+  camera.position = glm::mix(a.position, after->position, u);
+  camera.target = glm::mix(a.target, after->target, u);
+  return camera;
 }
 
 VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {

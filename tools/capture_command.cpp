@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "siviflow/headless_context.h"
 #include "siviflow/image_files.h"
 #include "siviflow/renderer.h"
+#include "siviflow/scene_file.h"
 
 namespace siviflow {
 namespace {
@@ -33,6 +35,10 @@ constexpr uint64_t kBytesPerPixel = 2 * (8 + 4);
 constexpr uint64_t kMaxCaptureBytes = 2ull << 30;
 
 struct CaptureOptions {
+  std::string scene_path;  // empty: the built-in default scene
+  bool size_given = false;  // flags win over the scene file's render settings
+  bool fps_given = false;
+  bool seed_given = false;
   uint32_t first_frame = 0;
   uint32_t end_frame = 1;
   cli::Size size{1280, 720};
@@ -50,9 +56,10 @@ struct CaptureOptions {
 
 void print_help() {
   std::printf(
-      "usage: siviflow capture [--frames N | --range A:B] [--size WxH] --out DIR [--seed S]\n"
-      "                        [--fps F] [--aov LIST] [--preview] [--validation]\n"
-      "  Renders the built-in default scene into DIR/frame_NNNNN.exr.\n"
+      "usage: siviflow capture [SCENE.json] [--frames N | --range A:B] [--size WxH] --out DIR\n"
+      "                        [--seed S] [--fps F] [--aov LIST] [--preview] [--validation]\n"
+      "  Renders the scene file (procedural rivers for now; its render settings unless a flag\n"
+      "  says otherwise), or the built-in default scene, into DIR/frame_NNNNN.exr.\n"
       "  --frames N     frames 0..N-1 (same as --range 0:N; default 1)\n"
       "  --range A:B    frames A..B-1; a frame is the same whatever range it is rendered in\n"
       "  --size WxH     output size in pixels (default 1280x720)\n"
@@ -95,15 +102,18 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
     } else if (arg == "--size") {
       SIVIFLOW_TRY(args.value(arg, &value));
       SIVIFLOW_TRY(cli::parse_size(arg, value, &options->size));
+      options->size_given = true;
     } else if (arg == "--out") {
       SIVIFLOW_TRY(args.value(arg, &value));
       options->out_dir = std::string(value);
     } else if (arg == "--seed") {
       SIVIFLOW_TRY(args.value(arg, &value));
       SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->seed));
+      options->seed_given = true;
     } else if (arg == "--fps") {
       SIVIFLOW_TRY(args.value(arg, &value));
       SIVIFLOW_TRY(cli::parse_positive_float(arg, value, &options->fps));
+      options->fps_given = true;
     } else if (arg == "--aov") {
       SIVIFLOW_TRY(args.value(arg, &value));
       for (const std::string& aov : cli::split_list(value)) {
@@ -126,8 +136,12 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
       options->preview = true;
     } else if (arg == "--validation") {
       options->validation = true;
-    } else {
+    } else if (!arg.empty() && arg[0] == '-') {
       return cli::unexpected_argument(arg);
+    } else if (options->scene_path.empty()) {
+      options->scene_path = std::string(arg);
+    } else {
+      return Status::error("unexpected argument '" + std::string(arg) + "': one scene file only");
     }
   }
   if (options->out_dir.empty()) return Status::error("--out DIR is required");
@@ -181,7 +195,8 @@ struct FinishedFrame {
 
 class Capture {
  public:
-  explicit Capture(const CaptureOptions& options) : options_(options) {}
+  Capture(const CaptureOptions& options, std::optional<SceneFile> scene)
+      : options_(options), scene_(std::move(scene)) {}
   // The GPU may still run a frame after an error: let it finish before the renderer goes.
   ~Capture() {
     if (context_ != nullptr) (void)context_->wait_idle();
@@ -195,6 +210,7 @@ class Capture {
   void report_progress(uint32_t done_count);
 
   CaptureOptions options_;
+  std::optional<SceneFile> scene_;
   std::unique_ptr<HeadlessContext> context_;
   std::unique_ptr<Renderer> renderer_;
   Status write_particles_csv(const std::string& path) const;
@@ -231,6 +247,7 @@ Status Capture::run() {
   info.frames_in_flight = kFramesInFlight;
   info.enable_readback = true;
   info.seed = options_.seed;
+  info.scene = scene_.has_value() ? &*scene_ : nullptr;
   SIVIFLOW_TRY(Renderer::create(info, &renderer_));
   // The particles carry state from frame to frame: a shard starting at frame A first advances
   // the simulation through frames 0..A-1, without rendering, so that its frames equal a full run's.
@@ -389,7 +406,7 @@ Status Capture::write_frame() {
     static const char* const kNames[3] = {"reflection.R", "reflection.G", "reflection.B"};
     add_planes(finished_.reflection, reflection_, kNames);
   }
-  frame.metadata.scene = "default";
+  frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
   frame.metadata.frame = static_cast<int>(finished_.frame);
   frame.metadata.time_seconds = static_cast<float>(finished_.frame / options_.fps);
   frame.metadata.seed = static_cast<int>(options_.seed);
@@ -451,7 +468,17 @@ int run_capture(int argc, char** argv) {
   }
   status = check_output_dir(options.out_dir);
   if (!status.ok()) return cli::fail(kCommand, status.message());
-  Capture capture(options);
+  std::optional<SceneFile> scene;
+  if (!options.scene_path.empty()) {
+    scene.emplace();
+    status = load_scene_file(options.scene_path, &*scene);
+    if (!status.ok()) return cli::fail(kCommand, status.message());
+    // The scene's render settings, unless a flag said otherwise.
+    if (!options.size_given) options.size = {scene->render.width, scene->render.height};
+    if (!options.fps_given) options.fps = static_cast<float>(scene->render.fps);
+    if (!options.seed_given) options.seed = scene->render.seed;
+  }
+  Capture capture(options, std::move(scene));
   status = capture.run();
   if (!status.ok()) return cli::fail(kCommand, status.message());
   std::printf("wrote frames %u..%u to %s/frame_NNNNN.exr%s\n", options.first_frame,

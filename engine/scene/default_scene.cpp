@@ -12,8 +12,8 @@ namespace {
 constexpr int kTerrainColumns = 120;   // quads across the valley (1.5 m)
 constexpr int kTerrainRows = 160;      // quads along the valley (1.5 m)
 constexpr float kTerrainHalfWidth = 90.0f;
-constexpr glm::vec3 kInRiverRadii{1.3f, 1.3f, 1.2f};  // the boulder in mid-river
-constexpr glm::vec3 kMovingRadii{1.1f, 1.0f, 1.0f};   // the boulder that rolls into the river
+constexpr float kInRiverRadius = 1.3f;  // the boulder in mid-river
+constexpr float kMovingRadius = 1.1f;   // the boulder that rolls into the river
 
 glm::vec3 terrain_normal(const ProceduralRiver& river, float x, float z) {
   const float e = 0.5f;
@@ -131,38 +131,43 @@ SceneLook default_scene_look() { return SceneLook{}; }
 std::vector<Obstacle> default_scene_obstacles(const ProceduralRiver& river) {
   Obstacle in_river;
   in_river.centre = on_ground(river, 1.5f, 2.0f) + glm::vec3(0.0f, 0.3f, 0.0f);
-  in_river.radius = kInRiverRadii.x;
+  in_river.radius = kInRiverRadius;
   // Rolls from the right bank (x < centreline looking downstream +Z) into the river, 0 .. 4 s.
   Obstacle moving;
   const float z = -12.0f;
-  const glm::vec3 bank = on_ground(river, -11.0f, z) + glm::vec3(0.0f, kMovingRadii.y * 0.6f, 0.0f);
-  const glm::vec3 water = on_ground(river, -2.0f, z) + glm::vec3(0.0f, kMovingRadii.y * 0.4f, 0.0f);
+  const glm::vec3 bank = on_ground(river, -11.0f, z) + glm::vec3(0.0f, kMovingRadius * 0.6f, 0.0f);
+  const glm::vec3 water = on_ground(river, -2.0f, z) + glm::vec3(0.0f, kMovingRadius * 0.4f, 0.0f);
   moving.centre = bank;
-  moving.radius = kMovingRadii.x;
+  moving.radius = kMovingRadius;
   moving.keys = {{0.0, bank}, {1.0, bank}, {4.0, water}};
   return {in_river, moving};
 }
 
 ProceduralRiverParams default_river_params() { return ProceduralRiverParams{}; }
 
-SceneGeometry build_default_scene_geometry(const ProceduralRiver& river) {
+SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles) {
   SceneGeometry geometry;
   add_terrain(river, &geometry);
   const glm::vec3 granite(0.46f, 0.44f, 0.42f);
   const glm::vec3 sandstone(0.55f, 0.45f, 0.35f);
-  // Boulders on both banks, and one in the water that the flow will go around.
+  // Boulders on both banks.
   add_boulder(on_ground(river, -10.0f, -20.0f) + glm::vec3(0, 0.6f, 0), {2.2f, 1.6f, 1.9f}, granite, 1.0f, &geometry);
   add_boulder(on_ground(river, 11.0f, 12.0f) + glm::vec3(0, 0.5f, 0), {1.6f, 1.2f, 1.5f}, sandstone, 2.0f, &geometry);
-  const std::vector<Obstacle> obstacles = default_scene_obstacles(river);
-  add_boulder(obstacles[0].centre, kInRiverRadii, granite, 3.0f, &geometry);
   for (int i = 0; i < 6; ++i) {
     const float z = -60.0f + 22.0f * static_cast<float>(i);
     const float side = (i % 2 == 0) ? -1.0f : 1.0f;
     add_tree(on_ground(river, side * (13.0f + 3.0f * static_cast<float>(i % 3)), z), 7.0f + static_cast<float>(i % 3), &geometry);
   }
   geometry.static_index_count = static_cast<uint32_t>(geometry.indices.size());
-  geometry.moving_first_index = geometry.static_index_count;
-  add_boulder(glm::vec3(0.0f), kMovingRadii, sandstone, 4.0f, &geometry);
+  // The obstacles: a boulder as wide as each footprint, slightly squat.
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    float radius = obstacles[i].radius;
+    for (const glm::vec2& corner : obstacles[i].polygon) radius = std::max(radius, glm::length(corner));
+    const uint32_t first = static_cast<uint32_t>(geometry.indices.size());
+    add_boulder(glm::vec3(0.0f), {radius, 0.95f * radius, 0.92f * radius}, i % 2 == 0 ? granite : sandstone,
+                3.0f + static_cast<float>(i), &geometry);
+    geometry.obstacle_boulders.push_back({first, static_cast<uint32_t>(geometry.indices.size()) - first});
+  }
   return geometry;
 }
 

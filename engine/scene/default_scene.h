@@ -21,9 +21,13 @@ struct SceneGeometry {
   std::vector<SceneVertex> vertices;
   std::vector<uint32_t> indices;  // triangle list, counter-clockwise seen from outside
   uint32_t static_index_count = 0;  // indices [0, this) never move
-  // The moving boulder, modelled around the origin: indices [this, indices.size()), drawn
-  // translated to the obstacle's centre of each frame.
-  uint32_t moving_first_index = 0;
+  // One boulder per obstacle, modelled around the origin and drawn translated to where its
+  // obstacle is each frame: indices [first, first + count).
+  struct Instance {
+    uint32_t first_index = 0;
+    uint32_t index_count = 0;
+  };
+  std::vector<Instance> obstacle_boulders;
 };
 
 // The objects in the water, as obstacles for the flow: the boulder in mid-river, and the one that
@@ -40,8 +44,8 @@ struct SceneLook {
 
 SceneLook default_scene_look();
 ProceduralRiverParams default_river_params();
-// Terrain of the river's valley plus the objects, in world space.
-SceneGeometry build_default_scene_geometry(const ProceduralRiver& river);
+// Terrain of the river's valley, trees and boulders on its banks, and a boulder for each obstacle.
+SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles);
 // The camera of the default scene at time t (seconds): it glides down the valley.
 Camera default_camera(const ProceduralRiver& river, double time_seconds);
 

@@ -9,19 +9,17 @@
 namespace siviflow {
 namespace {
 
-constexpr float kShepardPower = 1.5f;      // the paper's p
 constexpr float kSlopeStep = 0.5f;         // metres: finite-difference step of the riverbed slope
 
 }  // namespace
 
-Status RiverSimulation::create(const ProceduralRiver& river, float discharge,
+Status RiverSimulation::create(const ProceduralRiver& river, const FlowParams& flow,
                                std::vector<Obstacle> obstacles, uint64_t seed, glm::uvec2 viewport) {
   viewport_ = viewport;
   SIVIFLOW_TRY(river.generate_mesh(&mesh_));
   RiverSurface surface;
   SIVIFLOW_TRY(RiverSurface::build(mesh_.positions, mesh_.indices, RiverSurfaceOptions{}, &surface));
-  SIVIFLOW_TRY(StreamFunction::create(std::move(surface), FlowParams{discharge, kShepardPower, 0.0f},
-                                      &flow_));
+  SIVIFLOW_TRY(StreamFunction::create(std::move(surface), flow, &flow_));
   for (const Obstacle& obstacle : obstacles) has_keys_ = has_keys_ || !obstacle.keys.empty();
   SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
   const size_t count = mesh_.positions.size();

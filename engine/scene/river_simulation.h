@@ -22,10 +22,10 @@ namespace siviflow {
 
 class RiverSimulation {
  public:
-  // Builds the river's surface mesh, solves its flow (discharge in m^2/s) and sizes the particles
+  // Builds the river's surface mesh, solves its flow with the obstacles and sizes the particles
   // and flow textures for `viewport`. Must not be moved after create(): the particles keep spans
   // into this object's per-vertex arrays.
-  Status create(const ProceduralRiver& river, float discharge, std::vector<Obstacle> obstacles,
+  Status create(const ProceduralRiver& river, const FlowParams& flow, std::vector<Obstacle> obstacles,
                 uint64_t seed, glm::uvec2 viewport);
 
   // Places the keyframed obstacles at `time_seconds` and re-solves the flow near those that

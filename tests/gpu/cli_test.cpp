@@ -206,6 +206,49 @@ TEST_F(CliTest, FlowAndParticleAovs) {
   EXPECT_GE(covered * 100, water * 97) << covered << " of " << water << " water pixels have a particle";
 }
 
+TEST_F(CliTest, CaptureOfAProceduralSceneFile) {
+  const fs::path scene = dir_.parent_path() / "procedural_scene.json";
+  FILE* f = std::fopen(scene.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fputs(R"({"version":1,"river":{"procedural":{"seed":11,"width":9.0}},"flow":{"discharge":15.0},
+    "obstacles":[{"center":[0,0.3,10],"radius":1.6}],
+    "camera":{"fov_y_deg":60,"keys":[{"t":0,"position":[0,7,-20],"target":[0,0,15]},
+                                    {"t":10,"position":[5,9,0],"target":[0,0,30]}]},
+    "render":{"size":[80,48],"fps":24,"seed":3}})", f);
+  std::fclose(f);
+  const RunResult r = run_siviflow("capture " + scene.string() + " --range 2:3 --validation --out " + dir_.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ExrImage image;
+  ASSERT_TRUE(read_exr((dir_ / "frame_00002.exr").string(), &image).ok());
+  EXPECT_EQ(image.width, 80) << "the scene's render size";
+  EXPECT_EQ(image.height, 48);
+  EXPECT_EQ(image.metadata.seed, 3);
+  EXPECT_NEAR(image.metadata.time_seconds, 2.0f / 24.0f, 1e-6f) << "the scene's fps";
+  EXPECT_EQ(image.metadata.scene, scene.string());
+  // A flag wins over the scene's settings.
+  ASSERT_EQ(run_siviflow("capture " + scene.string() + " --size 32x16 --out " + dir_.string()).exit_code, 0);
+  ASSERT_TRUE(read_exr((dir_ / "frame_00000.exr").string(), &image).ok());
+  EXPECT_EQ(image.width, 32);
+}
+
+TEST_F(CliTest, CaptureRefusesScenesItCannotRenderYet) {
+  const fs::path gltf_scene = dir_.parent_path() / "gltf_scene.json";
+  FILE* f = std::fopen(gltf_scene.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fputs(R"({"version":1,"river":{"gltf":"river.glb"}})", f);
+  std::fclose(f);
+  expect_error(run_siviflow("capture " + gltf_scene.string() + " --out " + dir_.string()),
+               "not supported yet");
+  const fs::path bad = dir_.parent_path() / "bad_scene.json";
+  f = std::fopen(bad.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fputs(R"({"version":1,"river":{"procedural":{}},"rendr":{}})", f);
+  std::fclose(f);
+  expect_error(run_siviflow("capture " + bad.string() + " --out " + dir_.string()), "rendr");
+  expect_error(run_siviflow("capture " + bad.string() + " " + bad.string() + " --out " + dir_.string()),
+               "one scene file only");
+}
+
 TEST_F(CliTest, BenchReportsEveryPassAsJson) {
   const RunResult r = run_siviflow("bench --size 96x54 --frames 3 --warmup 1 --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;

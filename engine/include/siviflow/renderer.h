@@ -22,6 +22,7 @@
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan.h>
 
+#include "siviflow/scene_file.h"
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "sim/status.h"
@@ -60,6 +61,9 @@ struct CreateInfo {
   VkExtent2D extent = {0, 0};          // output size in pixels; required
   bool enable_readback = false;        // record copies of the frame's images into host buffers
   uint64_t seed = 0;                   // seed of the river particles' random choices
+  // The scene to render; null: the built-in default scene. Procedural rivers only for now (its
+  // river, flow, obstacles and camera keys); the renderer copies what it needs.
+  const SceneFile* scene = nullptr;
   bool enable_timing = false;          // GPU timestamps around every pass (see pass_times()),
                                        // and the flow pass's floor pass, for benchmarks
   VkDeviceSize staging_bytes_per_slot = 0;  // per-slot staging block; 0 means 8 MiB
