@@ -158,7 +158,6 @@ class ParticleField {
 
   const ParticleParams& params() const { return params_; }
   float min_distance_px() const { return min_distance_; }
-  float fill_spacing_px() const { return spacing_; }
   // With the camera still (or on the first frame, or a cut) the fill leaves no point of the
   // visible water (away from its edges) farther than this from a live particle: the minimum
   // distance plus a hair against float noise. While the camera moves, gaps are filled once

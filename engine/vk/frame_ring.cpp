@@ -99,6 +99,5 @@ void FrameRing::defer_deletion_until_all_slots(std::function<void()> destroy) {
   }
 }
 
-VkDeviceSize FrameRing::staging_used() const { return slots_[current_].allocator.used(); }
 
 }  // namespace siviflow

@@ -55,7 +55,6 @@ class FrameRing {
   Status ensure_staging_capacity(VkDeviceSize bytes);
 
   uint32_t slot_count() const { return static_cast<uint32_t>(slots_.size()); }
-  uint32_t current_slot() const { return current_; }
   // The host guarantees the GPU finished this slot's previous frame.
   Status begin_slot(uint32_t slot);
   Status allocate_staging(VkDeviceSize size, VkDeviceSize alignment, StagingAllocation* out);
@@ -63,7 +62,6 @@ class FrameRing {
   void defer_deletion(std::function<void()> destroy);
   // Runs `destroy` once every slot has come round again: for what frames of any slot may use.
   void defer_deletion_until_all_slots(std::function<void()> destroy);
-  VkDeviceSize staging_used() const;
   VkBuffer staging_buffer() const { return slots_[current_].staging.buffer; }
 
  private:

@@ -407,9 +407,6 @@ PFN_vkGetDeviceProcAddr HeadlessContext::get_device_proc_addr() const {
   return impl_->host.vkGetDeviceProcAddr;
 }
 const DeviceReport& HeadlessContext::report() const { return impl_->report; }
-const VkPhysicalDeviceFeatures2* HeadlessContext::enabled_features() const {
-  return &impl_->enabled.features2;
-}
 
 CreateInfo HeadlessContext::renderer_create_info(VkExtent2D extent, VkFormat color_format) const {
   CreateInfo info;

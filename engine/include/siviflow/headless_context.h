@@ -67,8 +67,6 @@ class HeadlessContext {
   PFN_vkGetInstanceProcAddr get_instance_proc_addr() const;
   PFN_vkGetDeviceProcAddr get_device_proc_addr() const;
   const DeviceReport& report() const;
-  // The features the device was created with: what CreateInfo::enabled_features points to.
-  const VkPhysicalDeviceFeatures2* enabled_features() const;
   // A renderer CreateInfo for this device, with every handle, the enabled features and debug
   // labels (when validation is on) filled; the caller sets the rest.
   CreateInfo renderer_create_info(VkExtent2D extent, VkFormat color_format) const;
