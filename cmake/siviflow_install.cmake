@@ -27,6 +27,7 @@ find_dependency(TinyGLTF CONFIG)
 find_dependency(nlohmann_json 3 CONFIG)
 find_dependency(OpenEXR 3 CONFIG)
 find_dependency(PNG)
+find_dependency(JPEG)
 include("${CMAKE_CURRENT_LIST_DIR}/siviflowTargets.cmake")
 ]=])
 configure_package_config_file(${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in

@@ -12,8 +12,10 @@
 #include "scene/default_scene.h"
 #include "scene/detail_texture.h"
 #include "scene/river_simulation.h"
+#include "scene/scene_objects.h"
 #include "scene/water_normal_map.h"
 #include "siviflow/scene_file.h"
+#include "siviflow/scene_river.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
@@ -34,6 +36,7 @@ constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
 constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kNormalMapFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr VkFormat kDetailFormat = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr VkFormat kBaseColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
 constexpr float kDefaultReflectionScale = 0.5f;
 constexpr uint32_t kMaxTimedPasses = 16;  // reflection target size relative to the output
 
@@ -86,6 +89,8 @@ struct Renderer::Impl {
   ProceduralRiver river{default_river_params()};
   FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
   std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is this frame
+  SceneObjects objects;             // the scene file's glTF objects, drawn where they stand
+  std::vector<Obstacle> object_obstacles;  // footprints of the objects marked obstacle
   SceneCamera camera_path;          // keys empty: the default camera gliding downstream
   SceneLook look = default_scene_look();
   RiverSimulation simulation;  // the river's flow, particles and flow textures, on the CPU
@@ -110,7 +115,7 @@ struct Renderer::Impl {
       {"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
       {"river depths", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
       {"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, {}, {}, {}}}};
-  enum StaticImageId { kDetail, kNormalMap, kStaticImageCount };
+  enum StaticImageId { kDetail, kNormalMap, kFirstBaseColor };
   struct StaticImage {
     const char* name;
     VkFormat format;
@@ -120,9 +125,9 @@ struct Renderer::Impl {
     Image image;
     ImageHandle in_frame_graph;
   };
-  std::array<StaticImage, kStaticImageCount> static_images{{
-      {"ground detail", kDetailFormat, {}, {}, {}, {}, {}},
-      {"water normal map", kNormalMapFormat, {}, {}, {}, {}, {}}}};
+  // The detail texture, the water normal map, then the objects' base-colour textures.
+  std::vector<StaticImage> static_images{{"ground detail", kDetailFormat, {}, {}, {}, {}, {}},
+                                         {"water normal map", kNormalMapFormat, {}, {}, {}, {}, {}}};
   // What the scene and reflection passes draw: the static scene, and the moving boulder with
   // its own constants (translated to where its obstacle is this frame).
   std::vector<SceneDraw> scene_draws;
@@ -257,16 +262,19 @@ Status Renderer::Impl::take_scene() {
   obstacles = default_scene_obstacles(river);
   if (info.scene == nullptr) return Status::success();
   const SceneFile& scene = *info.scene;
-  if (scene.river.source != SceneRiver::Source::kProcedural || !scene.objects.empty()) {
-    return invalid(scene.path + ": rendering a glTF river or glTF objects is not supported yet "
-                   "(siviflow flow solves them); use a procedural river without objects");
+  if (scene.river.source != SceneRiver::Source::kProcedural) {
+    return invalid(scene.path + ": rendering a glTF river is not supported yet (siviflow flow "
+                   "solves it); use a procedural river");
   }
   SIVIFLOW_TRY(ProceduralRiver::validate(scene.river.procedural));
   river = ProceduralRiver(scene.river.procedural);
   flow_params = scene.flow;
   obstacles = scene.obstacles;
   camera_path = scene.camera;
-  return Status::success();
+  SIVIFLOW_TRY(load_scene_objects(scene, &objects));
+  RiverMesh river_mesh;
+  SIVIFLOW_TRY(river.generate_mesh(&river_mesh));
+  return scene_object_obstacles(scene, river_mesh.positions, &object_obstacles);
 }
 
 Status Renderer::Impl::create_static_resources() {
@@ -274,7 +282,7 @@ Status Renderer::Impl::create_static_resources() {
     const auto* first = reinterpret_cast<const uint8_t*>(items.data());
     return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
   };
-  const SceneGeometry geometry = build_scene_geometry(river, obstacles);
+  SceneGeometry geometry = build_scene_geometry(river, obstacles);
   // Sized once: the draws point into it.
   obstacle_constants.resize(2 * obstacles.size());
   scene_draws = {{0, geometry.static_index_count, &constants}};
@@ -284,9 +292,26 @@ Status Renderer::Impl::create_static_resources() {
     scene_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i]});
     reflection_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i + 1]});
   }
+  // The objects after the valley, in world space: drawn with the view's own constants.
+  const auto first_object_vertex = static_cast<uint32_t>(geometry.vertices.size());
+  const auto first_object_index = static_cast<uint32_t>(geometry.indices.size());
+  geometry.vertices.insert(geometry.vertices.end(), objects.vertices.begin(), objects.vertices.end());
+  for (uint32_t index : objects.indices) geometry.indices.push_back(first_object_vertex + index);
+  for (const SceneObjects::Draw& draw : objects.draws) {
+    scene_draws.push_back({first_object_index + draw.first_index, draw.index_count, &constants, draw.texture + 1});
+    reflection_draws.push_back(
+        {first_object_index + draw.first_index, draw.index_count, &reflection_constants, draw.texture + 1});
+  }
+  for (BaseColorTexture& texture : objects.textures) {
+    static_images.push_back({"base colour", kBaseColorFormat, {texture.width, texture.height},
+                             std::move(texture.texels), std::move(texture.mip_offsets), {}, {}});
+  }
+  objects = SceneObjects{};  // copied into the static data
   static_buffers[kSceneVertices].bytes = bytes_of(geometry.vertices);
   static_buffers[kSceneIndices].bytes = bytes_of(geometry.indices);
-  SIVIFLOW_TRY(simulation.create(river, flow_params, obstacles, info.seed,
+  std::vector<Obstacle> flow_obstacles = obstacles;
+  flow_obstacles.insert(flow_obstacles.end(), object_obstacles.begin(), object_obstacles.end());
+  SIVIFLOW_TRY(simulation.create(river, flow_params, std::move(flow_obstacles), info.seed,
                                  {info.extent.width, info.extent.height}));
   const RiverMesh& river_mesh = simulation.mesh();
   river_index_count = static_cast<uint32_t>(river_mesh.indices.size());
@@ -344,8 +369,9 @@ Status Renderer::Impl::declare_static_graph() {
   SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
   SIVIFLOW_TRY(flow_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat,
                                 info.enable_readback, info.enable_timing));
-  scene_pass.set_detail_texture(gpu, static_images[kDetail].image.view);
-  return Status::success();
+  std::vector<VkImageView> base_colors;
+  for (size_t n = kFirstBaseColor; n < static_images.size(); ++n) base_colors.push_back(static_images[n].image.view);
+  return scene_pass.set_textures(gpu, static_images[kDetail].image.view, base_colors);
 }
 
 ImageHandle Renderer::Impl::frame_image(ImageHandle handle, bool persistent) {
@@ -392,6 +418,9 @@ Status Renderer::Impl::declare_graph() {
   mirrored.vertices = static_buffers[kSceneVertices].in_frame_graph;
   mirrored.indices = static_buffers[kSceneIndices].in_frame_graph;
   mirrored.detail = static_images[kDetail].in_frame_graph;
+  for (size_t n = kFirstBaseColor; n < static_images.size(); ++n) {
+    mirrored.base_colors.push_back(static_images[n].in_frame_graph);
+  }
   if (info.reflection != nullptr) {
     declare_host_reflection(&mirrored);
   } else {
@@ -408,6 +437,7 @@ Status Renderer::Impl::declare_graph() {
   scene.vertices = static_buffers[kSceneVertices].in_frame_graph;
   scene.indices = static_buffers[kSceneIndices].in_frame_graph;
   scene.detail = static_images[kDetail].in_frame_graph;
+  scene.base_colors = mirrored.base_colors;
   scene_pass.declare(graph, "scene", &scene_draws, &scene);
 
   // flow: the water material over the scene.

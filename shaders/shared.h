@@ -8,10 +8,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 namespace siviflow::gpu {
 using mat4 = glm::mat4;
+using vec2 = glm::vec2;
 using vec3 = glm::vec3;
 using vec4 = glm::vec4;
 using uint = uint32_t;
@@ -21,18 +23,21 @@ using uint = uint32_t;
 #define SIVIFLOW_ATTR_POSITION 0
 #define SIVIFLOW_ATTR_NORMAL 1
 #define SIVIFLOW_ATTR_COLOR 2
+#define SIVIFLOW_ATTR_TEXCOORD 3
 
 #ifdef __cplusplus
 // One vertex of the scene pipeline's vertex buffer (GLSL reads it through the attributes above).
 struct SceneVertex {
   vec3 position;
   vec3 normal;
-  vec4 color;  // rgb linear albedo, a ambient occlusion
+  vec4 color;  // rgb linear albedo (objects: base-colour factor), a ambient occlusion
+  vec2 texcoord;  // objects: base-colour texture coordinates; terrain: unused
 };
-static_assert(sizeof(SceneVertex) == 40);
+static_assert(sizeof(SceneVertex) == 48);
 static_assert(offsetof(SceneVertex, position) == 0);
 static_assert(offsetof(SceneVertex, normal) == 12);
 static_assert(offsetof(SceneVertex, color) == 24);
+static_assert(offsetof(SceneVertex, texcoord) == 40);
 #endif
 
 // Push constants of the sky and scene pipelines: one block for both, 128 bytes (the guaranteed

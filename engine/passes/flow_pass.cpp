@@ -69,7 +69,7 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   // A new set first: on failure the current one stays valid.
   VkDescriptorPool pool = VK_NULL_HANDLE;
   VkDescriptorSet set = VK_NULL_HANDLE;
-  const Status allocated = allocate_sampler_set(gpu, set_layout_, kBindingCount, &pool, &set);
+  const Status allocated = allocate_sampler_sets(gpu, set_layout_, kBindingCount, 1, &pool, &set);
   if (!allocated.ok()) {
     if (pool != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool, gpu.allocation_callbacks);
     return allocated;

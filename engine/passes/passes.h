@@ -55,6 +55,9 @@ struct SceneDraw {
   uint32_t first_index = 0;
   uint32_t index_count = 0;
   const gpu::SceneConstants* constants = nullptr;  // read when the pass records
+  // 0: terrain material (vertex colours and the ground detail); k > 0: object material with
+  // base-colour texture k - 1 of ScenePass::set_textures.
+  uint32_t material = 0;
 };
 
 class ScenePass {
@@ -62,8 +65,10 @@ class ScenePass {
   Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
                 VkFormat depth_format);
   void destroy(const GpuContext& gpu);
-  // Points the pass's descriptor at the ground-detail texture (once, after it is created).
-  void set_detail_texture(const GpuContext& gpu, VkImageView view);
+  // Points the pass's descriptors at the ground-detail texture and the objects' base-colour
+  // textures (once, after they are created).
+  Status set_textures(const GpuContext& gpu, VkImageView detail,
+                      const std::vector<VkImageView>& base_colors);
 
   struct Handles {
     ImageHandle color;
@@ -71,6 +76,7 @@ class ScenePass {
     BufferHandle vertices;
     BufferHandle indices;
     ImageHandle detail;
+    std::vector<ImageHandle> base_colors;  // in the order of set_textures
   };
   // Declares a pass drawing the scene's `draws` then the sky (the main view as "scene", the
   // mirrored view as "reflection"); the new versions of colour and depth go back into `handles`.
@@ -81,10 +87,12 @@ class ScenePass {
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet set_ = VK_NULL_HANDLE;
-  VkSampler sampler_ = VK_NULL_HANDLE;
+  std::vector<VkDescriptorSet> sets_;  // per material: the detail texture, then base colours
+  VkSampler detail_sampler_ = VK_NULL_HANDLE;
+  VkSampler base_color_sampler_ = VK_NULL_HANDLE;
   VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
   VkPipeline scene_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline object_pipeline_ = VK_NULL_HANDLE;
 };
 
 // ---- flow: the water material of Algorithm 3, drawn over the scene ----

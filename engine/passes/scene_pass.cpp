@@ -10,9 +10,10 @@ namespace siviflow {
 Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
                          VkFormat depth_format) {
   SIVIFLOW_TRY(create_pass_layout(gpu, 1, sizeof(gpu::SceneConstants), &set_layout_, &layout_));
-  SIVIFLOW_TRY(allocate_sampler_set(gpu, set_layout_, 1, &pool_, &set_));
   // The detail texture has one level: linear filtering, repeated over the terrain.
-  SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, false, &sampler_));
+  SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, false, &detail_sampler_));
+  // glTF's default sampler: linear, mipmapped, repeat.
+  SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, true, &base_color_sampler_));
 
   GraphicsPipelineDesc sky;
   sky.vertex_shader = "sky.vert";
@@ -34,32 +35,50 @@ Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat 
   scene.attributes = {
       {SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SceneVertex, position)},
       {SIVIFLOW_ATTR_NORMAL, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SceneVertex, normal)},
-      {SIVIFLOW_ATTR_COLOR, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(SceneVertex, color)}};
+      {SIVIFLOW_ATTR_COLOR, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(SceneVertex, color)},
+      {SIVIFLOW_ATTR_TEXCOORD, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(SceneVertex, texcoord)}};
   SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, scene, &scene_pipeline_));
-  return Status::success();
+  GraphicsPipelineDesc object = scene;
+  object.fragment_shader = "object.frag";
+  return create_graphics_pipeline(gpu, cache, object, &object_pipeline_);
 }
 
 void ScenePass::destroy(const GpuContext& gpu) {
   const DeviceTable& vk = *gpu.table;
   const VkAllocationCallbacks* callbacks = gpu.allocation_callbacks;
-  if (scene_pipeline_ != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, scene_pipeline_, callbacks);
-  if (sky_pipeline_ != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, sky_pipeline_, callbacks);
-  if (sampler_ != VK_NULL_HANDLE) vk.vkDestroySampler(vk.device, sampler_, callbacks);
+  for (VkPipeline pipeline : {object_pipeline_, scene_pipeline_, sky_pipeline_}) {
+    if (pipeline != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline, callbacks);
+  }
+  for (VkSampler sampler : {detail_sampler_, base_color_sampler_}) {
+    if (sampler != VK_NULL_HANDLE) vk.vkDestroySampler(vk.device, sampler, callbacks);
+  }
   if (pool_ != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool_, callbacks);
   if (layout_ != VK_NULL_HANDLE) vk.vkDestroyPipelineLayout(vk.device, layout_, callbacks);
   if (set_layout_ != VK_NULL_HANDLE) vk.vkDestroyDescriptorSetLayout(vk.device, set_layout_, callbacks);
   *this = ScenePass{};
 }
 
-void ScenePass::set_detail_texture(const GpuContext& gpu, VkImageView view) {
-  VkDescriptorImageInfo image{sampler_, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-  VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  write.dstSet = set_;
-  write.dstBinding = 0;
-  write.descriptorCount = 1;
-  write.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-  write.pImageInfo = &image;
-  gpu.table->vkUpdateDescriptorSets(gpu.table->device, 1, &write, 0, nullptr);
+Status ScenePass::set_textures(const GpuContext& gpu, VkImageView detail,
+                               const std::vector<VkImageView>& base_colors) {
+  sets_.resize(1 + base_colors.size());
+  SIVIFLOW_TRY(allocate_sampler_sets(gpu, set_layout_, 1, static_cast<uint32_t>(sets_.size()), &pool_,
+                                     sets_.data()));
+  std::vector<VkDescriptorImageInfo> images;
+  images.push_back({detail_sampler_, detail, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  for (VkImageView view : base_colors) {
+    images.push_back({base_color_sampler_, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  }
+  std::vector<VkWriteDescriptorSet> writes(sets_.size(), {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET});
+  for (size_t i = 0; i < writes.size(); ++i) {
+    writes[i].dstSet = sets_[i];
+    writes[i].dstBinding = 0;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    writes[i].pImageInfo = &images[i];
+  }
+  gpu.table->vkUpdateDescriptorSets(gpu.table->device, static_cast<uint32_t>(writes.size()),
+                                    writes.data(), 0, nullptr);
+  return Status::success();
 }
 
 void ScenePass::declare(FrameGraph& graph, const char* pass_name,
@@ -70,20 +89,27 @@ void ScenePass::declare(FrameGraph& graph, const char* pass_name,
   pass.vertex_read(handles->vertices);
   pass.index_read(handles->indices);
   pass.sampled_fragment(handles->detail);
+  for (ImageHandle base_color : handles->base_colors) pass.sampled_fragment(base_color);
   const Handles h = *handles;
   pass.record([this, h, draws](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
     const VkCommandBuffer cmd = ctx.cmd();
     constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
     set_viewport(vk, cmd, ctx.extent(h.color));
-    vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &set_, 0, nullptr);
     // Terrain and objects first, so the sky's fragments are depth-tested away behind them.
-    vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, scene_pipeline_);
     const VkBuffer vertices = ctx.buffer(h.vertices);
     const VkDeviceSize offset = 0;
     vk.vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
     vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
+    VkPipeline bound = VK_NULL_HANDLE;
     for (const SceneDraw& draw : *draws) {
+      const VkPipeline pipeline = draw.material == 0 ? scene_pipeline_ : object_pipeline_;
+      if (pipeline != bound) {
+        vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+        bound = pipeline;
+      }
+      vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1,
+                                 &sets_[draw.material], 0, nullptr);
       vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), draw.constants);
       vk.vkCmdDrawIndexed(cmd, draw.index_count, 1, draw.first_index, 0, 0);
     }

@@ -1,6 +1,7 @@
 #include "vk/pipeline.h"
 
 #include <string>
+#include <vector>
 
 #include "shader_registry.h"
 
@@ -169,21 +170,23 @@ Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_
                    "vkCreatePipelineLayout");
 }
 
-Status allocate_sampler_set(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
-                            uint32_t sampler_count, VkDescriptorPool* pool, VkDescriptorSet* set) {
+Status allocate_sampler_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
+                             uint32_t sampler_count, uint32_t set_count, VkDescriptorPool* pool,
+                             VkDescriptorSet* sets) {
   const DeviceTable& vk = *gpu.table;
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, sampler_count};
+  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, sampler_count * set_count};
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = 1;
+  pool_info.maxSets = set_count;
   pool_info.poolSizeCount = 1;
   pool_info.pPoolSizes = &size;
   SIVIFLOW_TRY(vk_status(vk.vkCreateDescriptorPool(vk.device, &pool_info, gpu.allocation_callbacks, pool),
                          "vkCreateDescriptorPool"));
   VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
   alloc.descriptorPool = *pool;
-  alloc.descriptorSetCount = 1;
-  alloc.pSetLayouts = &set_layout;
-  return vk_status(vk.vkAllocateDescriptorSets(vk.device, &alloc, set), "vkAllocateDescriptorSets");
+  const std::vector<VkDescriptorSetLayout> layouts(set_count, set_layout);
+  alloc.descriptorSetCount = set_count;
+  alloc.pSetLayouts = layouts.data();
+  return vk_status(vk.vkAllocateDescriptorSets(vk.device, &alloc, sets), "vkAllocateDescriptorSets");
 }
 
 Status create_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMode address,

@@ -41,9 +41,10 @@ Status vk_status(VkResult result, const char* call);
 Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_t push_constant_bytes,
                           VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout);
 
-// One set of that layout from a pool of its own (destroy the pool to free it).
-Status allocate_sampler_set(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
-                            uint32_t sampler_count, VkDescriptorPool* pool, VkDescriptorSet* set);
+// `set_count` sets of that layout from a pool of their own (destroy the pool to free them).
+Status allocate_sampler_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
+                             uint32_t sampler_count, uint32_t set_count, VkDescriptorPool* pool,
+                             VkDescriptorSet* sets);
 
 Status create_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMode address,
                       bool mipmapped, VkSampler* out);

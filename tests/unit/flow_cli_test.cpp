@@ -14,6 +14,7 @@
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 
+#include "gltf_test_files.h"
 #include "run_command.h"
 #include "sim/procedural_river.h"
 
@@ -43,10 +44,6 @@ std::vector<Row> read_csv(const fs::path& path, std::string* header) {
   return rows;
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-}
-
 class FlowCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -57,43 +54,6 @@ class FlowCliTest : public ::testing::Test {
   }
   fs::path dir_;
 };
-
-// A straight channel along +Z, `across` vertices per section, width w, as glTF with a .bin.
-void write_channel_gltf(const fs::path& gltf, int sections, int across, float width, float spacing) {
-  std::vector<float> positions;
-  for (int k = 0; k < sections; ++k) {
-    for (int j = 0; j < across; ++j) {
-      positions.push_back(width * 0.5f - width * static_cast<float>(j) / (across - 1));  // left = +X
-      positions.push_back(0.0f);
-      positions.push_back(spacing * static_cast<float>(k));
-    }
-  }
-  std::vector<uint32_t> indices;
-  for (int k = 0; k + 1 < sections; ++k) {
-    for (int j = 0; j + 1 < across; ++j) {
-      const uint32_t a = k * across + j, b = a + 1, c = a + across, d = c + 1;
-      indices.insert(indices.end(), {a, c, b, b, c, d});
-    }
-  }
-  const size_t position_bytes = positions.size() * sizeof(float);
-  const size_t index_bytes = indices.size() * sizeof(uint32_t);
-  std::ofstream bin(fs::path(gltf).replace_extension(".bin"), std::ios::binary);
-  bin.write(reinterpret_cast<const char*>(positions.data()), static_cast<std::streamsize>(position_bytes));
-  bin.write(reinterpret_cast<const char*>(indices.data()), static_cast<std::streamsize>(index_bytes));
-  bin.close();
-  const float half = width * 0.5f;
-  std::ostringstream json;
-  json << R"({"asset":{"version":"2.0"},"meshes":[{"name":"River","primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
-       << R"("buffers":[{"uri":")" << fs::path(gltf).replace_extension(".bin").filename().string()
-       << R"(","byteLength":)" << position_bytes + index_bytes << "}],"
-       << R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" << position_bytes
-       << R"(},{"buffer":0,"byteOffset":)" << position_bytes << R"(,"byteLength":)" << index_bytes << "}],"
-       << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << positions.size() / 3
-       << R"(,"type":"VEC3","min":[)" << -half << ",0,0],\"max\":[" << half << ",0,"
-       << spacing * static_cast<float>(sections - 1) << "]},"
-       << R"({"bufferView":1,"componentType":5125,"count":)" << indices.size() << R"(,"type":"SCALAR"}]})";
-  write_text(gltf, json.str());
-}
 
 TEST_F(FlowCliTest, StraightGltfChannelIsUniformAndInAccessorOrder) {
   constexpr int kSections = 30;
@@ -177,38 +137,6 @@ TEST_F(FlowCliTest, ProceduralRiverWithAMovingObstacle) {
   }
   EXPECT_GT(dry0, 0u) << "the obstacle in mid-river makes some vertices dry";
   EXPECT_GT(dry2, 0u);
-}
-
-// An axis-aligned box from -half to +half (12 triangles, indexed), as glTF with a .bin.
-void write_box_gltf(const fs::path& gltf, const glm::vec3& half) {
-  std::vector<float> positions;
-  for (int i = 0; i < 8; ++i) {
-    positions.push_back((i & 1) ? half.x : -half.x);
-    positions.push_back((i & 2) ? half.y : -half.y);
-    positions.push_back((i & 4) ? half.z : -half.z);
-  }
-  const std::vector<uint16_t> indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6,   // -z, +z
-                                         0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7,   // -y, +y
-                                         0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};  // -x, +x
-  const size_t position_bytes = positions.size() * sizeof(float);
-  const size_t index_bytes = indices.size() * sizeof(uint16_t);
-  const fs::path bin = fs::path(gltf).replace_extension(".bin");
-  std::ofstream out(bin, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(positions.data()), static_cast<std::streamsize>(position_bytes));
-  out.write(reinterpret_cast<const char*>(indices.data()), static_cast<std::streamsize>(index_bytes));
-  out.close();
-  std::ostringstream json;
-  json << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
-       << R"("meshes":[{"name":"Box","primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
-       << R"("buffers":[{"uri":")" << bin.filename().string() << R"(","byteLength":)"
-       << position_bytes + index_bytes << "}],"
-       << R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" << position_bytes
-       << R"(},{"buffer":0,"byteOffset":)" << position_bytes << R"(,"byteLength":)" << index_bytes << "}],"
-       << R"("accessors":[{"bufferView":0,"componentType":5126,"count":8,"type":"VEC3","min":[)"
-       << -half.x << "," << -half.y << "," << -half.z << "],\"max\":[" << half.x << "," << half.y
-       << "," << half.z << "]},"
-       << R"({"bufferView":1,"componentType":5123,"count":)" << indices.size() << R"(,"type":"SCALAR"}]})";
-  write_text(gltf, json.str());
 }
 
 // Even-odd point-in-polygon test in the XZ plane.

@@ -6,7 +6,7 @@ packages=(
   cmake ninja-build g++ pkg-config
   mesa-vulkan-drivers libvulkan-dev vulkan-validationlayers vulkan-tools
   glslang-tools spirv-tools
-  libglm-dev libtinygltf-dev libopenexr-dev libpng-dev nlohmann-json3-dev
+  libglm-dev libtinygltf-dev libopenexr-dev libpng-dev libjpeg62-turbo-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
 )
 missing=()
