@@ -1,0 +1,138 @@
+// glTF objects of a scene file on screen: drawn with their base-colour texture and factor,
+// reflected in the water when above it and not at all when wholly under it (the clip plane),
+// and a broken texture refused with a message naming it.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+#include <gtest/gtest.h>
+
+#include "gltf_test_files.h"
+#include "run_command.h"
+#include "siviflow/image_files.h"
+
+namespace siviflow::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kWidth = 320;
+constexpr int kHeight = 180;
+
+class SceneObjectsTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(SIVIFLOW_BINARY_DIR) / "tests" / "scene_objects" /
+           ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "out");
+  }
+  // Writes `name`.json (default procedural river, the given objects and camera) and captures
+  // its frame 0 with `aovs` into out/`name`/.
+  ExrImage capture(const std::string& name, const std::string& objects, const std::string& camera,
+                   const std::string& aovs) {
+    const fs::path scene = dir_ / (name + ".json");
+    write_text(scene, R"({"version":1,"river":{"procedural":{}},"objects":[)" + objects +
+                          R"(],"camera":)" + camera + "}");
+    const fs::path out = dir_ / "out" / name;
+    fs::create_directories(out);
+    const RunResult r = run_siviflow("capture " + scene.string() + " --frames 1 --size " +
+                                     std::to_string(kWidth) + "x" + std::to_string(kHeight) +
+                                     " --aov " + aovs + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    ExrImage image;
+    EXPECT_TRUE(read_exr((out / "frame_00000.exr").string(), &image).ok());
+    return image;
+  }
+  // A PNG of one colour (linear RGB), 8x8, beside the scene.
+  void write_color_png(const std::string& name, glm::vec3 color) {
+    std::vector<float> rgba;
+    for (int i = 0; i < 64; ++i) rgba.insert(rgba.end(), {color.r, color.g, color.b, 1.0f});
+    ASSERT_TRUE(write_png((dir_ / name).string(), 8, 8, rgba.data()).ok());
+  }
+  fs::path dir_;
+};
+
+std::string object(const std::string& gltf, glm::vec3 at) {
+  char text[256];
+  std::snprintf(text, sizeof(text), R"({"gltf":"%s","translation":[%g,%g,%g]})", gltf.c_str(),
+                at.x, at.y, at.z);
+  return text;
+}
+
+// Looking down the river at the reach around z = -25, where it runs from x = 3 to x = 14.
+const std::string kRiverCamera = R"({"keys":[{"t":0,"position":[8.5,3.0,-40.0],"target":[8.5,0.0,-25.0]}]})";
+
+TEST_F(SceneObjectsTest, ObjectAboveTheWaterIsReflectedAndOneUnderItIsNot) {
+  write_box_gltf(dir_ / "post.gltf", glm::vec3(0.8f, 1.5f, 0.8f));
+  write_box_gltf(dir_ / "stone.gltf", glm::vec3(0.4f));
+  const ExrImage none = capture("none", "", kRiverCamera, "reflection,flow");
+  // Not obstacles: the flow, and so the water's normal, stays the same in all three.
+  const ExrImage above = capture("above", object("post.gltf", {8.5f, 2.0f, -22.0f}), kRiverCamera,
+                                 "reflection,flow");
+  const ExrImage under = capture("under", object("stone.gltf", {8.5f, -1.0f, -28.0f}), kRiverCamera,
+                                 "reflection,flow");
+  const std::vector<float>* mask = none.find("water.mask");
+  ASSERT_NE(mask, nullptr);
+  size_t water = 0;
+  size_t reflected = 0;
+  float under_difference = 0.0f;
+  for (size_t i = 0; i < mask->size(); ++i) {
+    if ((*mask)[i] != 1.0f) continue;
+    ++water;
+    float above_difference = 0.0f;
+    for (const char* channel : {"reflection.R", "reflection.G", "reflection.B"}) {
+      const float reference = (*none.find(channel))[i];
+      above_difference = std::max(above_difference, std::abs((*above.find(channel))[i] - reference));
+      under_difference = std::max(under_difference, std::abs((*under.find(channel))[i] - reference));
+    }
+    reflected += above_difference > 0.05f ? 1 : 0;
+  }
+  std::printf("%zu water pixels: %zu show the post's reflection; largest change from the stone %g\n",
+              water, reflected, under_difference);
+  ASSERT_GT(water, size_t{kWidth * kHeight / 4}) << "the camera looks at the river";
+  EXPECT_GT(reflected, 150u) << "the post above the water is reflected in it";
+  EXPECT_EQ(under_difference, 0.0f) << "nothing under the water is reflected";
+}
+
+TEST_F(SceneObjectsTest, ObjectShowsItsBaseColourTextureTimesItsFactor) {
+  write_color_png("blue.png", {0.05f, 0.1f, 0.8f});
+  write_textured_box_gltf(dir_ / "blue.gltf", glm::vec3(1.0f), "blue.png", glm::vec4(1.0f));
+  write_textured_box_gltf(dir_ / "dark.gltf", glm::vec3(1.0f), "blue.png", glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+  // High above the valley, so the sky is behind it; the camera faces its -Z side.
+  const std::string camera = R"({"keys":[{"t":0,"position":[0,30,-8],"target":[0,30,0]}]})";
+  const ExrImage blue = capture("blue", object("blue.gltf", {0.0f, 30.0f, 0.0f}), camera, "depth");
+  const ExrImage dark = capture("dark", object("dark.gltf", {0.0f, 30.0f, 0.0f}), camera, "depth");
+  const size_t centre = size_t{kHeight / 2} * kWidth + kWidth / 2;
+  EXPECT_NEAR((*blue.find("depth.Z"))[centre], 7.0f, 0.01f) << "the box's near face is 7 m away";
+  const float r = (*blue.find("R"))[centre];
+  const float g = (*blue.find("G"))[centre];
+  const float b = (*blue.find("B"))[centre];
+  std::printf("blue box %g %g %g; red factor on it %g %g %g\n", r, g, b, (*dark.find("R"))[centre],
+              (*dark.find("G"))[centre], (*dark.find("B"))[centre]);
+  EXPECT_GT(b, 4.0f * r) << "the texture's blue, lit";
+  EXPECT_GT(b, 2.0f * g);
+  // Red factor times a blue texture: little light comes back, and mostly red.
+  EXPECT_LT((*dark.find("B"))[centre], 0.1f * b);
+  EXPECT_GT((*dark.find("R"))[centre], (*dark.find("B"))[centre]);
+}
+
+TEST_F(SceneObjectsTest, BrokenTextureIsRefusedNamingIt) {
+  write_text(dir_ / "broken.png", std::string("\x89PNG\r\n\x1a\n", 8) + "not really a png");
+  write_textured_box_gltf(dir_ / "crate.gltf", glm::vec3(1.0f), "broken.png", glm::vec4(1.0f));
+  write_text(dir_ / "scene.json", R"({"version":1,"river":{"procedural":{}},"objects":[)" +
+                                      object("crate.gltf", {0.0f, 2.0f, 0.0f}) + "]}");
+  const RunResult r = run_siviflow("capture " + (dir_ / "scene.json").string() + " --frames 1 --out " +
+                                   (dir_ / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("scene.json: objects[0]"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("crate.gltf"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::is_empty(dir_ / "out")) << "nothing written";
+}
+
+}  // namespace
+}  // namespace siviflow::testing
