@@ -86,7 +86,11 @@ struct Renderer::Impl {
   DeviceTable table;
   GpuContext gpu;
   FrameRing ring;
-  ProceduralRiver river{default_river_params()};
+  ProceduralRiver river{default_river_params()};  // the default scene's, or the scene file's
+  bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
+  RiverMesh river_mesh;           // handed to the simulation by create_static_resources
+  std::vector<float> river_slope;
+  std::vector<float> water_heights;  // this frame's live particles' heights
   FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
   std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is this frame
   SceneObjects objects;             // the scene file's glTF objects, drawn where they stand
@@ -184,6 +188,7 @@ struct Renderer::Impl {
   const Image* find_frame_image(ImageHandle handle) const;
   Status stage_static_data();
   Status simulate(const Camera& camera, double time_seconds);
+  float visible_water_level();
   Status record_static_upload(VkCommandBuffer cmd);
   Status create_query_pools();
   void declare_host_reflection(ScenePass::Handles* mirrored);
@@ -259,21 +264,28 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
 }
 
 Status Renderer::Impl::take_scene() {
-  obstacles = default_scene_obstacles(river);
-  if (info.scene == nullptr) return Status::success();
-  const SceneFile& scene = *info.scene;
-  if (scene.river.source != SceneRiver::Source::kProcedural) {
-    return invalid(scene.path + ": rendering a glTF river is not supported yet (siviflow flow "
-                   "solves it); use a procedural river");
+  if (info.scene == nullptr) {
+    obstacles = default_scene_obstacles(river);
+    return procedural_river_mesh(river, &river_mesh, &river_slope);
   }
-  SIVIFLOW_TRY(ProceduralRiver::validate(scene.river.procedural));
-  river = ProceduralRiver(scene.river.procedural);
+  const SceneFile& scene = *info.scene;
+  const auto in_scene = [&scene](const Status& status) {
+    return status.ok() ? status : Status::error(scene.path + ": " + status.message(), status.code());
+  };
+  if (scene.river.source == SceneRiver::Source::kGltf) {
+    TriangleMesh gltf;
+    SIVIFLOW_TRY(in_scene(load_river_mesh(scene.river.gltf, scene.river.mesh, &gltf)));
+    SIVIFLOW_TRY(in_scene(gltf_river_mesh(gltf, &river_mesh, &river_slope)));
+    river_from_file = true;
+  } else {
+    SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(scene.river.procedural)));
+    river = ProceduralRiver(scene.river.procedural);
+    SIVIFLOW_TRY(in_scene(procedural_river_mesh(river, &river_mesh, &river_slope)));
+  }
   flow_params = scene.flow;
   obstacles = scene.obstacles;
   camera_path = scene.camera;
   SIVIFLOW_TRY(load_scene_objects(scene, &objects));
-  RiverMesh river_mesh;
-  SIVIFLOW_TRY(river.generate_mesh(&river_mesh));
   return scene_object_obstacles(scene, river_mesh.positions, &object_obstacles);
 }
 
@@ -282,7 +294,8 @@ Status Renderer::Impl::create_static_resources() {
     const auto* first = reinterpret_cast<const uint8_t*>(items.data());
     return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
   };
-  SceneGeometry geometry = build_scene_geometry(river, obstacles);
+  SceneGeometry geometry = river_from_file ? build_riverbed_geometry(river_mesh, obstacles)
+                                           : build_scene_geometry(river, obstacles);
   // Sized once: the draws point into it.
   obstacle_constants.resize(2 * obstacles.size());
   scene_draws = {{0, geometry.static_index_count, &constants}};
@@ -311,13 +324,14 @@ Status Renderer::Impl::create_static_resources() {
   static_buffers[kSceneIndices].bytes = bytes_of(geometry.indices);
   std::vector<Obstacle> flow_obstacles = obstacles;
   flow_obstacles.insert(flow_obstacles.end(), object_obstacles.begin(), object_obstacles.end());
-  SIVIFLOW_TRY(simulation.create(river, flow_params, std::move(flow_obstacles), info.seed,
+  SIVIFLOW_TRY(simulation.create(std::move(river_mesh), std::move(river_slope), flow_params,
+                                 std::move(flow_obstacles), info.seed,
                                  {info.extent.width, info.extent.height}));
-  const RiverMesh& river_mesh = simulation.mesh();
-  river_index_count = static_cast<uint32_t>(river_mesh.indices.size());
-  static_buffers[kRiverVertices].bytes = bytes_of(river_mesh.positions);
-  static_buffers[kRiverDepths].bytes = bytes_of(river_mesh.depth);
-  static_buffers[kRiverIndices].bytes = bytes_of(river_mesh.indices);
+  const RiverMesh& surface = simulation.mesh();
+  river_index_count = static_cast<uint32_t>(surface.indices.size());
+  static_buffers[kRiverVertices].bytes = bytes_of(surface.positions);
+  static_buffers[kRiverDepths].bytes = bytes_of(surface.depth);
+  static_buffers[kRiverIndices].bytes = bytes_of(surface.indices);
 
   DetailTexture detail = make_detail_texture();
   static_images[kDetail].extent = {detail.size, detail.size};
@@ -669,10 +683,12 @@ Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
   constants.clip_plane = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // main view: nothing clipped
   constants.fog = fog;
 
+  SIVIFLOW_TRY(simulation.set_time(time_seconds));
+  SIVIFLOW_TRY(simulation.simulate(constants.view_proj, dt));
+
   // The reflection renders the scene mirrored about the water plane y = h from the real camera,
   // so the flow pass samples it at its own screen position; only what is above the water stays.
-  // The default river is level: the visible reach's plane is the water level itself.
-  const float h = river.water_level();
+  const float h = visible_water_level();
   glm::mat4 mirror(1.0f);
   mirror[1][1] = -1.0f;
   mirror[3][1] = 2.0f * h;
@@ -693,15 +709,28 @@ Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
   // The obstacles where they are this frame, each drawn as a translated boulder.
-  SIVIFLOW_TRY(simulation.set_time(time_seconds));
   for (size_t i = 0; i < obstacles.size(); ++i) {
     const glm::vec3 offset = simulation.obstacle_centre(i);
     obstacle_constants[2 * i] = translated(constants, offset);
     obstacle_constants[2 * i + 1] = translated(reflection_constants, offset);
   }
-  SIVIFLOW_TRY(simulation.simulate(constants.view_proj, dt));
   last_time = time_seconds;
   return Status::success();
+}
+
+// The plane of the visible reach: the median height of this frame's live particles. They are
+// spread evenly over the water on screen, so this is the level of most of the water seen (a
+// level river's own level); a descending river's reflection is right where most of it shows.
+float Renderer::Impl::visible_water_level() {
+  std::vector<float>& heights = water_heights;  // kept: a steady frame allocates nothing
+  heights.clear();
+  for (const Particle& p : simulation.particle_field().particles()) {
+    if (p.live()) heights.push_back(p.world.y);
+  }
+  if (heights.empty()) return simulation.mesh().positions.front().y;  // no water on screen
+  const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
+  std::nth_element(heights.begin(), middle, heights.end());
+  return *middle;
 }
 
 Status Renderer::simulate(const Camera& camera, double time_seconds) {
@@ -812,7 +841,8 @@ Status Renderer::resize(VkExtent2D extent) {
 Camera Renderer::scene_camera(double time_seconds) const {
   const SceneCamera& path = impl_->camera_path;
   if (path.keys.empty()) {
-    Camera camera = default_camera(impl_->river, time_seconds);
+    Camera camera = impl_->river_from_file ? river_overview_camera(impl_->simulation.mesh().positions)
+                                           : default_camera(impl_->river, time_seconds);
     if (impl_->info.scene != nullptr) camera.fov_y_deg = path.fov_y_deg;
     return camera;
   }

@@ -14,6 +14,8 @@ constexpr int kTerrainRows = 160;      // quads along the valley (1.5 m)
 constexpr float kTerrainHalfWidth = 90.0f;
 constexpr float kInRiverRadius = 1.3f;  // the boulder in mid-river
 constexpr float kMovingRadius = 1.1f;   // the boulder that rolls into the river
+constexpr glm::vec3 kGranite(0.46f, 0.44f, 0.42f);
+constexpr glm::vec3 kSandstone(0.55f, 0.45f, 0.35f);
 
 glm::vec3 terrain_normal(const ProceduralRiver& river, float x, float z) {
   const float e = 0.5f;
@@ -124,6 +126,19 @@ glm::vec3 on_ground(const ProceduralRiver& river, float lateral_offset, float z)
   return {x, river.terrain_height(x, z), z};
 }
 
+// The obstacles: a boulder as wide as each footprint, slightly squat, modelled at the origin.
+void add_obstacle_boulders(const std::vector<Obstacle>& obstacles, SceneGeometry* geometry) {
+  geometry->static_index_count = static_cast<uint32_t>(geometry->indices.size());
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    float radius = obstacles[i].radius;
+    for (const glm::vec2& corner : obstacles[i].polygon) radius = std::max(radius, glm::length(corner));
+    const uint32_t first = static_cast<uint32_t>(geometry->indices.size());
+    add_boulder(glm::vec3(0.0f), {radius, 0.95f * radius, 0.92f * radius},
+                i % 2 == 0 ? kGranite : kSandstone, 3.0f + static_cast<float>(i), geometry);
+    geometry->obstacle_boulders.push_back({first, static_cast<uint32_t>(geometry->indices.size()) - first});
+  }
+}
+
 }  // namespace
 
 SceneLook default_scene_look() { return SceneLook{}; }
@@ -148,27 +163,57 @@ ProceduralRiverParams default_river_params() { return ProceduralRiverParams{}; }
 SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles) {
   SceneGeometry geometry;
   add_terrain(river, &geometry);
-  const glm::vec3 granite(0.46f, 0.44f, 0.42f);
-  const glm::vec3 sandstone(0.55f, 0.45f, 0.35f);
   // Boulders on both banks.
-  add_boulder(on_ground(river, -10.0f, -20.0f) + glm::vec3(0, 0.6f, 0), {2.2f, 1.6f, 1.9f}, granite, 1.0f, &geometry);
-  add_boulder(on_ground(river, 11.0f, 12.0f) + glm::vec3(0, 0.5f, 0), {1.6f, 1.2f, 1.5f}, sandstone, 2.0f, &geometry);
+  add_boulder(on_ground(river, -10.0f, -20.0f) + glm::vec3(0, 0.6f, 0), {2.2f, 1.6f, 1.9f}, kGranite, 1.0f, &geometry);
+  add_boulder(on_ground(river, 11.0f, 12.0f) + glm::vec3(0, 0.5f, 0), {1.6f, 1.2f, 1.5f}, kSandstone, 2.0f, &geometry);
   for (int i = 0; i < 6; ++i) {
     const float z = -60.0f + 22.0f * static_cast<float>(i);
     const float side = (i % 2 == 0) ? -1.0f : 1.0f;
     add_tree(on_ground(river, side * (13.0f + 3.0f * static_cast<float>(i % 3)), z), 7.0f + static_cast<float>(i % 3), &geometry);
   }
-  geometry.static_index_count = static_cast<uint32_t>(geometry.indices.size());
-  // The obstacles: a boulder as wide as each footprint, slightly squat.
-  for (size_t i = 0; i < obstacles.size(); ++i) {
-    float radius = obstacles[i].radius;
-    for (const glm::vec2& corner : obstacles[i].polygon) radius = std::max(radius, glm::length(corner));
-    const uint32_t first = static_cast<uint32_t>(geometry.indices.size());
-    add_boulder(glm::vec3(0.0f), {radius, 0.95f * radius, 0.92f * radius}, i % 2 == 0 ? granite : sandstone,
-                3.0f + static_cast<float>(i), &geometry);
-    geometry.obstacle_boulders.push_back({first, static_cast<uint32_t>(geometry.indices.size()) - first});
-  }
+  add_obstacle_boulders(obstacles, &geometry);
   return geometry;
+}
+
+SceneGeometry build_riverbed_geometry(const RiverMesh& river, const std::vector<Obstacle>& obstacles) {
+  SceneGeometry geometry;
+  const glm::vec3 riverbed(0.30f, 0.27f, 0.21f);
+  const glm::vec3 sand(0.62f, 0.55f, 0.42f);
+  std::vector<glm::vec3> normals(river.positions.size(), glm::vec3(0.0f));
+  std::vector<glm::vec3> bed(river.positions.size());
+  for (size_t v = 0; v < bed.size(); ++v) bed[v] = river.positions[v] - glm::vec3(0.0f, river.depth[v], 0.0f);
+  for (size_t t = 0; t + 2 < river.indices.size(); t += 3) {
+    const glm::vec3& a = bed[river.indices[t]];
+    const glm::vec3 n = glm::cross(bed[river.indices[t + 1]] - a, bed[river.indices[t + 2]] - a);
+    for (int k = 0; k < 3; ++k) normals[river.indices[t + k]] += n;  // area-weighted
+  }
+  for (size_t v = 0; v < bed.size(); ++v) {
+    glm::vec3 n = glm::length(normals[v]) > 0.0f ? glm::normalize(normals[v]) : glm::vec3(0, 1, 0);
+    if (n.y < 0.0f) n = -n;  // the file's winding may face down; the bed is lit from above
+    const glm::vec3 albedo = glm::mix(sand, riverbed, glm::smoothstep(0.0f, 0.8f, river.depth[v]));
+    geometry.vertices.push_back({bed[v], n, glm::vec4(albedo, 1.0f)});
+  }
+  geometry.indices = river.indices;
+  add_obstacle_boulders(obstacles, &geometry);
+  return geometry;
+}
+
+Camera river_overview_camera(std::span<const glm::vec3> positions) {
+  glm::vec3 lo = positions.front();
+  glm::vec3 hi = lo;
+  for (const glm::vec3& p : positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  const glm::vec3 centre = 0.5f * (lo + hi);
+  const float extent = std::max(glm::length(hi - lo), 1.0f);
+  Camera camera;
+  camera.position = centre + glm::vec3(0.0f, 0.35f, -0.55f) * extent;
+  camera.target = centre;
+  camera.fov_y_deg = 55.0f;
+  camera.near_plane = 0.1f;
+  camera.far_plane = std::max(600.0f, 4.0f * extent);
+  return camera;
 }
 
 Camera default_camera(const ProceduralRiver& river, double time_seconds) {

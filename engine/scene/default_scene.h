@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -46,7 +47,13 @@ SceneLook default_scene_look();
 ProceduralRiverParams default_river_params();
 // Terrain of the river's valley, trees and boulders on its banks, and a boulder for each obstacle.
 SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles);
+// For a river from a file, which brings no terrain: its bed (the surface lowered by the depth
+// of each vertex), and a boulder for each obstacle. Banks and valley come from the scene's objects.
+SceneGeometry build_riverbed_geometry(const RiverMesh& river, const std::vector<Obstacle>& obstacles);
 // The camera of the default scene at time t (seconds): it glides down the valley.
 Camera default_camera(const ProceduralRiver& river, double time_seconds);
+// A still camera for a river from a file without camera keys: above and in front of its bounds,
+// looking at their centre.
+Camera river_overview_camera(std::span<const glm::vec3> positions);
 
 }  // namespace siviflow

@@ -13,10 +13,39 @@ constexpr float kSlopeStep = 0.5f;         // metres: finite-difference step of 
 
 }  // namespace
 
-Status RiverSimulation::create(const ProceduralRiver& river, const FlowParams& flow,
+Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh, std::vector<float>* slope) {
+  SIVIFLOW_TRY(river.generate_mesh(mesh));
+  slope->resize(mesh->positions.size());
+  for (size_t v = 0; v < mesh->positions.size(); ++v) {
+    const glm::vec3& p = mesh->positions[v];
+    const float dx = river.terrain_height(p.x + kSlopeStep, p.z) - river.terrain_height(p.x - kSlopeStep, p.z);
+    const float dz = river.terrain_height(p.x, p.z + kSlopeStep) - river.terrain_height(p.x, p.z - kSlopeStep);
+    (*slope)[v] = std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
+  }
+  return Status::success();
+}
+
+Status gltf_river_mesh(const TriangleMesh& gltf, RiverMesh* mesh, std::vector<float>* slope) {
+  RiverSurface surface;
+  SIVIFLOW_TRY(RiverSurface::build(gltf.positions, gltf.indices, RiverSurfaceOptions{}, &surface));
+  mesh->positions = gltf.positions;
+  mesh->indices = gltf.indices;
+  mesh->depth.resize(gltf.positions.size());
+  slope->resize(gltf.positions.size());
+  for (size_t v = 0; v < gltf.positions.size(); ++v) {
+    const RiverVertex vertex = surface.vertex(v);
+    const float w2 = vertex.width * vertex.width;
+    mesh->depth[v] = kGltfRiverDepth * 4.0f * vertex.d_left * vertex.d_right / w2;
+    (*slope)[v] = std::abs(kGltfRiverDepth * 4.0f * (vertex.d_right - vertex.d_left) / w2);
+  }
+  return Status::success();
+}
+
+Status RiverSimulation::create(RiverMesh mesh, std::vector<float> slope, const FlowParams& flow,
                                std::vector<Obstacle> obstacles, uint64_t seed, glm::uvec2 viewport) {
   viewport_ = viewport;
-  SIVIFLOW_TRY(river.generate_mesh(&mesh_));
+  mesh_ = std::move(mesh);
+  slope_ = std::move(slope);
   RiverSurface surface;
   SIVIFLOW_TRY(RiverSurface::build(mesh_.positions, mesh_.indices, RiverSurfaceOptions{}, &surface));
   SIVIFLOW_TRY(StreamFunction::create(std::move(surface), flow, &flow_));
@@ -25,14 +54,7 @@ Status RiverSimulation::create(const ProceduralRiver& river, const FlowParams& f
   const size_t count = mesh_.positions.size();
   velocity_.resize(count);
   speed_.resize(count);
-  slope_.resize(count);
   refresh_velocity();
-  for (size_t v = 0; v < count; ++v) {
-    const glm::vec3& p = mesh_.positions[v];
-    const float dx = river.terrain_height(p.x + kSlopeStep, p.z) - river.terrain_height(p.x - kSlopeStep, p.z);
-    const float dz = river.terrain_height(p.x, p.z + kSlopeStep) - river.terrain_height(p.x, p.z - kSlopeStep);
-    slope_[v] = std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
-  }
   RiverFlowField field;
   field.positions = mesh_.positions;
   field.indices = mesh_.indices;

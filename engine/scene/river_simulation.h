@@ -1,4 +1,4 @@
-// The simulation half of a frame for the default scene's river, on the CPU: the river surface
+// The simulation half of a frame for the scene's river, on the CPU: the river surface
 // and its stream-function flow (solved once), and the screen-space particles and flow textures
 // (kept every frame). No Vulkan: the renderer copies pack()'s bytes into its staging block.
 #pragma once
@@ -11,6 +11,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "scene/gltf_import.h"
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "sim/procedural_river.h"
@@ -20,13 +21,23 @@
 
 namespace siviflow {
 
+// A glTF river has no riverbed: its depth is this much in mid-river, falling as a parabola to
+// nothing at the banks (4 d_left d_right / width^2 of it).
+inline constexpr float kGltfRiverDepth = 1.5f;
+
+// The procedural river's mesh, and the slope of the terrain under each of its vertices.
+Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh, std::vector<float>* slope);
+// A glTF river's mesh with the depth profile above, and the slope of that riverbed across.
+Status gltf_river_mesh(const TriangleMesh& gltf, RiverMesh* mesh, std::vector<float>* slope);
+
 class RiverSimulation {
  public:
-  // Builds the river's surface mesh, solves its flow with the obstacles and sizes the particles
-  // and flow textures for `viewport`. Must not be moved after create(): the particles keep spans
-  // into this object's per-vertex arrays.
-  Status create(const ProceduralRiver& river, const FlowParams& flow, std::vector<Obstacle> obstacles,
-                uint64_t seed, glm::uvec2 viewport);
+  // Builds the surface of the river `mesh` (positions, indices, depth) with the riverbed `slope`
+  // per vertex, solves its flow with the obstacles and sizes the particles and flow textures for
+  // `viewport`. Must not be moved after create(): the particles keep spans into this object's
+  // per-vertex arrays.
+  Status create(RiverMesh mesh, std::vector<float> slope, const FlowParams& flow,
+                std::vector<Obstacle> obstacles, uint64_t seed, glm::uvec2 viewport);
 
   // Places the keyframed obstacles at `time_seconds` and re-solves the flow near those that
   // moved, so the next simulate() hands the particles the new course.

@@ -236,14 +236,14 @@ TEST_F(CliTest, CaptureOfAProceduralSceneFile) {
   EXPECT_EQ(image.width, 32);
 }
 
-TEST_F(CliTest, CaptureRefusesScenesItCannotRenderYet) {
+TEST_F(CliTest, CaptureRefusesBadSceneFiles) {
   const fs::path gltf_scene = dir_.parent_path() / "gltf_scene.json";
   FILE* f = std::fopen(gltf_scene.c_str(), "w");
   ASSERT_NE(f, nullptr);
-  std::fputs(R"({"version":1,"river":{"gltf":"river.glb"}})", f);
+  std::fputs(R"({"version":1,"river":{"gltf":"no_such_river.glb"}})", f);
   std::fclose(f);
   expect_error(run_siviflow("capture " + gltf_scene.string() + " --out " + dir_.string()),
-               "not supported yet");
+               "no_such_river.glb");
   const fs::path bad = dir_.parent_path() / "bad_scene.json";
   f = std::fopen(bad.c_str(), "w");
   ASSERT_NE(f, nullptr);

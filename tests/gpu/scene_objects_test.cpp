@@ -1,12 +1,13 @@
 // glTF objects of a scene file on screen: drawn with their base-colour texture and factor,
 // reflected in the water when above it and not at all when wholly under it (the clip plane),
-// and a broken texture refused with a message naming it.
+// and a broken texture refused with a message naming it; a glTF river rendered with its flow.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 #include <gtest/gtest.h>
@@ -132,6 +133,38 @@ TEST_F(SceneObjectsTest, BrokenTextureIsRefusedNamingIt) {
   EXPECT_NE(r.output.find("scene.json: objects[0]"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("crate.gltf"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::is_empty(dir_ / "out")) << "nothing written";
+}
+
+// A descending glTF channel (1 m drop per 20 m) with a crate in it that is an obstacle, seen by
+// the overview camera: the water shows, its flow runs downstream (+Z), and the reflection plane
+// is the visible reach's level, so the crate's reflection lies on the water.
+TEST_F(SceneObjectsTest, GltfRiverFlowsDownstreamAroundAnObjectObstacle) {
+  write_channel_gltf(dir_ / "channel.gltf", 41, 9, 8.0f, 1.0f, 0.05f);
+  write_box_gltf(dir_ / "crate.gltf", glm::vec3(0.8f));
+  const fs::path scene = dir_ / "scene.json";
+  write_text(scene, R"({"version":1,"river":{"gltf":"channel.gltf"},"flow":{"discharge":8.0},)"
+                    R"("objects":[{"gltf":"crate.gltf","translation":[0,-0.6,20],"obstacle":true}]})");
+  const RunResult r = run_siviflow("capture " + scene.string() + " --frames 2 --size 320x180 "
+                                   "--aov flow,reflection --preview --out " + (dir_ / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ExrImage image;
+  ASSERT_TRUE(read_exr((dir_ / "out" / "frame_00001.exr").string(), &image).ok());
+  size_t water = 0;
+  size_t downstream = 0;
+  size_t aside = 0;  // turned by more than 6 degrees
+  for (size_t i = 0; i < image.find("water.mask")->size(); ++i) {
+    if ((*image.find("water.mask"))[i] != 1.0f) continue;
+    ++water;
+    const glm::vec3 flow((*image.find("flow.X"))[i], (*image.find("flow.Y"))[i], (*image.find("flow.Z"))[i]);
+    downstream += (glm::length(flow) > 0.1f && flow.z > 0.9f * glm::length(flow)) ? 1 : 0;
+    aside += std::abs(flow.x) > 0.1f * glm::length(flow) ? 1 : 0;
+  }
+  std::printf("%zu water pixels, %zu flowing downstream within 26 degrees, %zu turned aside\n", water,
+              downstream, aside);
+  ASSERT_GT(water, size_t{kWidth * kHeight / 20}) << "the channel is in view";
+  EXPECT_GT(downstream, water * 7 / 10) << "the channel's flow runs along it";
+  EXPECT_GT(aside, 30u) << "the crate turns some of it aside";
+  EXPECT_LT(aside, water / 5);
 }
 
 }  // namespace
