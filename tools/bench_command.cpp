@@ -1,10 +1,11 @@
-// `siviflow bench`: GPU time per pass (timestamp queries) and CPU time per stage of the default
-// scene's frames, with the flow pass's floor measured in the same run.
+// `siviflow bench`: GPU time per pass (timestamp queries) and CPU time per stage of a scene file's
+// or the default scene's frames, with the flow pass's floor measured in the same run.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "commands.h"
 #include "siviflow/headless_context.h"
 #include "siviflow/renderer.h"
+#include "siviflow/scene_file.h"
 
 namespace siviflow {
 namespace {
@@ -23,7 +25,9 @@ constexpr const char* kFloorPass = "flow floor";
 constexpr VkFormat kOutputFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 
 struct BenchOptions {
+  std::string scene_path;  // empty: the built-in default scene
   cli::Size size{1280, 720};
+  bool size_given = false;  // a flag wins over the scene file's render size
   uint32_t frames = 60;
   uint32_t warmup = 10;
   bool json = false;
@@ -45,8 +49,9 @@ Stats stats_of(std::vector<double> values) {
 
 void print_help() {
   std::printf(
-      "usage: siviflow bench [--size WxH] [--frames N] [--warmup W] [--json]\n"
-      "  Renders the default scene: W warm-up frames (default 10), then N measured frames\n"
+      "usage: siviflow bench [SCENE.json] [--size WxH] [--frames N] [--warmup W] [--json]\n"
+      "  Renders the scene file (at its render size unless --size says otherwise) or the\n"
+      "  default scene (1280x720): W warm-up frames (default 10), then N measured frames\n"
       "  (default 60), one at a time. Reports per pass the median, min and max GPU time\n"
       "  (timestamps), the whole frame, the flow pass's floor (a full-screen pass making the same\n"
       "  texture reads), and the CPU stages' medians. --json prints one JSON object.\n");
@@ -62,6 +67,7 @@ Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
     } else if (arg == "--size") {
       SIVIFLOW_TRY(args.value(arg, &value));
       SIVIFLOW_TRY(cli::parse_size(arg, value, &options->size));
+      options->size_given = true;
     } else if (arg == "--frames") {
       SIVIFLOW_TRY(args.value(arg, &value));
       SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->frames));
@@ -71,6 +77,8 @@ Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
       SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->warmup));
     } else if (arg == "--json") {
       options->json = true;
+    } else if (!arg.empty() && arg[0] != '-' && options->scene_path.empty()) {
+      options->scene_path = std::string(arg);
     } else {
       return cli::unexpected_argument(arg);
     }
@@ -93,6 +101,15 @@ int run_bench(int argc, char** argv) {
     print_help();
     return cli::kExitOk;
   }
+  std::optional<SceneFile> scene;
+  double fps = 30.0;
+  if (!options.scene_path.empty()) {
+    scene.emplace();
+    status = load_scene_file(options.scene_path, &*scene);
+    if (!status.ok()) return cli::fail(kCommand, status.message());
+    if (!options.size_given) options.size = {scene->render.width, scene->render.height};
+    fps = scene->render.fps;
+  }
   std::unique_ptr<HeadlessContext> context;
   status = HeadlessContext::create(HeadlessContextOptions{}, &context);
   if (!status.ok()) return cli::fail(kCommand, status.message());
@@ -100,6 +117,7 @@ int run_bench(int argc, char** argv) {
   CreateInfo info = context->renderer_create_info(extent, kOutputFormat);
   info.frames_in_flight = 1;
   info.enable_timing = true;
+  info.scene = scene.has_value() ? &*scene : nullptr;
   std::unique_ptr<Renderer> renderer;
   status = Renderer::create(info, &renderer);
   if (!status.ok()) return cli::fail(kCommand, status.message());
@@ -114,7 +132,7 @@ int run_bench(int argc, char** argv) {
   ImageState state;
   std::vector<PassTime> times;
   for (uint32_t frame = 0; frame < options.warmup + options.frames; ++frame) {
-    const double time = frame / 30.0;
+    const double time = frame / fps;
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     status = context->begin_slot(0, &cmd);
     if (status.ok()) status = renderer->begin_frame(0);

@@ -58,8 +58,8 @@ void print_help() {
   std::printf(
       "usage: siviflow capture [SCENE.json] [--frames N | --range A:B] [--size WxH] --out DIR\n"
       "                        [--seed S] [--fps F] [--aov LIST] [--preview] [--validation]\n"
-      "  Renders the scene file (procedural rivers for now; its render settings unless a flag\n"
-      "  says otherwise), or the built-in default scene, into DIR/frame_NNNNN.exr.\n"
+      "  Renders the scene file (its render settings unless a flag says otherwise), or the\n"
+      "  built-in default scene, into DIR/frame_NNNNN.exr.\n"
       "  --frames N     frames 0..N-1 (same as --range 0:N; default 1)\n"
       "  --range A:B    frames A..B-1; a frame is the same whatever range it is rendered in\n"
       "  --size WxH     output size in pixels (default 1280x720)\n"

@@ -89,8 +89,7 @@ Status unexpected_argument(std::string_view arg) {
   if (!arg.empty() && arg[0] == '-') {
     return Status::error("unknown option '" + std::string(arg) + "' (see --help)");
   }
-  return Status::error("unexpected argument '" + std::string(arg) +
-                       "': scene files are not supported yet, only the built-in default scene");
+  return Status::error("unexpected argument '" + std::string(arg) + "' (see --help)");
 }
 
 int fail(std::string_view command, const std::string& message) {

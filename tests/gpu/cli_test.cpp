@@ -270,6 +270,16 @@ TEST_F(CliTest, BenchReportsEveryPassAsJson) {
   EXPECT_FALSE(report.at("passes").contains("flow floor")) << "the floor is reported apart";
   EXPECT_GE(report.at("cpu").at("update_ms").get<double>(), 0.0);
   expect_error(run_siviflow("bench --frames 0"), "--frames");
+  // A scene file, at its own render size.
+  const fs::path scene = dir_.parent_path() / "bench_scene.json";
+  FILE* f = std::fopen(scene.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  std::fputs(R"({"version":1,"river":{"procedural":{"seed":5}},"render":{"size":[64,36]}})", f);
+  std::fclose(f);
+  const RunResult from_scene = run_siviflow("bench " + scene.string() + " --frames 2 --warmup 0 --json");
+  ASSERT_EQ(from_scene.exit_code, 0) << from_scene.output;
+  EXPECT_FALSE(nlohmann::json::parse(from_scene.output, nullptr, false).is_discarded()) << from_scene.output;
+  expect_error(run_siviflow("bench " + (dir_ / "missing.json").string()), "missing.json");
 }
 
 TEST_F(CliTest, RangeShardsEqualTheFullRun) {
