@@ -31,6 +31,9 @@ Status decode_png(const GltfImage& image, const std::string& what, std::vector<u
     return extent_mismatch(what, png.width, png.height, image);
   }
   png.format = PNG_FORMAT_RGBA;  // 8-bit sRGB: gray, palette and 16-bit files are converted
+  // glTF base colour is sRGB at any depth; without this libpng takes an untagged 16-bit file as
+  // linear and brightens it (mid-grey 32896 would become 186).
+  png.flags |= PNG_IMAGE_FLAG_16BIT_sRGB;
   rgba->resize(PNG_IMAGE_SIZE(png));
   if (png_image_finish_read(&png, nullptr, rgba->data(), 0, nullptr) == 0) {
     return Status::error(what + ": PNG data is corrupt: " + png.message);
