@@ -6,6 +6,7 @@
 #include <csetjmp>
 #include <cstdio>
 
+#include <jerror.h>  // JWRN_JPEG_EOF
 #include <jpeglib.h>
 #include <png.h>
 
@@ -58,6 +59,12 @@ void jpeg_fail(j_common_ptr cinfo) {
 
 void jpeg_quiet(j_common_ptr) {}  // warnings (recoverable corruption) are not printed
 
+// Warnings are decoded through, except running out of data: libjpeg would then invent the
+// missing rows (grey) and report success.
+void jpeg_warning(j_common_ptr cinfo, int msg_level) {
+  if (msg_level < 0 && cinfo->err->msg_code == JWRN_JPEG_EOF) jpeg_fail(cinfo);
+}
+
 // Decodes into `rgba` (sized for the header's extent); on failure returns false and the reason
 // is in error.message.
 bool decode_jpeg_rows(const GltfImage& image, uint8_t* rgba, JpegError& error, uint32_t* width,
@@ -66,6 +73,7 @@ bool decode_jpeg_rows(const GltfImage& image, uint8_t* rgba, JpegError& error, u
   cinfo.err = jpeg_std_error(&error.manager);
   error.manager.error_exit = jpeg_fail;
   error.manager.output_message = jpeg_quiet;
+  error.manager.emit_message = jpeg_warning;
   if (setjmp(error.jump) != 0) {
     jpeg_destroy_decompress(&cinfo);
     return false;
