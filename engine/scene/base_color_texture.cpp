@@ -129,7 +129,7 @@ uint8_t linear_to_srgb(float linear) {
 }
 
 // Appends each level after mip 0 (already in texels): a 2x2 box in linear light for colour,
-// plain for alpha; an odd edge repeats its last texel.
+// plain for alpha; an odd size drops its last row or column (a side of 1 repeats its texel).
 void build_mips(BaseColorTexture* texture) {
   const std::array<float, 256>& to_linear = srgb_to_linear_table();
   uint32_t width = texture->width;
