@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared.h"
 // The flow pass's floor, for `siviflow bench`: drawn with the water's geometry and depth test
-// (flow.vert), so over the same pixels, the same texture reads as the water material (6 flow
+// (flow.vert), so over the same pixels, the same texture reads as the water material (5 flow
 // texel fetches, 1 aux fetch, 1 reflection and 4 normal-map reads with gradients) and next to no
 // arithmetic, so flow / floor tells what the material's own maths costs.
 layout(push_constant) uniform Push { FlowConstants flow; };
@@ -18,7 +18,7 @@ void main() {
   ivec2 texel = ivec2(gl_FragCoord.xy / flow.water.w);
   uint slots = 0u;
   ivec2 last = textureSize(flow_texture, 0) - 1;
-  for (int i = 0; i < 6; ++i) {
+  for (int i = 0; i < 5; ++i) {
     slots += texelFetch(flow_texture, clamp(texel + ivec2(i & 1, i >> 1), ivec2(0), last), 0).r;
   }
   vec4 aux = texelFetch(particle_aux, ivec2(int(slots % SIVIFLOW_AUX_WIDTH), 0), 0);

@@ -29,19 +29,13 @@ const float kRippleStrength = 0.55;      // van Hoesel's 0.3 transp^2 scale, bri
 const float kFresnelF0 = 0.02;           // water at normal incidence
 const float kFadeInfluence = 0.25;       // how much a fading particle calms its cell
 
-vec4 particle_aux_at(uint slot) {
-  uint width = SIVIFLOW_AUX_WIDTH;
-  return texelFetch(particle_aux, ivec2(int(slot % width), int(slot / width)), 0);
-}
-
 void main() {
-  // The particle covering this pixel: its flow, and by its slot its speed, depth, slope, fade.
-  vec3 own_flow;
-  ivec2 texel = ivec2(gl_FragCoord.xy / flow.water.w);
-  bool covered = tdf_fetch_flow(flow_texture, texel, own_flow);
-  uint slot = texelFetch(flow_texture, texel, 0).r;
-  vec4 aux = covered ? particle_aux_at(slot) : vec4(0.0);
-  float fade = covered ? aux.a : 0.0;
+  // The particle covering this pixel: its flow, and by its slot its speed, depth, slope, fade
+  // (slot 0, no particle, reads the aux texture's all-zero texel 0: no branch needed).
+  uvec4 own = texelFetch(flow_texture, ivec2(gl_FragCoord.xy * (1.0 / flow.water.w)), 0);
+  vec3 own_flow = tdf_texel_flow(own);
+  float fade = texelFetch(particle_aux, ivec2(own.r % SIVIFLOW_AUX_WIDTH,
+                                               own.r / SIVIFLOW_AUX_WIDTH), 0).a;
 
   // Shallow water ripples less, so the shore is calm. A fading particle only eases its cell's
   // ripples part of the way: a full fade would print the particles' cells on the water.
@@ -58,11 +52,12 @@ void main() {
   vec2 uv = gl_FragCoord.xy * flow.screen.zw + tdf.tilt * flow.water.y;
   vec3 reflection = texture(reflection_map, clamp(uv, vec2(0.0), vec2(1.0))).rgb;
   float cos_theta = max(dot(n, to_eye), 0.0);
-  float fresnel = kFresnelF0 + (1.0 - kFresnelF0) * pow(1.0 - cos_theta, 5.0);
+  float grazing = 1.0 - cos_theta;
+  float grazing_sq = grazing * grazing;
+  float fresnel = kFresnelF0 + (1.0 - kFresnelF0) * grazing_sq * grazing_sq * grazing;
 
   // Depth-based colour and absorption: clear in the shallows, dark and opaque in the deep.
-  vec3 sun = normalize(flow.sun_direction.xyz);
-  float light = 0.35 + 0.65 * max(dot(n, sun), 0.0);
+  float light = 0.35 + 0.65 * max(dot(n, flow.sun_direction.xyz), 0.0);  // a unit vector already
   vec3 body = mix(kShallowColour, kDeepColour, 1.0 - exp(-kAbsorptionPerMetre * in_depth)) * light;
   float opacity = 1.0 - exp(-kOpacityPerMetre * in_depth);
   vec3 colour = mix(body, reflection, fresnel);

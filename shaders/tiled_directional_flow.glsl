@@ -59,25 +59,45 @@ struct TdfResult {
                 // the natural input of a screen-space reflection offset
 };
 
-// Flow texel decode (shared.h). False when no particle covers the texel.
-bool tdf_fetch_flow(usampler2D flow_tex, ivec2 texel, out vec3 flow) {
-  uvec4 t = texelFetch(flow_tex, texel, 0);
-  flow = vec3(unpackHalf2x16(t.g | (t.b << 16)), unpackHalf2x16(t.a).x);
-  return t.r != SIVIFLOW_PARTICLE_NONE;
+// The flow of a flow texel (shared.h layout); t.r == SIVIFLOW_PARTICLE_NONE: no particle there.
+vec3 tdf_texel_flow(uvec4 t) {
+  return vec3(unpackHalf2x16(t.g | (t.b << 16)), unpackHalf2x16(t.a).x);
 }
 
-// The flow at a world point: projected to the output (Vulkan clip space, +Y down, origin top
-// left, as sim/particles.h) and looked up in the flow texture; `fallback` when none is there.
-vec3 tdf_flow_at(vec3 world, vec3 fallback, mat4 view_proj, vec2 viewport_px, float texel_px,
-                 usampler2D flow_tex) {
-  vec4 clip = view_proj * vec4(world, 1.0);
-  if (clip.w <= 1e-6) return fallback;
-  vec2 ndc = clip.xy / clip.w;
-  if (any(greaterThan(abs(ndc), vec2(1.0)))) return fallback;
-  ivec2 texel = ivec2((ndc * 0.5 + 0.5) * viewport_px / texel_px);
-  texel = clamp(texel, ivec2(0), textureSize(flow_tex, 0) - 1);
-  vec3 flow;
-  return tdf_fetch_flow(flow_tex, texel, flow) ? flow : fallback;
+// Where a tile centre falls in the flow texture, as an affine map of tile coordinates: the rows
+// x, y, w of view_proj at the fragment's height, x and y remapped from NDC to flow texels (times
+// w). Made once per fragment, so a tile centre costs 6 multiply-adds and one divide.
+struct TdfProjection {
+  vec3 origin;   // (texel.x w, texel.y w, w) of tile coordinates (0, 0)
+  vec3 per_u;    // ... per tile along world x
+  vec3 per_v;    // ... per tile along world z
+  vec2 extent;   // flow texels across the viewport: NDC [-1, 1] is [0, extent]
+};
+
+TdfProjection tdf_projection(float height, float tile_size_m, mat4 view_proj, vec2 viewport_px,
+                             float texel_px) {
+  vec2 half_texels = 0.5 * viewport_px / texel_px;
+  // Clip x, y to (NDC * 0.5 + 0.5) * texels, times w: x' = half_texels.x * (x + w).
+  mat4 to_texels = mat4(vec4(half_texels.x, 0.0, 0.0, 0.0), vec4(0.0, half_texels.y, 0.0, 0.0),
+                        vec4(0.0, 0.0, 1.0, 0.0), vec4(half_texels, 0.0, 1.0)) * view_proj;
+  TdfProjection p;
+  p.origin = (to_texels[1] * height + to_texels[3]).xyw;
+  p.per_u = to_texels[0].xyw * tile_size_m;
+  p.per_v = to_texels[2].xyw * tile_size_m;
+  p.extent = 2.0 * half_texels;
+  return p;
+}
+
+// The flow at a tile centre (tile coordinates); `fallback` when off screen, behind the camera or
+// on a texel without particle.
+vec3 tdf_flow_at(TdfProjection p, vec2 centre_u, vec3 fallback, usampler2D flow_tex) {
+  vec3 h = p.origin + centre_u.x * p.per_u + centre_u.y * p.per_v;
+  vec2 at = h.xy * (1.0 / h.z);
+  bool inside =
+      h.z > 1e-6 && all(greaterThanEqual(at, vec2(0.0))) && all(lessThanEqual(at, p.extent));
+  ivec2 texel = clamp(ivec2(at), ivec2(0), textureSize(flow_tex, 0) - 1);
+  uvec4 t = texelFetch(flow_tex, texel, 0);
+  return inside && t.r != SIVIFLOW_PARTICLE_NONE ? tdf_texel_flow(t) : fallback;
 }
 
 // Per-tile offset into the tileable map, [0,1)^2, from the tile's integer cell and grid.
@@ -91,25 +111,27 @@ vec2 tdf_tile_offset(vec2 cell, int grid) {
 }
 
 // One tile of one grid: its normal-map sample, as a tangent tilt along world x/z.
-//   u: the fragment in tile units; cell, centre_u: the tile; flow: its flow (world m/s).
-vec2 tdf_tile_sample(vec2 u, vec2 cell, vec2 centre_u, int grid, vec3 flow, float time,
-                     float repeat_m, vec2 du_dx, vec2 du_dy, sampler2D normal_map) {
-  float speed = length(flow.xz);
-  vec2 dir = speed > kTdfMinSpeed ? flow.xz / speed : vec2(1.0, 0.0);
-  float fast = clamp(speed / kTdfSpeedFast, 0.0, 1.0);
+//   u: the fragment in tile units; cell, centre_u: the tile; flow: its flow (world m/s);
+//   cycles_per_mps: scroll cycles per period per m/s of scaled speed; periods: time / period.
+vec2 tdf_tile_sample(vec2 u, vec2 cell, vec2 centre_u, int grid, vec3 flow, float periods,
+                     float cycles_per_mps, vec2 du_dx, vec2 du_dy, sampler2D normal_map) {
+  float speed_sq = dot(flow.xz, flow.xz);
+  float inv_speed = inversesqrt(max(speed_sq, 1e-20));  // one root gives speed and direction
+  float speed = speed_sq * inv_speed;
+  vec2 dir = speed > kTdfMinSpeed ? flow.xz * inv_speed : vec2(1.0, 0.0);
+  float fast = clamp(speed * (1.0 / kTdfSpeedFast), 0.0, 1.0);
   float scale = mix(kTdfScaleStill, kTdfScaleFast, fast);
   // M = scale * R(-angle): the world flow direction maps to the map's +U (column-major mat2).
-  mat2 m = (scale / kTdfRepeatTiles) * mat2(dir.x, -dir.y, dir.y, dir.x);
+  mat2 m = (scale * (1.0 / kTdfRepeatTiles)) * mat2(dir.x, -dir.y, dir.y, dir.x);
   // Pattern world speed = rate * repeat_m / scale; whole cycles per period keep the wrap seamless.
-  float rate = kTdfAdvection * speed * scale / repeat_m * kTdfGridSpeed[grid];
-  rate = round(rate * SIVIFLOW_TDF_TIME_PERIOD) / SIVIFLOW_TDF_TIME_PERIOD;
-  float phase = fract(time * rate + kTdfGridPhase[grid]);
+  float cycles = round(speed * scale * cycles_per_mps * kTdfGridSpeed[grid]);
+  float phase = fract(cycles * periods + kTdfGridPhase[grid]);
   // Subtracting the phase after M moves the pattern along +dir, i.e. downstream.
   vec2 s = m * (u - centre_u) + tdf_tile_offset(cell, grid) - vec2(phase, 0.0);
   vec2 n = textureGrad(normal_map, s, m * du_dx, m * du_dy).rg * 2.0 - 1.0;
-  float roughness = mix(kTdfStillRoughness, 1.0, fast);
-  // R(+angle): the sampled tilt back into world x/z, matching the rotated ripples.
-  return roughness * (mat2(dir.x, dir.y, -dir.y, dir.x) * n);
+  // R(+angle) scaled by the roughness: the sampled tilt back into world x/z.
+  vec2 back = mix(kTdfStillRoughness, 1.0, fast) * dir;
+  return mat2(back.x, back.y, -back.y, back.x) * n;
 }
 
 // The Tiled Directional Flow normal of a water fragment.
@@ -127,15 +149,18 @@ TdfResult tdf_normal(vec3 world, vec3 surface_normal, vec3 own_flow, float stren
   vec2 u = world.xz / tile_size_m;
   vec2 du_dx = dFdx(u);
   vec2 du_dy = dFdy(u);
-  float repeat_m = tile_size_m * kTdfRepeatTiles;
+  TdfProjection projection = tdf_projection(world.y, tile_size_m, view_proj, viewport_px, texel_px);
+  float cycles_per_mps =
+      kTdfAdvection * SIVIFLOW_TDF_TIME_PERIOD / (tile_size_m * kTdfRepeatTiles);
+  float periods = time * (1.0 / SIVIFLOW_TDF_TIME_PERIOD);
   const vec2 kOffsets[4] = vec2[4](vec2(0.0), vec2(0.5, 0.0), vec2(0.0, 0.5), vec2(0.5));
   vec2 n[4];
   for (int k = 0; k < 4; ++k) {
     vec2 cell = floor(u + kOffsets[k]);
     vec2 centre_u = cell + 0.5 - kOffsets[k];
-    vec3 centre = vec3(centre_u.x * tile_size_m, world.y, centre_u.y * tile_size_m);
-    vec3 flow = tdf_flow_at(centre, own_flow, view_proj, viewport_px, texel_px, flow_tex);
-    n[k] = tdf_tile_sample(u, cell, centre_u, k, flow, time, repeat_m, du_dx, du_dy, normal_map);
+    vec3 flow = tdf_flow_at(projection, centre_u, own_flow, flow_tex);
+    n[k] = tdf_tile_sample(u, cell, centre_u, k, flow, periods, cycles_per_mps, du_dx, du_dy,
+                           normal_map);
   }
   // van Hoesel's weights: ff = 1 at the centre of grid A's tile, 0 at its edges (per axis).
   vec2 g = abs(2.0 * fract(u) - 1.0) - 0.5;
@@ -143,18 +168,23 @@ TdfResult tdf_normal(vec3 world, vec3 surface_normal, vec3 own_flow, float stren
   vec2 n_ab = ff.x * n[0] + (1.0 - ff.x) * n[1];
   vec2 n_cd = ff.x * n[2] + (1.0 - ff.x) * n[3];
   vec2 tilt = ff.y * n_ab + (1.0 - ff.y) * n_cd;
-  // Restore the contrast the blend of uncorrelated samples took away.
-  vec2 ff_scale = sqrt(ff * ff + (1.0 - ff) * (1.0 - ff));
-  tilt *= 0.5 * strength / (ff_scale.x * ff_scale.y);  // 0.5: van Hoesel's N is rg - 0.5
-  float len = length(tilt);
-  if (len > kTdfMaxTilt) tilt *= kTdfMaxTilt / len;
-  float z = sqrt(max(1.0 - dot(tilt, tilt), 0.0));
-  // Tangent frame of the surface: x and z axes projected onto it (x, up, z for flat water).
+  // Restore the contrast the blend of uncorrelated samples took away: per axis
+  // sqrt(ff^2 + (1 - ff)^2), both axes under one root. 0.5: van Hoesel's N is rg - 0.5.
+  vec2 ff_sq = ff * ff + (1.0 - ff) * (1.0 - ff);
+  tilt *= 0.5 * strength * inversesqrt(ff_sq.x * ff_sq.y);
+  float len_sq = dot(tilt, tilt);
+  if (len_sq > kTdfMaxTilt * kTdfMaxTilt) {
+    tilt *= kTdfMaxTilt * inversesqrt(len_sq);
+    len_sq = kTdfMaxTilt * kTdfMaxTilt;
+  }
+  float z = sqrt(max(1.0 - len_sq, 0.0));
+  // Tangent frame of the surface: x and z axes projected onto it (x, up, z for flat water). The
+  // frame is orthonormal and |(tilt, z)| = 1, so the normal needs no normalize.
   vec3 up = normalize(surface_normal);
   vec3 tx = normalize(vec3(1.0, 0.0, 0.0) - up * up.x);
   vec3 tz = cross(tx, up);
   TdfResult result;
-  result.normal = normalize(tx * tilt.x + tz * tilt.y + up * z);
+  result.normal = tx * tilt.x + tz * tilt.y + up * z;
   result.tilt = tilt;
   return result;
 }
