@@ -88,8 +88,7 @@ struct Renderer::Impl {
   FrameRing ring;
   ProceduralRiver river{default_river_params()};  // the default scene's, or the scene file's
   bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
-  RiverMesh river_mesh;           // handed to the simulation by create_static_resources
-  std::vector<float> river_slope;
+  RiverInput river_input;         // handed to the simulation by create_static_resources
   std::vector<float> water_heights;  // this frame's live particles' heights
   FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
   std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is this frame
@@ -266,7 +265,7 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
 Status Renderer::Impl::take_scene() {
   if (info.scene == nullptr) {
     obstacles = default_scene_obstacles(river);
-    return procedural_river_mesh(river, &river_mesh, &river_slope);
+    return procedural_river_input(river, &river_input);
   }
   const SceneFile& scene = *info.scene;
   const auto in_scene = [&scene](const Status& status) {
@@ -275,18 +274,18 @@ Status Renderer::Impl::take_scene() {
   if (scene.river.source == SceneRiver::Source::kGltf) {
     TriangleMesh gltf;
     SIVIFLOW_TRY(in_scene(load_river_mesh(scene.river.gltf, scene.river.mesh, &gltf)));
-    SIVIFLOW_TRY(in_scene(gltf_river_mesh(gltf, &river_mesh, &river_slope)));
+    SIVIFLOW_TRY(in_scene(gltf_river_input(std::move(gltf), &river_input)));
     river_from_file = true;
   } else {
     SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(scene.river.procedural)));
     river = ProceduralRiver(scene.river.procedural);
-    SIVIFLOW_TRY(in_scene(procedural_river_mesh(river, &river_mesh, &river_slope)));
+    SIVIFLOW_TRY(in_scene(procedural_river_input(river, &river_input)));
   }
   flow_params = scene.flow;
   obstacles = scene.obstacles;
   camera_path = scene.camera;
   SIVIFLOW_TRY(load_scene_objects(scene, &objects));
-  return scene_object_obstacles(scene, river_mesh.positions, &object_obstacles);
+  return scene_object_obstacles(scene, river_input.mesh.positions, &object_obstacles);
 }
 
 Status Renderer::Impl::create_static_resources() {
@@ -294,7 +293,7 @@ Status Renderer::Impl::create_static_resources() {
     const auto* first = reinterpret_cast<const uint8_t*>(items.data());
     return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
   };
-  SceneGeometry geometry = river_from_file ? build_riverbed_geometry(river_mesh, obstacles)
+  SceneGeometry geometry = river_from_file ? build_riverbed_geometry(river_input.mesh, obstacles)
                                            : build_scene_geometry(river, obstacles);
   // Sized once: the draws point into it.
   obstacle_constants.resize(2 * obstacles.size());
@@ -324,9 +323,8 @@ Status Renderer::Impl::create_static_resources() {
   static_buffers[kSceneIndices].bytes = bytes_of(geometry.indices);
   std::vector<Obstacle> flow_obstacles = obstacles;
   flow_obstacles.insert(flow_obstacles.end(), object_obstacles.begin(), object_obstacles.end());
-  SIVIFLOW_TRY(simulation.create(std::move(river_mesh), std::move(river_slope), flow_params,
-                                 std::move(flow_obstacles), info.seed,
-                                 {info.extent.width, info.extent.height}));
+  SIVIFLOW_TRY(simulation.create(std::move(river_input), flow_params, std::move(flow_obstacles),
+                                 info.seed, {info.extent.width, info.extent.height}));
   const RiverMesh& surface = simulation.mesh();
   river_index_count = static_cast<uint32_t>(surface.indices.size());
   static_buffers[kRiverVertices].bytes = bytes_of(surface.positions);

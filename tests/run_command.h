@@ -1,10 +1,14 @@
-// Runs the siviflow tool as a user would, capturing its exit status and output.
+// Runs the siviflow tool as a user would, capturing its exit status and output; a fresh folder
+// for what a test run writes.
 #pragma once
 
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
+
+#include <gtest/gtest.h>
 
 namespace siviflow::testing {
 
@@ -26,6 +30,15 @@ inline RunResult run_siviflow(const std::string& args, const std::string& env = 
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// An empty folder for the running test's files: <build>/tests/<group>/<test name>.
+inline std::filesystem::path fresh_test_dir(const std::string& group) {
+  const std::filesystem::path dir = std::filesystem::path(SIVIFLOW_BINARY_DIR) / "tests" / group /
+                                    ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
 }
 
 }  // namespace siviflow::testing

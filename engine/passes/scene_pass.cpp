@@ -102,14 +102,17 @@ void ScenePass::declare(FrameGraph& graph, const char* pass_name,
     vk.vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
     vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
     VkPipeline bound = VK_NULL_HANDLE;
+    VkDescriptorSet bound_set = VK_NULL_HANDLE;
     for (const SceneDraw& draw : *draws) {
       const VkPipeline pipeline = draw.material == 0 ? scene_pipeline_ : object_pipeline_;
       if (pipeline != bound) {
         vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
         bound = pipeline;
       }
-      vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1,
-                                 &sets_[draw.material], 0, nullptr);
+      if (sets_[draw.material] != bound_set) {
+        bound_set = sets_[draw.material];
+        vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &bound_set, 0, nullptr);
+      }
       vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), draw.constants);
       vk.vkCmdDrawIndexed(cmd, draw.index_count, 1, draw.first_index, 0, 0);
     }

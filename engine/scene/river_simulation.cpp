@@ -13,42 +13,46 @@ constexpr float kSlopeStep = 0.5f;         // metres: finite-difference step of 
 
 }  // namespace
 
-Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh, std::vector<float>* slope) {
-  SIVIFLOW_TRY(river.generate_mesh(mesh));
-  slope->resize(mesh->positions.size());
-  for (size_t v = 0; v < mesh->positions.size(); ++v) {
-    const glm::vec3& p = mesh->positions[v];
+Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
+  RiverInput input;
+  SIVIFLOW_TRY(river.generate_mesh(&input.mesh));
+  const RiverMesh& mesh = input.mesh;
+  SIVIFLOW_TRY(RiverSurface::build(mesh.positions, mesh.indices, RiverSurfaceOptions{}, &input.surface));
+  input.slope.resize(mesh.positions.size());
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    const glm::vec3& p = mesh.positions[v];
     const float dx = river.terrain_height(p.x + kSlopeStep, p.z) - river.terrain_height(p.x - kSlopeStep, p.z);
     const float dz = river.terrain_height(p.x, p.z + kSlopeStep) - river.terrain_height(p.x, p.z - kSlopeStep);
-    (*slope)[v] = std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
+    input.slope[v] = std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
   }
+  *out = std::move(input);
   return Status::success();
 }
 
-Status gltf_river_mesh(const TriangleMesh& gltf, RiverMesh* mesh, std::vector<float>* slope) {
-  RiverSurface surface;
-  SIVIFLOW_TRY(RiverSurface::build(gltf.positions, gltf.indices, RiverSurfaceOptions{}, &surface));
-  mesh->positions = gltf.positions;
-  mesh->indices = gltf.indices;
-  mesh->depth.resize(gltf.positions.size());
-  slope->resize(gltf.positions.size());
-  for (size_t v = 0; v < gltf.positions.size(); ++v) {
-    const RiverVertex vertex = surface.vertex(v);
+Status gltf_river_input(TriangleMesh gltf, RiverInput* out) {
+  RiverInput input;
+  SIVIFLOW_TRY(RiverSurface::build(gltf.positions, gltf.indices, RiverSurfaceOptions{}, &input.surface));
+  input.mesh.positions = std::move(gltf.positions);
+  input.mesh.indices = std::move(gltf.indices);
+  const size_t count = input.mesh.positions.size();
+  input.mesh.depth.resize(count);
+  input.slope.resize(count);
+  for (size_t v = 0; v < count; ++v) {
+    const RiverVertex vertex = input.surface.vertex(v);
     const float w2 = vertex.width * vertex.width;
-    mesh->depth[v] = kGltfRiverDepth * 4.0f * vertex.d_left * vertex.d_right / w2;
-    (*slope)[v] = std::abs(kGltfRiverDepth * 4.0f * (vertex.d_right - vertex.d_left) / w2);
+    input.mesh.depth[v] = kGltfRiverDepth * 4.0f * vertex.d_left * vertex.d_right / w2;
+    input.slope[v] = std::abs(kGltfRiverDepth * 4.0f * (vertex.d_right - vertex.d_left) / w2);
   }
+  *out = std::move(input);
   return Status::success();
 }
 
-Status RiverSimulation::create(RiverMesh mesh, std::vector<float> slope, const FlowParams& flow,
-                               std::vector<Obstacle> obstacles, uint64_t seed, glm::uvec2 viewport) {
+Status RiverSimulation::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
+                               uint64_t seed, glm::uvec2 viewport) {
   viewport_ = viewport;
-  mesh_ = std::move(mesh);
-  slope_ = std::move(slope);
-  RiverSurface surface;
-  SIVIFLOW_TRY(RiverSurface::build(mesh_.positions, mesh_.indices, RiverSurfaceOptions{}, &surface));
-  SIVIFLOW_TRY(StreamFunction::create(std::move(surface), flow, &flow_));
+  mesh_ = std::move(river.mesh);
+  slope_ = std::move(river.slope);
+  SIVIFLOW_TRY(StreamFunction::create(std::move(river.surface), flow, &flow_));
   for (const Obstacle& obstacle : obstacles) has_keys_ = has_keys_ || !obstacle.keys.empty();
   SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
   const size_t count = mesh_.positions.size();

@@ -15,6 +15,7 @@
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "sim/procedural_river.h"
+#include "sim/river_surface.h"
 #include "sim/obstacle.h"
 #include "sim/status.h"
 #include "sim/stream_function.h"
@@ -25,19 +26,26 @@ namespace siviflow {
 // nothing at the banks (4 d_left d_right / width^2 of it).
 inline constexpr float kGltfRiverDepth = 1.5f;
 
-// The procedural river's mesh, and the slope of the terrain under each of its vertices.
-Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh, std::vector<float>* slope);
-// A glTF river's mesh with the depth profile above, and the slope of that riverbed across.
-Status gltf_river_mesh(const TriangleMesh& gltf, RiverMesh* mesh, std::vector<float>* slope);
+// What the simulation runs on: the river's mesh (positions, indices, depth), the riverbed slope
+// under each vertex (rise over run), and the surface built from the mesh (built once).
+struct RiverInput {
+  RiverMesh mesh;
+  std::vector<float> slope;
+  RiverSurface surface;
+};
+
+// The procedural river, with the slope of the terrain under each vertex.
+Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
+// A glTF river with the depth profile above, and the slope of that riverbed across.
+Status gltf_river_input(TriangleMesh gltf, RiverInput* out);
 
 class RiverSimulation {
  public:
-  // Builds the surface of the river `mesh` (positions, indices, depth) with the riverbed `slope`
-  // per vertex, solves its flow with the obstacles and sizes the particles and flow textures for
+  // Solves the flow of `river` with the obstacles and sizes the particles and flow textures for
   // `viewport`. Must not be moved after create(): the particles keep spans into this object's
   // per-vertex arrays.
-  Status create(RiverMesh mesh, std::vector<float> slope, const FlowParams& flow,
-                std::vector<Obstacle> obstacles, uint64_t seed, glm::uvec2 viewport);
+  Status create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
+                uint64_t seed, glm::uvec2 viewport);
 
   // Places the keyframed obstacles at `time_seconds` and re-solves the flow near those that
   // moved, so the next simulate() hands the particles the new course.

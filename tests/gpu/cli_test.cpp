@@ -23,10 +23,7 @@ namespace fs = std::filesystem;
 class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(SIVIFLOW_BINARY_DIR) / "tests" / "cli_out" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = fresh_test_dir("cli_out");
   }
   void expect_error(const RunResult& r, const std::string& needle) {
     EXPECT_EQ(r.exit_code, 1) << r.output;

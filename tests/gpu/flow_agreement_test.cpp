@@ -141,10 +141,7 @@ std::vector<WaterPixel> water_pixels(const ExrImage& image, const Camera& camera
 class FlowAgreement : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(SIVIFLOW_BINARY_DIR) / "tests" / "flow_agreement" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = fresh_test_dir("flow_agreement");
     std::ofstream(dir_ / "scene.json") << default_scene_json(river_);
   }
   // Captures frames [first, last] of the default scene with the depth and flow AOVs.

@@ -27,9 +27,7 @@ constexpr int kHeight = 180;
 class SceneObjectsTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(SIVIFLOW_BINARY_DIR) / "tests" / "scene_objects" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
+    dir_ = fresh_test_dir("scene_objects");
     fs::create_directories(dir_ / "out");
   }
   // Writes `name`.json (default procedural river, the given objects and camera) and captures

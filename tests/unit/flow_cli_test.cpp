@@ -47,10 +47,7 @@ std::vector<Row> read_csv(const fs::path& path, std::string* header) {
 class FlowCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(SIVIFLOW_BINARY_DIR) / "tests" / "flow_cli_out" /
-           ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = fresh_test_dir("flow_cli_out");
   }
   fs::path dir_;
 };

@@ -61,8 +61,8 @@ struct CreateInfo {
   VkExtent2D extent = {0, 0};          // output size in pixels; required
   bool enable_readback = false;        // record copies of the frame's images into host buffers
   uint64_t seed = 0;                   // seed of the river particles' random choices
-  // The scene to render; null: the built-in default scene. Procedural rivers only for now (its
-  // river, flow, obstacles and camera keys); the renderer copies what it needs.
+  // The scene to render (its river, flow, obstacles, objects and camera keys); null: the
+  // built-in default scene. Read by create() only: the renderer copies what it needs.
   const SceneFile* scene = nullptr;
   bool enable_timing = false;          // GPU timestamps around every pass (see pass_times()),
                                        // and the flow pass's floor pass, for benchmarks
