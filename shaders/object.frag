@@ -6,13 +6,13 @@
 
 layout(push_constant) uniform Push { SceneConstants scene; };
 layout(set = 0, binding = 0) uniform sampler2D base_color;
-layout(location = 0) in vec3 in_world;
-layout(location = 1) in vec3 in_normal;
+layout(location = 1) in vec3 in_irradiance;
 layout(location = 2) in vec4 in_color;
 layout(location = 3) in vec2 in_texcoord;
+layout(location = 4) in vec4 in_fog;
 layout(location = 0) out vec4 out_color;
 
 void main() {
   vec3 albedo = texture(base_color, in_texcoord).rgb * in_color.rgb;
-  out_color = vec4(shade_scene(scene, albedo, in_color.a, in_world, in_normal), 1.0);
+  out_color = vec4(shade_scene(albedo, in_irradiance, in_fog), 1.0);
 }

@@ -7,8 +7,9 @@
 layout(push_constant) uniform Push { SceneConstants scene; };
 layout(set = 0, binding = 0) uniform sampler2D ground_detail;
 layout(location = 0) in vec3 in_world;
-layout(location = 1) in vec3 in_normal;
+layout(location = 1) in vec3 in_irradiance;
 layout(location = 2) in vec4 in_color;
+layout(location = 4) in vec4 in_fog;
 layout(location = 0) out vec4 out_color;
 
 void main() {
@@ -16,5 +17,5 @@ void main() {
   float detail = texture(ground_detail, in_world.xz * 0.25).r * 0.6 +
                  texture(ground_detail, in_world.xz * 0.031).g * 0.4;
   vec3 albedo = in_color.rgb * mix(0.75, 1.25, detail);
-  out_color = vec4(shade_scene(scene, albedo, in_color.a, in_world, in_normal), 1.0);
+  out_color = vec4(shade_scene(albedo, in_irradiance, in_fog), 1.0);
 }

@@ -1,19 +1,30 @@
 // Lighting and fog of everything the scene pass draws (terrain, riverbed, objects), so objects
-// from glTF files sit in the same light and haze as the valley.
+// from glTF files sit in the same light and haze as the valley. Evaluated per vertex: both vary
+// slowly over the 1.5 m terrain grid, and per fragment they were a third of the scene pass.
 #include "sky_common.glsl"
 
-vec3 shade_scene(SceneConstants scene, vec3 albedo, float occlusion, vec3 world, vec3 normal) {
+struct SceneLight {
+  vec3 irradiance;  // sun (Lambert) plus hemispheric sky light: multiplies the albedo
+  vec4 fog;         // rgb sky colour of the view direction, a fog amount (0 clear .. 1 sky)
+};
+
+SceneLight light_scene(SceneConstants scene, float occlusion, vec3 world, vec3 normal) {
   vec3 n = normalize(normal);
   vec3 sun = scene.sun_direction.xyz;
   // Sun (Lambert) plus a hemispheric sky term scaled by ambient occlusion.
   float diffuse = max(dot(n, sun), 0.0);
   vec3 sky_light = mix(vec3(0.20, 0.19, 0.17), vec3(0.35, 0.45, 0.62), n.y * 0.5 + 0.5);
-  vec3 lit = albedo * (vec3(1.0, 0.95, 0.85) * 1.1 * diffuse + sky_light * occlusion);
+  SceneLight light;
+  light.irradiance = vec3(1.0, 0.95, 0.85) * 1.1 * diffuse + sky_light * occlusion;
   // Height-attenuated exponential fog towards the sky colour of the view direction.
-  vec3 to_fragment = world - scene.camera_position.xyz;
-  float dist = length(to_fragment);
-  vec3 direction = to_fragment / max(dist, 1e-4);
+  vec3 to_vertex = world - scene.camera_position.xyz;
+  float dist = length(to_vertex);
+  vec3 direction = to_vertex / max(dist, 1e-4);
   float fog = 1.0 - exp(-scene.fog.x * dist * exp(-scene.fog.y * max(world.y + scene.fog.z, 0.0)));
-  vec3 fog_color = sky_radiance(direction, sun, 0.0);
-  return mix(lit, fog_color, clamp(fog, 0.0, 1.0));
+  light.fog = vec4(sky_radiance(direction, sun, 0.0), clamp(fog, 0.0, 1.0));
+  return light;
+}
+
+vec3 shade_scene(vec3 albedo, vec3 irradiance, vec4 fog) {
+  return mix(albedo * irradiance, fog.rgb, fog.a);
 }
