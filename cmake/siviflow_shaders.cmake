@@ -19,6 +19,11 @@ function(siviflow_add_shaders)
     set(header ${out_dir}/${file_name}.h)
     set(spv ${out_dir}/${file_name}.spv)
     set(common_args -V --target-env vulkan1.3 -I${S_INCLUDE_DIR} ${debug_flags})
+    # SPIR-V 1.6 states a compute workgroup size with LocalSizeId, which needs maintenance4; 1.5
+    # keeps the literal size and runs on every Vulkan 1.3 device.
+    if(file_name MATCHES "\\.comp$")
+      list(APPEND common_args --target-env spirv1.5)
+    endif()
     add_custom_command(
       OUTPUT ${header}
       COMMAND ${GLSLANG_VALIDATOR} ${common_args} --quiet --depfile ${header}.d

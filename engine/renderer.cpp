@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -16,6 +17,7 @@
 #include "scene/water_normal_map.h"
 #include "siviflow/scene_file.h"
 #include "siviflow/scene_river.h"
+#include "sim/water_heights.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
@@ -43,6 +45,7 @@ constexpr uint32_t kMaxTimedPasses = 16;  // reflection target size relative to 
 // Tunables of the water's look, in one place.
 constexpr float kReflectionDistortion = 0.04f;    // screen uv offset per unit of normal tilt
 constexpr float kTdfTileMetres = 3.0f;            // Tiled Directional Flow tile size on the water
+constexpr uint32_t kMaxWaterHeightSamples = 2048;  // per axis: 8 MiB at most, samples widen beyond
 constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
 
 uint32_t texel_bytes(VkFormat format) {
@@ -77,6 +80,18 @@ Status invalid(const std::string& message) {
   return Status::error("siviflow::Renderer: " + message, VK_ERROR_INITIALIZATION_FAILED);
 }
 
+// The longest triangle edge of a mesh, seen from above.
+float longest_edge_xz(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices) {
+  float longest = 0.0f;
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    for (int e = 0; e < 3; ++e) {
+      const glm::vec3 d = positions[indices[t + e]] - positions[indices[t + (e + 1) % 3]];
+      longest = std::max(longest, glm::length(glm::vec2(d.x, d.z)));
+    }
+  }
+  return longest;
+}
+
 }  // namespace
 
 const char* version_string() { return "siviflow 0.1.0"; }
@@ -89,7 +104,7 @@ struct Renderer::Impl {
   ProceduralRiver river{default_river_params()};  // the default scene's, or the scene file's
   bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
   RiverInput river_input;         // handed to the simulation by create_static_resources
-  std::vector<float> water_heights;  // this frame's live particles' heights
+  std::vector<float> particle_heights;  // this frame's live particles' heights
   FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
   std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is this frame
   SceneObjects objects;             // the scene file's glTF objects, drawn where they stand
@@ -118,7 +133,7 @@ struct Renderer::Impl {
       {"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
       {"river depths", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
       {"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, {}, {}, {}}}};
-  enum StaticImageId { kDetail, kNormalMap, kFirstBaseColor };
+  enum StaticImageId { kDetail, kNormalMap, kWaterHeights, kFirstBaseColor };
   struct StaticImage {
     const char* name;
     VkFormat format;
@@ -127,10 +142,14 @@ struct Renderer::Impl {
     std::vector<size_t> mip_offsets;     // into texels
     Image image;
     ImageHandle in_frame_graph;
+    Access read_as = Access::SampledFragment;  // how the frame graph reads it
   };
-  // The detail texture, the water normal map, then the objects' base-colour textures.
-  std::vector<StaticImage> static_images{{"ground detail", kDetailFormat, {}, {}, {}, {}, {}},
-                                         {"water normal map", kNormalMapFormat, {}, {}, {}, {}, {}}};
+  // The detail texture, the water normal map, the water heights, then the objects' base-colour
+  // textures.
+  std::vector<StaticImage> static_images{
+      {"ground detail", kDetailFormat, {}, {}, {}, {}, {}},
+      {"water normal map", kNormalMapFormat, {}, {}, {}, {}, {}},
+      {"water heights", FlowPass::kWaterHeightsFormat, {}, {}, {}, {}, {}, Access::SampledCompute}};
   // What the scene and reflection passes draw: the static scene, and the moving boulder with
   // its own constants (translated to where its obstacle is this frame).
   std::vector<SceneDraw> scene_draws;
@@ -164,6 +183,12 @@ struct Renderer::Impl {
   gpu::SceneConstants constants{};
   gpu::SceneConstants reflection_constants{};
   gpu::FlowConstants flow_constants{};
+  gpu::FlowTileConstants tile_constants{};
+  // The tile table's lattice (shaders/shared.h): the points the water heights cover, and the
+  // table's size, a power of two per axis.
+  glm::ivec2 lattice_lo{0};
+  glm::ivec2 lattice_hi{0};
+  TileTableLayout tile_table;  // its corner moves with the camera when the river is larger
 
   // With CreateInfo::enable_timing: per slot, two timestamps around each pass of the graph.
   std::vector<VkQueryPool> query_pools;
@@ -186,6 +211,8 @@ struct Renderer::Impl {
   Status create_frame_images();
   const Image* find_frame_image(ImageHandle handle) const;
   Status stage_static_data();
+  void make_tile_lattice(const std::vector<glm::vec3>& surface, const std::vector<uint32_t>& indices);
+  glm::ivec2 tile_window(glm::vec3 camera_position) const;
   Status simulate(const Camera& camera, double time_seconds);
   float visible_water_level();
   Status record_static_upload(VkCommandBuffer cmd);
@@ -330,6 +357,7 @@ Status Renderer::Impl::create_static_resources() {
   static_buffers[kRiverVertices].bytes = bytes_of(surface.positions);
   static_buffers[kRiverDepths].bytes = bytes_of(surface.depth);
   static_buffers[kRiverIndices].bytes = bytes_of(surface.indices);
+  make_tile_lattice(surface.positions, surface.indices);
 
   DetailTexture detail = make_detail_texture();
   static_images[kDetail].extent = {detail.size, detail.size};
@@ -351,6 +379,48 @@ Status Renderer::Impl::create_static_resources() {
   return Status::success();
 }
 
+// The water heights around the river, and the tile table that covers their lattice points (or
+// as many as SIVIFLOW_TILE_TABLE_MAX allows, then a window around the camera).
+void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
+                                       const std::vector<uint32_t>& indices) {
+  const float half_tile = 0.5f * kTdfTileMetres;
+  // A tile reaches half a tile beyond the water it covers; the margin keeps its centre inside.
+  const WaterHeights heights = water_heights(surface, half_tile, kTdfTileMetres, kMaxWaterHeightSamples);
+  const glm::vec2 far_corner = heights.origin + heights.spacing * glm::vec2(heights.columns - 1, heights.rows - 1);
+  lattice_lo = glm::ivec2(glm::floor(heights.origin / half_tile));
+  lattice_hi = glm::ivec2(glm::ceil(far_corner / half_tile));
+  const auto table_side = [](int points) {
+    return std::min(std::bit_ceil(static_cast<uint32_t>(points)), SIVIFLOW_TILE_TABLE_MAX);
+  };
+  tile_table.width = table_side(lattice_hi.x - lattice_lo.x + 1);
+  tile_table.height = table_side(lattice_hi.y - lattice_lo.y + 1);
+  tile_table.tile_size_m = kTdfTileMetres;
+  tile_constants.heights = glm::vec4(heights.origin, heights.spacing, kTdfTileMetres);
+  StaticImage& image = static_images[kWaterHeights];
+  image.extent = {heights.columns, heights.rows};
+  // A tile centre is within a tile of water it covers, and water within its longest triangle
+  // edge of a vertex: samples farther than both are no tile's. Steps go along the axes, so a
+  // distance d takes up to d sqrt(2) / spacing of them, plus one for the vertex's own sample.
+  const float reach = (kTdfTileMetres + longest_edge_xz(surface, indices)) * std::sqrt(2.0f);
+  const auto reach_steps = static_cast<uint32_t>(std::ceil(reach / heights.spacing)) + 1;
+  std::vector<float> texels(heights.heights.size());
+  for (size_t i = 0; i < texels.size(); ++i) {
+    texels[i] = heights.steps[i] <= reach_steps ? heights.heights[i] : static_cast<float>(SIVIFLOW_FAR_FROM_WATER);
+  }
+  const auto* first = reinterpret_cast<const uint8_t*>(texels.data());
+  image.texels.assign(first, first + texels.size() * sizeof(float));
+  image.mip_offsets = {0};
+}
+
+// The lattice point of the tile table's window corner: the river's first point when the table
+// holds them all, else a window centred on the camera and kept over the river.
+glm::ivec2 Renderer::Impl::tile_window(glm::vec3 camera_position) const {
+  const glm::ivec2 size(tile_table.width, tile_table.height);
+  const glm::ivec2 camera(glm::round(glm::vec2(camera_position.x, camera_position.z) / (0.5f * kTdfTileMetres)));
+  const glm::ivec2 corner = glm::clamp(camera - size / 2, lattice_lo, glm::max(lattice_lo, lattice_hi - size + 1));
+  return corner;
+}
+
 Status Renderer::Impl::declare_static_graph() {
   static_staging = static_graph.import_buffer({"static staging", 0}, ResourceState{});
   for (const StaticBuffer& b : static_buffers) {
@@ -362,7 +432,7 @@ Status Renderer::Impl::declare_static_graph() {
   for (const StaticImage& i : static_images) {
     const ImageHandle handle = static_graph.import_image({i.name, i.format, i.extent, {}},
                                                          ResourceState{},
-                                                         state_of(Access::SampledFragment));
+                                                         state_of(i.read_as));
     image_handles.push_back(handle);
     for (uint32_t level = 0; level < i.mip_offsets.size(); ++level) {
       const VkExtent2D extent{std::max(1u, i.extent.width >> level), std::max(1u, i.extent.height >> level)};
@@ -403,8 +473,7 @@ Status Renderer::Impl::declare_graph() {
   }
   for (StaticImage& i : static_images) {
     i.in_frame_graph = graph.import_image({i.name, i.format, i.extent, {}},
-                                          state_of(Access::SampledFragment),
-                                          state_of(Access::SampledFragment));
+                                          state_of(i.read_as), state_of(i.read_as));
   }
   VkClearValue transparent{};
   VkClearValue far_depth{};
@@ -469,16 +538,19 @@ Status Renderer::Impl::declare_graph() {
     water.reflection_sample = frame_image(
         graph.create_image({"reflection sample", FlowPass::kReflectionFormat, extent, transparent}));
   }
+  water.water_heights = static_images[kWaterHeights].in_frame_graph;
+  water.tile_table = frame_image(graph.create_image({"tile table", FlowPass::kTileTableFormat, {tile_table.width, tile_table.height}, {}}));
+  flow_pass.declare_tiles(graph, &tile_constants, &water);
   flow_pass.declare(graph, &flow_constants, river_index_count, &water);
   if (info.enable_timing) {
-    const ImageHandle floor = frame_image(graph.create_image({"flow floor", FlowPass::kFloorFormat, extent, {}}));
+    const ImageHandle floor = frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
     flow_pass.declare_floor(graph, &flow_constants, river_index_count, water, floor);
   }
 
   if (info.enable_readback) {
     const ImageHandle images[kReadbackImageCount] = {
         water.color, scene.depth, water.mask, frame_uploads.images[0].destination,
-        frame_uploads.images[1].destination, water.normal, water.reflection_sample};
+        frame_uploads.images[1].destination, water.normal, water.reflection_sample, water.tile_table};
     readbacks.clear();
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
       const BufferHandle buffer = graph.import_buffer(
@@ -496,6 +568,8 @@ Status Renderer::Impl::declare_graph() {
   textures.aux = find_frame_image(particle_aux)->view;
   textures.reflection = find_frame_image(mirrored.color)->view;
   textures.normal_map = static_images[kNormalMap].image.view;
+  textures.tile_table = find_frame_image(water.tile_table)->view;
+  textures.water_heights = static_images[kWaterHeights].image.view;
   return flow_pass.bind_textures(gpu, textures, [this](VkDescriptorPool pool) {
     ring.defer_deletion_until_all_slots([gpu_context = gpu, pool] {
       gpu_context.table->vkDestroyDescriptorPool(gpu_context.table->device, pool,
@@ -698,14 +772,20 @@ Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
 
   const FlowTextureLayout& layout = simulation.layout();
   flow_constants.view_proj = constants.view_proj;
-  flow_constants.camera_position =
-      glm::vec4(camera.position, static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
+  flow_constants.camera_position = glm::vec4(camera.position, 0.0f);
   flow_constants.sun_direction = sun;
   flow_constants.water = glm::vec4(h, kReflectionDistortion, kTdfTileMetres,
                                    static_cast<float>(layout.texel_px));
   flow_constants.screen = glm::vec4(info.extent.width, info.extent.height,
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
+  tile_constants.view_proj = constants.view_proj;
+  const glm::ivec2 corner = tile_window(camera.position);
+  tile_table.corner_x = corner.x;
+  tile_table.corner_z = corner.y;
+  tile_constants.lattice = glm::vec4(corner, tile_table.width, tile_table.height);
+  tile_constants.screen = glm::vec4(info.extent.width, info.extent.height, static_cast<float>(layout.texel_px),
+                                    static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
   // The obstacles where they are this frame, each drawn as a translated boulder.
   for (size_t i = 0; i < obstacles.size(); ++i) {
     const glm::vec3 offset = simulation.obstacle_centre(i);
@@ -720,7 +800,7 @@ Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
 // spread evenly over the water on screen, so this is the level of most of the water seen (a
 // level river's own level); a descending river's reflection is right where most of it shows.
 float Renderer::Impl::visible_water_level() {
-  std::vector<float>& heights = water_heights;  // kept: a steady frame allocates nothing
+  std::vector<float>& heights = particle_heights;  // kept: a steady frame allocates nothing
   heights.clear();
   for (const Particle& p : simulation.particle_field().particles()) {
     if (p.live()) heights.push_back(p.world.y);
@@ -877,6 +957,8 @@ VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
     case ReadbackImage::kNormal:
     case ReadbackImage::kReflection:
       return pixels * 4 * sizeof(float);
+    case ReadbackImage::kTileTable:
+      return VkDeviceSize{impl_->tile_table.width} * impl_->tile_table.height * 4 * sizeof(uint32_t);
   }
   return 0;
 }
@@ -897,11 +979,15 @@ const char* readback_image_name(ReadbackImage image) {
       return "readback water normal";
     case ReadbackImage::kReflection:
       return "readback reflection sample";
+    case ReadbackImage::kTileTable:
+      return "readback tile table";
   }
   return "readback";
 }
 
 const ParticleField& Renderer::particle_field() const { return impl_->simulation.particle_field(); }
+const TileTableLayout& Renderer::tile_table_layout() const { return impl_->tile_table; }
+
 const FlowTextureLayout& Renderer::flow_texture_layout() const { return impl_->simulation.layout(); }
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 

@@ -9,6 +9,7 @@ layout(set = 0, binding = 0) uniform usampler2D flow_texture;   // shared.h layo
 layout(set = 0, binding = 1) uniform sampler2D particle_aux;    // shared.h layout, texelFetch only
 layout(set = 0, binding = 2) uniform sampler2D reflection_map;  // the mirrored scene
 layout(set = 0, binding = 3) uniform sampler2D normal_map;      // tileable ripples, mipmapped
+layout(set = 0, binding = 4) uniform usampler2D tile_table;     // this frame's, flow_tiles.comp
 
 layout(location = 0) in vec3 in_world;
 layout(location = 1) in float in_depth;
@@ -30,21 +31,20 @@ const float kFresnelF0 = 0.02;           // water at normal incidence
 const float kFadeInfluence = 0.25;       // how much a fading particle calms its cell
 
 void main() {
-  // The particle covering this pixel: its flow, and by its slot its speed, depth, slope, fade
-  // (slot 0, no particle, reads the aux texture's all-zero texel 0: no branch needed).
-  uvec4 own = texelFetch(flow_texture, ivec2(gl_FragCoord.xy * (1.0 / flow.water.w)), 0);
-  vec3 own_flow = tdf_texel_flow(own);
-  float fade = texelFetch(particle_aux, ivec2(own.r % SIVIFLOW_AUX_WIDTH,
-                                               own.r / SIVIFLOW_AUX_WIDTH), 0).a;
+  // The particle covering this pixel, and by its slot its speed, depth, slope, fade (slot 0, no
+  // particle, reads the aux texture's all-zero texel 0: no branch needed). Its flow reaches the
+  // ripples through the tile table.
+  uint own = texelFetch(flow_texture, ivec2(gl_FragCoord.xy * (1.0 / flow.water.w)), 0).r;
+  float fade = texelFetch(particle_aux, ivec2(own % SIVIFLOW_AUX_WIDTH,
+                                               own / SIVIFLOW_AUX_WIDTH), 0).a;
 
   // Shallow water ripples less, so the shore is calm. A fading particle only eases its cell's
   // ripples part of the way: a full fade would print the particles' cells on the water.
   float shore = smoothstep(0.0, kShoreFadeMetres, in_depth);
   float transparency = shore * mix(1.0 - kFadeInfluence, 1.0, fade);
-  TdfResult tdf = tdf_normal(in_world, vec3(0.0, 1.0, 0.0), own_flow,
-                             kRippleStrength * transparency * transparency,
-                             flow.camera_position.w, flow.water.z, flow.view_proj, flow.screen.xy,
-                             flow.water.w, flow_texture, normal_map);
+  TdfResult tdf = tdf_normal(in_world, vec3(0.0, 1.0, 0.0),
+                             kRippleStrength * transparency * transparency, flow.water.z,
+                             tile_table, normal_map);
   vec3 n = tdf.normal;
 
   // Reflection: the mirrored scene at this pixel, offset by the normal's tilt (paper §4.3).

@@ -98,14 +98,42 @@ static_assert(offsetof(ParticleAux, fade) == 12);
 // Push constants of the flow pass (the water material).
 struct FlowConstants {
   mat4 view_proj;        // world -> clip of the main view
-  vec4 camera_position;  // xyz world position; w scene time in seconds mod SIVIFLOW_TDF_TIME_PERIOD
+  vec4 camera_position;  // xyz world position, w unused
   vec4 sun_direction;    // xyz unit vector towards the sun
   vec4 water;            // x water level (m), y reflection distortion (uv per unit normal tilt),
                          // z TDF tile size (m), w flow texel size (pixels)
   vec4 screen;           // xy output size (pixels), zw 1 / size
 };
 
-// Scene time reaches the water material wrapped to [0, this period) seconds (wrapped on the CPU
+// The flow pass's tile table (shaders/flow_tiles.comp, read by tiled_directional_flow.glsl).
+// Tiled Directional Flow reads one flow per tile of four grids offset by half a tile; all their
+// centres lie on one lattice of half-tile spacing: lattice point (i, j) is the world point
+// (i, j) * tile_size / 2 in x, z, and belongs to grid (i even) + 2 (j even). Per frame, a pass
+// fills each lattice point near the camera with what its tile needs, once, instead of every
+// water fragment redoing it for its four tiles. The table is VK_FORMAT_R32G32B32A32_UINT,
+// SIVIFLOW_TILE_TABLE_MAX texels a side at most and a power of two; lattice point (i, j) lives
+// in texel (i, j) mod size:
+//   .r  .g  float bits of (a, b): the tile's map transform M = mat2(a, -b, b, a), its rotation
+//           by the flow direction times the map repeats per tile (its length also gives the
+//           roughness, tdf_back_rotation)
+//   .b  .a  float bits of the map offset at the tile centre: hashed offset minus the scroll
+#define SIVIFLOW_TILE_TABLE_MAX 512u
+// Water heights (R32_SFLOAT, world-aligned samples, see FlowTileConstants.heights) are this or
+// more where no water is near: the lattice points there are no tile of any water fragment.
+#define SIVIFLOW_FAR_FROM_WATER 1.0e30
+
+// Push constants of the tile table pass (compute).
+struct FlowTileConstants {
+  mat4 view_proj;  // world -> clip of the main view
+  vec4 lattice;    // xy the lattice point of the table's window corner, zw the table size (all
+                   // integers): texel t holds the point corner + ((t - corner) mod size)
+  vec4 heights;    // xy world x, z of water height sample (0, 0), z metres between samples,
+                   // w tile size (m)
+  vec4 screen;     // xy output size (pixels), z flow texel size (pixels), w scene time in
+                   // seconds mod SIVIFLOW_TDF_TIME_PERIOD
+};
+
+// Scene time reaches the tile table pass wrapped to [0, this period) seconds (wrapped on the CPU
 // in double): floats keep sub-millisecond steps, and every TDF scroll rate makes whole cycles per
 // period, so the wrap is seamless.
 #define SIVIFLOW_TDF_TIME_PERIOD 64.0
@@ -116,6 +144,10 @@ struct FlowConstants {
 
 #ifdef __cplusplus
 static_assert(sizeof(FlowConstants) == 128);
+static_assert(sizeof(FlowTileConstants) == 112);
+static_assert(offsetof(FlowTileConstants, lattice) == 64);
+static_assert(offsetof(FlowTileConstants, heights) == 80);
+static_assert(offsetof(FlowTileConstants, screen) == 96);
 static_assert(offsetof(FlowConstants, camera_position) == 64);
 static_assert(offsetof(FlowConstants, water) == 96);
 static_assert(offsetof(FlowConstants, screen) == 112);

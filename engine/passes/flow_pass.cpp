@@ -1,6 +1,7 @@
 #include "passes/passes.h"
 
 #include <array>
+#include <span>
 #include <string>
 
 #include "vk/device_table.h"
@@ -9,9 +10,14 @@
 namespace siviflow {
 namespace {
 
-// Bindings 0..3 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
-// normal map.
-constexpr uint32_t kBindingCount = 4;
+// Bindings 0..4 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
+// normal map, tile table.
+constexpr uint32_t kBindingCount = 5;
+// Bindings of shaders/flow_tiles.comp: flow texture, water heights, tile table.
+constexpr std::array<VkDescriptorType, 3> kTileBindings = {
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+constexpr uint32_t kTileGroupSide = 8;  // flow_tiles.comp's local size
 
 }  // namespace
 
@@ -39,60 +45,91 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
   desc.attributes = {{SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                      {SIVIFLOW_ATTR_WATER_DEPTH, 1, VK_FORMAT_R32_SFLOAT, 0}};
   SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, desc, &pipeline_));
+  SIVIFLOW_TRY(create_layouts(gpu, kTileBindings, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(gpu::FlowTileConstants),
+                              &tiles_set_layout_, &tiles_layout_));
+  SIVIFLOW_TRY(create_compute_pipeline(gpu, cache, "flow_tiles.comp", tiles_layout_, &tiles_pipeline_));
   if (!with_floor) return Status::success();
-  // The same geometry and depth test as the water, so the floor shades exactly its pixels.
+  // The same geometry, depth test, colour format and blending as the water, so the floor shades
+  // exactly its pixels and writes them as the water does.
   GraphicsPipelineDesc floor = desc;
   floor.fragment_shader = "flow_floor.frag";
-  floor.color_format = kFloorFormat;
   floor.extra_color_formats.clear();
-  floor.alpha_blend = false;
   return create_graphics_pipeline(gpu, cache, floor, &floor_pipeline_);
 }
 
 void FlowPass::destroy(const GpuContext& gpu) {
   const DeviceTable& vk = *gpu.table;
   const VkAllocationCallbacks* callbacks = gpu.allocation_callbacks;
-  if (pipeline_ != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline_, callbacks);
-  if (floor_pipeline_ != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, floor_pipeline_, callbacks);
-  if (pool_ != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool_, callbacks);
+  for (VkPipeline pipeline : {pipeline_, tiles_pipeline_, floor_pipeline_}) {
+    if (pipeline != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline, callbacks);
+  }
+  for (VkDescriptorPool pool : {pool_, tiles_pool_}) {
+    if (pool != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool, callbacks);
+  }
   for (VkSampler sampler : {nearest_, linear_clamp_, linear_repeat_}) {
     if (sampler != VK_NULL_HANDLE) vk.vkDestroySampler(vk.device, sampler, callbacks);
   }
-  if (layout_ != VK_NULL_HANDLE) vk.vkDestroyPipelineLayout(vk.device, layout_, callbacks);
-  if (set_layout_ != VK_NULL_HANDLE) vk.vkDestroyDescriptorSetLayout(vk.device, set_layout_, callbacks);
+  for (VkPipelineLayout layout : {layout_, tiles_layout_}) {
+    if (layout != VK_NULL_HANDLE) vk.vkDestroyPipelineLayout(vk.device, layout, callbacks);
+  }
+  for (VkDescriptorSetLayout layout : {set_layout_, tiles_set_layout_}) {
+    if (layout != VK_NULL_HANDLE) vk.vkDestroyDescriptorSetLayout(vk.device, layout, callbacks);
+  }
   *this = FlowPass{};
 }
 
 Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
                                const std::function<void(VkDescriptorPool)>& retire) {
   const DeviceTable& vk = *gpu.table;
-  // A new set first: on failure the current one stays valid.
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  VkDescriptorSet set = VK_NULL_HANDLE;
-  const Status allocated = allocate_sampler_sets(gpu, set_layout_, kBindingCount, 1, &pool, &set);
+  // New sets first: on failure the current ones stay valid.
+  const std::array<VkDescriptorType, kBindingCount> material_bindings{
+      VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+      VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+      VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
+  std::array<VkDescriptorPool, 2> pools{};
+  std::array<VkDescriptorSet, 2> sets{};
+  Status allocated = allocate_sets(gpu, set_layout_, material_bindings, 1, &pools[0], &sets[0]);
+  if (allocated.ok()) allocated = allocate_sets(gpu, tiles_set_layout_, kTileBindings, 1, &pools[1], &sets[1]);
   if (!allocated.ok()) {
-    if (pool != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool, gpu.allocation_callbacks);
+    for (VkDescriptorPool pool : pools) {
+      if (pool != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool, gpu.allocation_callbacks);
+    }
     return allocated;
   }
-  if (pool_ != VK_NULL_HANDLE) retire(pool_);
-  pool_ = pool;
-  set_ = set;
+  for (VkDescriptorPool pool : {pool_, tiles_pool_}) {
+    if (pool != VK_NULL_HANDLE) retire(pool);
+  }
+  pool_ = pools[0];
+  tiles_pool_ = pools[1];
+  set_ = sets[0];
+  tiles_set_ = sets[1];
   const VkImageLayout read = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  const std::array<VkDescriptorImageInfo, kBindingCount> images{{
+  const std::array<VkDescriptorImageInfo, kBindingCount> material{{
       {nearest_, textures.flow, read},
       {nearest_, textures.aux, read},
       {linear_clamp_, textures.reflection, textures.reflection_layout},
-      {linear_repeat_, textures.normal_map, read}}};
-  std::array<VkWriteDescriptorSet, kBindingCount> writes{};
-  for (uint32_t i = 0; i < kBindingCount; ++i) {
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = set_;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    writes[i].pImageInfo = &images[i];
-  }
-  vk.vkUpdateDescriptorSets(vk.device, kBindingCount, writes.data(), 0, nullptr);
+      {linear_repeat_, textures.normal_map, read},
+      {nearest_, textures.tile_table, read}}};
+  const std::array<VkDescriptorImageInfo, kTileBindings.size()> tiles{{
+      {nearest_, textures.flow, read},
+      {nearest_, textures.water_heights, read},
+      {VK_NULL_HANDLE, textures.tile_table, VK_IMAGE_LAYOUT_GENERAL}}};
+  std::vector<VkWriteDescriptorSet> writes;
+  const auto write = [&writes](VkDescriptorSet set, std::span<const VkDescriptorType> types,
+                               std::span<const VkDescriptorImageInfo> images) {
+    for (uint32_t i = 0; i < types.size(); ++i) {
+      VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+      w.dstSet = set;
+      w.dstBinding = i;
+      w.descriptorCount = 1;
+      w.descriptorType = types[i];
+      w.pImageInfo = &images[i];
+      writes.push_back(w);
+    }
+  };
+  write(set_, material_bindings, material);
+  write(tiles_set_, kTileBindings, tiles);
+  vk.vkUpdateDescriptorSets(vk.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
   return Status::success();
 }
 
@@ -110,12 +147,34 @@ void FlowPass::declare(FrameGraph& graph, const gpu::FlowConstants* constants, u
   pass.sampled_fragment(handles->aux);
   pass.sampled_fragment(handles->reflection);
   pass.sampled_fragment(handles->normal_map);
+  pass.sampled_fragment(handles->tile_table);
   pass.vertex_read(handles->vertices);
   pass.vertex_read(handles->depths);
   pass.index_read(handles->indices);
   const Handles h = *handles;
   pass.record([this, h, constants, index_count](const PassContext& ctx) {
     draw_river(ctx, pipeline_, h, ctx.extent(h.color), constants, index_count);
+    return Status::success();
+  });
+}
+
+void FlowPass::declare_tiles(FrameGraph& graph, const gpu::FlowTileConstants* constants,
+                             Handles* handles) {
+  PassBuilder pass = graph.add_pass("flow tiles", PassKind::Compute);
+  handles->tile_table = pass.storage_write(handles->tile_table);  // every texel written
+  pass.sampled(handles->flow, ShaderStage::Compute);
+  pass.sampled(handles->water_heights, ShaderStage::Compute);
+  const ImageHandle table = handles->tile_table;
+  pass.record([this, table, constants](const PassContext& ctx) {
+    const DeviceTable& vk = ctx.table();
+    const VkCommandBuffer cmd = ctx.cmd();
+    vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tiles_pipeline_);
+    vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tiles_layout_, 0, 1, &tiles_set_, 0, nullptr);
+    vk.vkCmdPushConstants(cmd, tiles_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::FlowTileConstants),
+                          constants);
+    const VkExtent2D extent = ctx.extent(table);
+    vk.vkCmdDispatch(cmd, (extent.width + kTileGroupSide - 1) / kTileGroupSide,
+                     (extent.height + kTileGroupSide - 1) / kTileGroupSide, 1);
     return Status::success();
   });
 }
@@ -129,6 +188,7 @@ void FlowPass::declare_floor(FrameGraph& graph, const gpu::FlowConstants* consta
   pass.sampled_fragment(inputs.aux);
   pass.sampled_fragment(inputs.reflection);
   pass.sampled_fragment(inputs.normal_map);
+  pass.sampled_fragment(inputs.tile_table);
   pass.vertex_read(inputs.vertices);
   pass.vertex_read(inputs.depths);
   pass.index_read(inputs.indices);

@@ -97,17 +97,19 @@ class ScenePass {
 
 // ---- flow: the water material of Algorithm 3, drawn over the scene ----
 
-// Draws the river surface: per fragment the particle flow (flow texture, aux data by slot), the
-// Tiled Directional Flow normal, the reflection sampled with that normal, depth colour and shore
-// fade, blended over the scene's colour. With AOVs it also writes the water mask, the normal
-// and the reflection sample, unblended.
+// Draws the river surface: first (compute) the tile table, the flow at every Tiled Directional
+// Flow tile centre near the camera; then per fragment the particle (flow texture, aux data by
+// slot), the Tiled Directional Flow normal from the table, the reflection sampled with that
+// normal, depth colour and shore fade, blended over the scene's colour. With AOVs it also writes
+// the water mask, the normal and the reflection sample, unblended.
 class FlowPass {
  public:
   static constexpr VkFormat kMaskFormat = VK_FORMAT_R32_SFLOAT;
   static constexpr VkFormat kNormalFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
   static constexpr VkFormat kReflectionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 
-  static constexpr VkFormat kFloorFormat = VK_FORMAT_R8_UNORM;
+  static constexpr VkFormat kTileTableFormat = VK_FORMAT_R32G32B32A32_UINT;  // shaders/shared.h
+  static constexpr VkFormat kWaterHeightsFormat = VK_FORMAT_R32_SFLOAT;
 
   // with_floor: also the bench's floor pipeline (declare_floor).
   Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
@@ -120,6 +122,8 @@ class FlowPass {
     VkImageView reflection = VK_NULL_HANDLE;  // the mirrored scene
     VkImageLayout reflection_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     VkImageView normal_map = VK_NULL_HANDLE;  // tileable, mipmapped
+    VkImageView tile_table = VK_NULL_HANDLE;  // kTileTableFormat
+    VkImageView water_heights = VK_NULL_HANDLE;  // kWaterHeightsFormat, sim/water_heights.h
   };
   // Points a fresh descriptor set at the textures of this configuration. The previous pool is
   // handed to `retire`, to be destroyed once no frame in flight uses it.
@@ -133,6 +137,8 @@ class FlowPass {
     ImageHandle aux;
     ImageHandle reflection;
     ImageHandle normal_map;
+    ImageHandle tile_table;     // written by declare_tiles (compute), read by the material
+    ImageHandle water_heights;  // read by declare_tiles
     BufferHandle vertices;   // river surface positions (vec3)
     BufferHandle depths;     // water depth per vertex (float)
     BufferHandle indices;
@@ -140,11 +146,14 @@ class FlowPass {
     ImageHandle normal;
     ImageHandle reflection_sample;
   };
+  // The tile table of this frame (shaders/flow_tiles.comp), before declare; the new version of
+  // handles->tile_table goes back into `handles`.
+  void declare_tiles(FrameGraph& graph, const gpu::FlowTileConstants* constants, Handles* handles);
   void declare(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
                Handles* handles);
   // The floor of the flow pass for benchmarks: the same pixels (river mesh, depth test) making
-  // the same texture reads with next to no arithmetic, into `target` (kFloorFormat); kept
-  // although nothing reads it.
+  // the same texture reads with next to no arithmetic, blended into `target` (of the colour
+  // format); kept although nothing reads it.
   void declare_floor(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
                      const Handles& inputs, ImageHandle target);
 
@@ -157,6 +166,11 @@ class FlowPass {
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
+  VkPipeline tiles_pipeline_ = VK_NULL_HANDLE;  // compute, with a layout and set of its own
+  VkDescriptorSetLayout tiles_set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout tiles_layout_ = VK_NULL_HANDLE;
+  VkDescriptorPool tiles_pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet tiles_set_ = VK_NULL_HANDLE;
   VkSampler nearest_ = VK_NULL_HANDLE;  // flow and aux: texelFetch only, integer formats
   VkSampler linear_clamp_ = VK_NULL_HANDLE;
   VkSampler linear_repeat_ = VK_NULL_HANDLE;

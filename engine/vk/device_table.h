@@ -38,6 +38,7 @@ namespace siviflow {
   X(vkCreatePipelineLayout)            \
   X(vkDestroyPipelineLayout)           \
   X(vkCreateGraphicsPipelines)         \
+  X(vkCreateComputePipelines)          \
   X(vkDestroyPipeline)                 \
   X(vkCreateDescriptorSetLayout)       \
   X(vkDestroyDescriptorSetLayout)      \
@@ -56,6 +57,7 @@ namespace siviflow {
   X(vkCmdSetViewport)                  \
   X(vkCmdSetScissor)                   \
   X(vkCmdDraw)                         \
+  X(vkCmdDispatch)                     \
   X(vkCmdDrawIndexed)                  \
   X(vkCmdCopyBuffer)                   \
   X(vkCmdCopyBufferToImage)            \

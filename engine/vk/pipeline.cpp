@@ -1,5 +1,6 @@
 #include "vk/pipeline.h"
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -147,20 +148,39 @@ Status vk_status(VkResult result, const char* call) {
   return Status::error(std::string(call) + " failed: " + result_name(result), result);
 }
 
-Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_t push_constant_bytes,
-                          VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout) {
+Status create_compute_pipeline(const GpuContext& gpu, VkPipelineCache cache, std::string_view shader,
+                               VkPipelineLayout layout, VkPipeline* out) {
   const DeviceTable& vk = *gpu.table;
-  std::vector<VkDescriptorSetLayoutBinding> bindings(sampler_count);
-  for (uint32_t i = 0; i < sampler_count; ++i) {
-    bindings[i] = {i, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+  VkShaderModule module = VK_NULL_HANDLE;
+  SIVIFLOW_TRY(create_module(gpu, shader, &module));
+  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = module;
+  info.stage.pName = "main";
+  info.layout = layout;
+  const VkResult result =
+      vk.vkCreateComputePipelines(vk.device, cache, 1, &info, gpu.allocation_callbacks, out);
+  vk.vkDestroyShaderModule(vk.device, module, gpu.allocation_callbacks);
+  if (result != VK_SUCCESS) {
+    return Status::error("vkCreateComputePipelines (" + std::string(shader) + ") failed: " + result_name(result),
+                         result);
   }
+  return Status::success();
+}
+
+Status create_layouts(const GpuContext& gpu, std::span<const VkDescriptorType> bindings,
+                      VkShaderStageFlags stages, uint32_t push_constant_bytes,
+                      VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout) {
+  const DeviceTable& vk = *gpu.table;
+  std::vector<VkDescriptorSetLayoutBinding> set_bindings(bindings.size());
+  for (uint32_t i = 0; i < bindings.size(); ++i) set_bindings[i] = {i, bindings[i], 1, stages, nullptr};
   VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  set_info.bindingCount = sampler_count;
-  set_info.pBindings = bindings.data();
+  set_info.bindingCount = static_cast<uint32_t>(set_bindings.size());
+  set_info.pBindings = set_bindings.data();
   SIVIFLOW_TRY(vk_status(vk.vkCreateDescriptorSetLayout(vk.device, &set_info, gpu.allocation_callbacks, set_layout),
                          "vkCreateDescriptorSetLayout"));
-  const VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                                  push_constant_bytes};
+  const VkPushConstantRange range{stages, 0, push_constant_bytes};
   VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
   layout_info.setLayoutCount = 1;
   layout_info.pSetLayouts = set_layout;
@@ -170,15 +190,31 @@ Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_
                    "vkCreatePipelineLayout");
 }
 
-Status allocate_sampler_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
-                             uint32_t sampler_count, uint32_t set_count, VkDescriptorPool* pool,
-                             VkDescriptorSet* sets) {
+Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_t push_constant_bytes,
+                          VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout) {
+  const std::vector<VkDescriptorType> samplers(sampler_count, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
+  return create_layouts(gpu, samplers, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                        push_constant_bytes, set_layout, layout);
+}
+
+Status allocate_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
+                     std::span<const VkDescriptorType> bindings, uint32_t set_count,
+                     VkDescriptorPool* pool, VkDescriptorSet* sets) {
   const DeviceTable& vk = *gpu.table;
-  const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, sampler_count * set_count};
+  std::vector<VkDescriptorPoolSize> sizes;
+  for (VkDescriptorType type : bindings) {
+    const auto same = std::find_if(sizes.begin(), sizes.end(),
+                                   [type](const VkDescriptorPoolSize& size) { return size.type == type; });
+    if (same != sizes.end()) {
+      same->descriptorCount += set_count;
+    } else {
+      sizes.push_back({type, set_count});
+    }
+  }
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = set_count;
-  pool_info.poolSizeCount = 1;
-  pool_info.pPoolSizes = &size;
+  pool_info.poolSizeCount = static_cast<uint32_t>(sizes.size());
+  pool_info.pPoolSizes = sizes.data();
   SIVIFLOW_TRY(vk_status(vk.vkCreateDescriptorPool(vk.device, &pool_info, gpu.allocation_callbacks, pool),
                          "vkCreateDescriptorPool"));
   VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
@@ -187,6 +223,13 @@ Status allocate_sampler_sets(const GpuContext& gpu, VkDescriptorSetLayout set_la
   alloc.descriptorSetCount = set_count;
   alloc.pSetLayouts = layouts.data();
   return vk_status(vk.vkAllocateDescriptorSets(vk.device, &alloc, sets), "vkAllocateDescriptorSets");
+}
+
+Status allocate_sampler_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
+                             uint32_t sampler_count, uint32_t set_count, VkDescriptorPool* pool,
+                             VkDescriptorSet* sets) {
+  const std::vector<VkDescriptorType> samplers(sampler_count, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
+  return allocate_sets(gpu, set_layout, samplers, set_count, pool, sets);
 }
 
 Status create_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMode address,

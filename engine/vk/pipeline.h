@@ -1,8 +1,9 @@
-// Graphics pipelines for dynamic rendering, built from the SPIR-V embedded at build time, and the
+// Graphics pipelines for dynamic rendering and compute pipelines, built from the SPIR-V embedded at build time, and the
 // small objects every pass creates with them: layouts, samplers, descriptor sets.
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -33,6 +34,9 @@ struct GraphicsPipelineDesc {
 Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
                                 const GraphicsPipelineDesc& desc, VkPipeline* out);
 
+Status create_compute_pipeline(const GpuContext& gpu, VkPipelineCache cache, std::string_view shader,
+                               VkPipelineLayout layout, VkPipeline* out);
+
 // The result of a Vulkan call as a Status naming the call: "vkCreateSampler failed: ...".
 Status vk_status(VkResult result, const char* call);
 
@@ -41,7 +45,16 @@ Status vk_status(VkResult result, const char* call);
 Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_t push_constant_bytes,
                           VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout);
 
+// A set layout of `bindings` (binding i of type bindings[i]) for `stages`, and a pipeline layout
+// with that set and one push-constant range for `stages`.
+Status create_layouts(const GpuContext& gpu, std::span<const VkDescriptorType> bindings,
+                      VkShaderStageFlags stages, uint32_t push_constant_bytes,
+                      VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout);
+
 // `set_count` sets of that layout from a pool of their own (destroy the pool to free them).
+Status allocate_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
+                     std::span<const VkDescriptorType> bindings, uint32_t set_count,
+                     VkDescriptorPool* pool, VkDescriptorSet* sets);
 Status allocate_sampler_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
                              uint32_t sampler_count, uint32_t set_count, VkDescriptorPool* pool,
                              VkDescriptorSet* sets);

@@ -10,12 +10,12 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
-#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include "run_command.h"
 #include "scene/default_scene.h"
 #include "siviflow/image_files.h"
+#include "view_proj.h"
 
 namespace siviflow::testing {
 namespace {
@@ -114,12 +114,7 @@ struct WaterPixel {
 // The water pixels with a flow of at least 0.2 m/s, placed in the world through the renderer's
 // camera and the depth AOV.
 std::vector<WaterPixel> water_pixels(const ExrImage& image, const Camera& camera) {
-  glm::mat4 projection = glm::perspectiveRH_ZO(glm::radians(camera.fov_y_deg),
-                                               float(kWidth) / float(kHeight), camera.near_plane,
-                                               camera.far_plane);
-  projection[1][1] *= -1.0f;
-  const glm::mat4 view = glm::lookAtRH(camera.position, camera.target, glm::vec3(0, 1, 0));
-  const glm::mat4 inverse = glm::inverse(projection * view);
+  const glm::mat4 inverse = glm::inverse(view_proj_of(camera, kWidth, kHeight));
   const glm::vec3 forward = glm::normalize(camera.target - camera.position);
   std::vector<WaterPixel> pixels;
   for (int y = 0; y < kHeight; ++y) {

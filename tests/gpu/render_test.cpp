@@ -13,6 +13,7 @@
 #include "scene/default_scene.h"
 #include "shaders/shared.h"
 #include "sim/flow_textures.h"
+#include "view_proj.h"
 
 namespace siviflow::testing {
 namespace {
@@ -29,6 +30,7 @@ struct Frame {
   std::vector<std::byte> particle_aux;
   std::vector<float> normal;  // RGBA per pixel: xyz the water normal, 0 off water
   std::vector<float> reflection;  // RGBA per pixel: the reflection sample, 0 off water
+  std::vector<uint32_t> tile_table;  // RGBA32UI texels (shaders/shared.h)
 
   const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * width + x) * 4]; }
 };
@@ -77,6 +79,8 @@ class RenderTest : public GpuTest {
       out.normal.assign(normal, normal + size_t{width} * height * 4);
       const auto* reflection = static_cast<const float*>(slot.readback[6].data);
       out.reflection.assign(reflection, reflection + size_t{width} * height * 4);
+      const auto* tiles = static_cast<const uint32_t*>(slot.readback[7].data);
+      out.tile_table.assign(tiles, tiles + renderer_->readback_bytes(ReadbackImage::kTileTable) / sizeof(uint32_t));
       frames.push_back(std::move(out));
       slot.pending = false;
     };
@@ -318,6 +322,66 @@ TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
   }
   EXPECT_GT(on_screen, 20u);
   EXPECT_GE(own_texel * 100, on_screen * 95);
+}
+
+// Each tile of the water's Tiled Directional Flow takes the flow of the particle under its centre:
+// the tile table turns the map along that flow and scales it with its speed. Checked where that
+// particle lies within a tile of the centre: tiles farther from water are no water pixel's.
+TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
+  const std::vector<Frame> frames = render(0, 2);
+  ASSERT_EQ(frames.size(), 2u);
+  const Frame& frame = frames[1];
+  const TileTableLayout& table = renderer_->tile_table_layout();
+  ASSERT_EQ(frame.tile_table.size(), size_t{table.width} * table.height * 4);
+  const FlowTextureLayout& layout = renderer_->flow_texture_layout();
+  std::vector<std::byte> staging(layout.total_bytes);
+  std::memcpy(staging.data() + layout.flow_offset, frame.flow_texture.data(), layout.flow_bytes);
+  const glm::mat4 view_proj = view_proj_of(renderer_->scene_camera(1.0 / 30.0), kWidth, kHeight);
+  const float water_level = renderer_->particle_field().particles().front().world.y;  // level river
+  const glm::vec2 texels = glm::vec2(kWidth, kHeight) / float(layout.texel_px);
+  const glm::ivec2 size(table.width, table.height);
+  const glm::ivec2 corner(table.corner_x, table.corner_z);
+  std::vector<glm::vec3> particle_at(UINT16_MAX + 1);  // by slot
+  for (const Particle& p : renderer_->particle_field().particles()) particle_at[p.slot] = p.world;
+  size_t checked = 0;
+  size_t agreeing = 0;
+  for (int y = 0; y < size.y; ++y) {
+    for (int x = 0; x < size.x; ++x) {
+      const glm::ivec2 lattice = corner + ((glm::ivec2(x, y) - corner) & (size - 1));
+      const glm::vec2 centre = glm::vec2(lattice) * (0.5f * table.tile_size_m);
+      const glm::vec4 clip = view_proj * glm::vec4(centre.x, water_level, centre.y, 1.0f);
+      if (clip.w < 1e-3f) continue;
+      const glm::vec2 at = (glm::vec2(clip) / clip.w * 0.5f + 0.5f) * texels;
+      const glm::vec2 within = glm::fract(at);
+      // Off screen, or so near a texel edge that GPU rounding may pick the neighbour: skipped.
+      if (at.x < 0.0f || at.y < 0.0f || at.x >= texels.x || at.y >= texels.y ||
+          glm::any(glm::lessThan(within, glm::vec2(0.02f))) || glm::any(glm::greaterThan(within, glm::vec2(0.98f)))) {
+        continue;
+      }
+      gpu::FlowTexel texel{};
+      ASSERT_TRUE(read_flow_texel(staging, layout, uint32_t(at.x), uint32_t(at.y), &texel).ok());
+      const glm::vec3 flow = decode_flow(texel);
+      const float speed = glm::length(glm::vec2(flow.x, flow.z));
+      if (texel.id == SIVIFLOW_PARTICLE_NONE || speed < 0.05f) continue;  // no direction to check
+      const glm::vec3 particle = particle_at[texel.id];
+      if (glm::distance(glm::vec2(particle.x, particle.z), centre) > table.tile_size_m) continue;
+      ++checked;
+      const uint32_t* tile = &frame.tile_table[(size_t(y) * size.x + x) * 4];
+      glm::vec2 ab;
+      std::memcpy(&ab, tile, sizeof(ab));
+      // Map repeats per tile: 1 / 3.5 in still water, 1.5 / 3.5 from 1.5 m/s.
+      const float scale = glm::mix(1.0f, 1.5f, std::clamp(speed / 1.5f, 0.0f, 1.0f)) / 3.5f;
+      const float cos_angle = glm::dot(ab, glm::vec2(flow.x, flow.z)) / (glm::length(ab) * speed);
+      if (cos_angle > std::cos(glm::radians(0.5f)) && std::abs(glm::length(ab) - scale) < 1e-4f) {
+        ++agreeing;
+      } else {
+        ADD_FAILURE() << "lattice point (" << lattice.x << ", " << lattice.y << "): flow (" << flow.x
+                      << ", " << flow.z << "), table (" << ab.x << ", " << ab.y << ")";
+      }
+    }
+  }
+  EXPECT_GT(checked, 100u);
+  EXPECT_EQ(agreeing, checked);
 }
 
 TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {

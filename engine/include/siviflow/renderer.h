@@ -125,8 +125,20 @@ enum class ReadbackImage : uint32_t {
   kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)
   kNormal,       // RGBA32F: the final water normal in world space (xyz) on water, 0 elsewhere
   kReflection,   // RGBA32F: the reflection sample of the water material before blending
+  kTileTable,    // RGBA32UI: the water's tile table (shaders/shared.h), tile_table_layout()
 };
-inline constexpr uint32_t kReadbackImageCount = 7;
+inline constexpr uint32_t kReadbackImageCount = 8;
+
+// The tile table of the water material (shaders/shared.h): its size and which lattice points
+// the last updated frame put in it. Texel (x, y) holds lattice point
+// corner + ((x, y) - corner) mod size, the world point (i, j) * tile_size_m / 2 in x, z.
+struct TileTableLayout {
+  uint32_t width = 0;   // texels, a power of two
+  uint32_t height = 0;
+  int32_t corner_x = 0;  // lattice point of the window's corner
+  int32_t corner_z = 0;
+  float tile_size_m = 0.0f;
+};
 const char* readback_image_name(ReadbackImage image);
 
 struct ReadbackTargets {
@@ -183,6 +195,7 @@ class Renderer {
   const ParticleField& particle_field() const;
   // Where the flow texture's and the aux data's texels are (sizes, texel size in pixels).
   const FlowTextureLayout& flow_texture_layout() const;
+  const TileTableLayout& tile_table_layout() const;
   // The index of the next frame update() or simulate() will advance to.
   uint64_t next_frame() const;
 

@@ -1,0 +1,68 @@
+// The per-tile half of Tiled Directional Flow (see tiled_directional_flow.glsl): its tunables and
+// the tile table texel of one tile, made per frame by flow_tiles.comp. Any stage may include it.
+#ifndef SIVIFLOW_TDF_TILE_TABLE_GLSL
+#define SIVIFLOW_TDF_TILE_TABLE_GLSL
+
+#include "shared.h"
+
+// ---- Tunables (one place) ----------------------------------------------------------------------
+// Seconds; the CPU passes time modulo this. Define it in shared.h to share it with C++.
+#ifndef SIVIFLOW_TDF_TIME_PERIOD
+#define SIVIFLOW_TDF_TIME_PERIOD 64.0
+#endif
+const float kTdfRepeatTiles = 3.5;       // normal-map repeat in tiles at scale 1 (van Hoesel 35/10)
+const float kTdfScaleStill = 1.0;        // map repeats per repeat length in still water
+const float kTdfScaleFast = 1.5;         // ... in fast water: shorter, choppier ripples
+const float kTdfSpeedFast = 1.5;         // m/s at which fast-water scale and roughness are reached
+const float kTdfStillRoughness = 0.4;    // ripple amplitude of still water relative to fast
+const float kTdfAdvection = 0.9;         // ripple pattern speed / surface flow speed
+const float kTdfMinSpeed = 1e-3;         // m/s below which the flow has no direction
+const float kTdfMaxTilt = 0.95;          // |N.xy| cap, so z = sqrt(1 - |N|^2) stays real
+const vec4 kTdfGridSpeed = vec4(1.0, 1.06, 1.33, 1.24);  // van Hoesel's per-grid speeds c_k
+const vec4 kTdfGridPhase = vec4(0.0, 0.62, 0.27, 0.0);   // van Hoesel's start offsets e_k
+
+// The flow of a flow texel (shared.h layout); t.r == SIVIFLOW_PARTICLE_NONE: no particle there.
+vec3 tdf_texel_flow(uvec4 t) {
+  return vec3(unpackHalf2x16(t.g | (t.b << 16)), unpackHalf2x16(t.a).x);
+}
+
+// Per-tile offset into the tileable map, [0,1)^2, from the tile's integer cell and grid.
+vec2 tdf_tile_offset(ivec2 cell, int grid) {
+  uvec2 v = uvec2(cell) * uvec2(1664525u, 1013904223u) + uint(grid) * 2654435769u;
+  v.x ^= v.y >> 16;
+  v.y ^= v.x << 5;
+  v = v * 747796405u + 2891336453u;
+  v ^= v >> 16;
+  return vec2(v >> 8) * (1.0 / 16777216.0);
+}
+
+// The tile table texel (shared.h) of the tile centred on lattice point `lattice`, whose flow is
+// `flow` (world m/s; zero for still water).
+//   cycles_per_mps: scroll cycles per period per m/s of scaled speed; periods: time / period.
+uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float periods, float cycles_per_mps) {
+  // Lattice (2c + 1, .) is grid A's tile c, (2c, .) the grid offset by half a tile, per axis.
+  int grid = int((lattice.x & 1) == 0) + 2 * int((lattice.y & 1) == 0);
+  ivec2 cell = lattice >> 1;
+  float speed = length(flow.xz);
+  vec2 dir = speed > kTdfMinSpeed ? flow.xz / speed : vec2(1.0, 0.0);
+  float fast = clamp(speed * (1.0 / kTdfSpeedFast), 0.0, 1.0);
+  float scale = mix(kTdfScaleStill, kTdfScaleFast, fast);
+  // M = scale * R(-angle): the world flow direction maps to the map's +U.
+  vec2 ab = (scale * (1.0 / kTdfRepeatTiles)) * dir;
+  // Pattern world speed = rate * repeat_m / scale; whole cycles per period keep the wrap seamless.
+  float cycles = round(speed * scale * cycles_per_mps * kTdfGridSpeed[grid]);
+  float phase = fract(cycles * periods + kTdfGridPhase[grid]);
+  // Subtracting the phase after M moves the pattern along +dir, i.e. downstream.
+  vec2 offset = tdf_tile_offset(cell, grid) - vec2(phase, 0.0);
+  return uvec4(floatBitsToUint(ab), floatBitsToUint(offset));
+}
+
+// R(+angle) scaled by the roughness, which turns a tile's sampled tilt back into world x/z: both
+// follow from (a, b) = scale / repeat * dir, as scale and roughness grow together with speed.
+vec2 tdf_back_rotation(vec2 ab) {
+  float inv_k = inversesqrt(dot(ab, ab));  // repeat / scale
+  float fast = (kTdfRepeatTiles / inv_k - kTdfScaleStill) / (kTdfScaleFast - kTdfScaleStill);
+  return (mix(kTdfStillRoughness, 1.0, fast) * inv_k) * ab;
+}
+
+#endif  // SIVIFLOW_TDF_TILE_TABLE_GLSL
