@@ -45,7 +45,7 @@ constexpr uint32_t kMaxTimedPasses = 16;  // reflection target size relative to 
 // Tunables of the water's look, in one place.
 constexpr float kReflectionDistortion = 0.04f;    // screen uv offset per unit of normal tilt
 constexpr float kTdfTileMetres = 3.0f;            // Tiled Directional Flow tile size on the water
-constexpr uint32_t kMaxWaterHeightSamples = 2048;  // per axis: 8 MiB at most, samples widen beyond
+constexpr uint32_t kMaxWaterHeightSamples = 2048;  // per axis: 16 MiB at most, samples widen beyond
 constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
 
 uint32_t texel_bytes(VkFormat format) {
@@ -81,7 +81,8 @@ Status invalid(const std::string& message) {
 }
 
 // The longest triangle edge of a mesh, seen from above.
-float longest_edge_xz(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices) {
+float longest_edge_xz(const std::vector<glm::vec3>& positions,
+                      const std::vector<uint32_t>& indices) {
   float longest = 0.0f;
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     for (int e = 0; e < 3; ++e) {
@@ -211,8 +212,9 @@ struct Renderer::Impl {
   Status create_frame_images();
   const Image* find_frame_image(ImageHandle handle) const;
   Status stage_static_data();
-  void make_tile_lattice(const std::vector<glm::vec3>& surface, const std::vector<uint32_t>& indices);
-  glm::ivec2 tile_window(glm::vec3 camera_position) const;
+  void make_tile_lattice(const std::vector<glm::vec3>& surface,
+                         const std::vector<uint32_t>& indices);
+  glm::ivec2 tile_window(const Camera& camera) const;
   Status simulate(const Camera& camera, double time_seconds);
   float visible_water_level();
   Status record_static_upload(VkCommandBuffer cmd);
@@ -385,8 +387,10 @@ void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
                                        const std::vector<uint32_t>& indices) {
   const float half_tile = 0.5f * kTdfTileMetres;
   // A tile reaches half a tile beyond the water it covers; the margin keeps its centre inside.
-  const WaterHeights heights = water_heights(surface, half_tile, kTdfTileMetres, kMaxWaterHeightSamples);
-  const glm::vec2 far_corner = heights.origin + heights.spacing * glm::vec2(heights.columns - 1, heights.rows - 1);
+  const WaterHeights heights =
+      water_heights(surface, half_tile, kTdfTileMetres, kMaxWaterHeightSamples);
+  const glm::vec2 far_corner =
+      heights.origin + heights.spacing * glm::vec2(heights.columns - 1, heights.rows - 1);
   lattice_lo = glm::ivec2(glm::floor(heights.origin / half_tile));
   lattice_hi = glm::ivec2(glm::ceil(far_corner / half_tile));
   const auto table_side = [](int points) {
@@ -405,7 +409,8 @@ void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
   const auto reach_steps = static_cast<uint32_t>(std::ceil(reach / heights.spacing)) + 1;
   std::vector<float> texels(heights.heights.size());
   for (size_t i = 0; i < texels.size(); ++i) {
-    texels[i] = heights.steps[i] <= reach_steps ? heights.heights[i] : static_cast<float>(SIVIFLOW_FAR_FROM_WATER);
+    texels[i] = heights.steps[i] <= reach_steps ? heights.heights[i]
+                                                : static_cast<float>(SIVIFLOW_FAR_FROM_WATER);
   }
   const auto* first = reinterpret_cast<const uint8_t*>(texels.data());
   image.texels.assign(first, first + texels.size() * sizeof(float));
@@ -413,12 +418,19 @@ void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
 }
 
 // The lattice point of the tile table's window corner: the river's first point when the table
-// holds them all, else a window centred on the camera and kept over the river.
-glm::ivec2 Renderer::Impl::tile_window(glm::vec3 camera_position) const {
+// holds them all, else a window reaching as far ahead of the camera as it can (what lies behind
+// is not seen), kept over the river. Water beyond the window, farther than the table's reach
+// (768 m at SIVIFLOW_TILE_TABLE_MAX), takes the tiles of points a table size away.
+glm::ivec2 Renderer::Impl::tile_window(const Camera& camera) const {
   const glm::ivec2 size(tile_table.width, tile_table.height);
-  const glm::ivec2 camera(glm::round(glm::vec2(camera_position.x, camera_position.z) / (0.5f * kTdfTileMetres)));
-  const glm::ivec2 corner = glm::clamp(camera - size / 2, lattice_lo, glm::max(lattice_lo, lattice_hi - size + 1));
-  return corner;
+  const float half_tile = 0.5f * kTdfTileMetres;
+  const glm::vec2 position = glm::vec2(camera.position.x, camera.position.z) / half_tile;
+  glm::vec2 forward(camera.target.x - camera.position.x, camera.target.z - camera.position.z);
+  forward = glm::length(forward) > 0.0f ? glm::normalize(forward) : glm::vec2(0.0f);
+  // The window's centre half a window ahead, less a tile, so the camera's own tiles stay in it.
+  const glm::vec2 ahead = forward * (0.5f * glm::vec2(size) - 2.0f);
+  const glm::ivec2 centre(glm::round(position + ahead));
+  return glm::clamp(centre - size / 2, lattice_lo, glm::max(lattice_lo, lattice_hi - size + 1));
 }
 
 Status Renderer::Impl::declare_static_graph() {
@@ -431,8 +443,7 @@ Status Renderer::Impl::declare_static_graph() {
   std::vector<ImageHandle> image_handles;
   for (const StaticImage& i : static_images) {
     const ImageHandle handle = static_graph.import_image({i.name, i.format, i.extent, {}},
-                                                         ResourceState{},
-                                                         state_of(i.read_as));
+                                                         ResourceState{}, state_of(i.read_as));
     image_handles.push_back(handle);
     for (uint32_t level = 0; level < i.mip_offsets.size(); ++level) {
       const VkExtent2D extent{std::max(1u, i.extent.width >> level), std::max(1u, i.extent.height >> level)};
@@ -472,8 +483,8 @@ Status Renderer::Impl::declare_graph() {
                                            state_of(b.read_as));
   }
   for (StaticImage& i : static_images) {
-    i.in_frame_graph = graph.import_image({i.name, i.format, i.extent, {}},
-                                          state_of(i.read_as), state_of(i.read_as));
+    i.in_frame_graph = graph.import_image({i.name, i.format, i.extent, {}}, state_of(i.read_as),
+                                          state_of(i.read_as));
   }
   VkClearValue transparent{};
   VkClearValue far_depth{};
@@ -539,18 +550,25 @@ Status Renderer::Impl::declare_graph() {
         graph.create_image({"reflection sample", FlowPass::kReflectionFormat, extent, transparent}));
   }
   water.water_heights = static_images[kWaterHeights].in_frame_graph;
-  water.tile_table = frame_image(graph.create_image({"tile table", FlowPass::kTileTableFormat, {tile_table.width, tile_table.height}, {}}));
+  water.tile_table = frame_image(graph.create_image(
+      {"tile table", FlowPass::kTileTableFormat, {tile_table.width, tile_table.height}, {}}));
   flow_pass.declare_tiles(graph, &tile_constants, &water);
   flow_pass.declare(graph, &flow_constants, river_index_count, &water);
   if (info.enable_timing) {
-    const ImageHandle floor = frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
+    const ImageHandle floor =
+        frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
     flow_pass.declare_floor(graph, &flow_constants, river_index_count, water, floor);
   }
 
   if (info.enable_readback) {
-    const ImageHandle images[kReadbackImageCount] = {
-        water.color, scene.depth, water.mask, frame_uploads.images[0].destination,
-        frame_uploads.images[1].destination, water.normal, water.reflection_sample, water.tile_table};
+    const ImageHandle images[kReadbackImageCount] = {water.color,
+                                                     scene.depth,
+                                                     water.mask,
+                                                     frame_uploads.images[0].destination,
+                                                     frame_uploads.images[1].destination,
+                                                     water.normal,
+                                                     water.reflection_sample,
+                                                     water.tile_table};
     readbacks.clear();
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
       const BufferHandle buffer = graph.import_buffer(
@@ -780,12 +798,13 @@ Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
   tile_constants.view_proj = constants.view_proj;
-  const glm::ivec2 corner = tile_window(camera.position);
+  const glm::ivec2 corner = tile_window(camera);
   tile_table.corner_x = corner.x;
   tile_table.corner_z = corner.y;
   tile_constants.lattice = glm::vec4(corner, tile_table.width, tile_table.height);
-  tile_constants.screen = glm::vec4(info.extent.width, info.extent.height, static_cast<float>(layout.texel_px),
-                                    static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
+  tile_constants.screen =
+      glm::vec4(info.extent.width, info.extent.height, static_cast<float>(layout.texel_px),
+                static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
   // The obstacles where they are this frame, each drawn as a translated boulder.
   for (size_t i = 0; i < obstacles.size(); ++i) {
     const glm::vec3 offset = simulation.obstacle_centre(i);
@@ -958,7 +977,8 @@ VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
     case ReadbackImage::kReflection:
       return pixels * 4 * sizeof(float);
     case ReadbackImage::kTileTable:
-      return VkDeviceSize{impl_->tile_table.width} * impl_->tile_table.height * 4 * sizeof(uint32_t);
+      return VkDeviceSize{impl_->tile_table.width} * impl_->tile_table.height * 4 *
+             sizeof(uint32_t);
   }
   return 0;
 }

@@ -1,6 +1,7 @@
 // Lighting and fog of everything the scene pass draws (terrain, riverbed, objects), so objects
 // from glTF files sit in the same light and haze as the valley. Evaluated per vertex: both vary
-// slowly over the 1.5 m terrain grid, and per fragment they were a third of the scene pass.
+// slowly over the 1.5 m terrain grid, and per fragment they were a third of the scene pass (a
+// glTF mesh of large triangles gets its fog and sun interpolated linearly across each).
 #include "sky_common.glsl"
 
 struct SceneLight {

@@ -6,11 +6,12 @@
 // (offsets (0,0), (.5,0), (0,.5), (.5,.5) tiles) reads ONE flow per tile, at the tile centre.
 // All tile centres lie on a lattice of half-tile spacing (shared.h, the tile table), so the work
 // is split in two:
-//   - per frame, per lattice point (flow_tiles.comp, tdf_encode_tile in tdf_tile_table.glsl): the centre, at the water's
-//     height there, is projected with view_proj to a pixel and the flow texel under it is read;
-//     if it holds no particle (off screen, behind the camera, on land, occluded) the nearest of
-//     the eight lattice neighbours that has one gives the flow, else the water is still. From the
-//     flow: a rotation-plus-scale M, the scroll phase and a hashed offset, stored in the table.
+//   - per frame, per lattice point (flow_tiles.comp; tdf_encode_tile in tdf_tile_table.glsl):
+//     the centre, at the water's height there, is projected with view_proj to a pixel and the
+//     flow texel under it is read; if it holds no particle (off screen, behind the camera, on
+//     land, occluded) the nearest of the eight lattice neighbours that has one gives the flow,
+//     else the water is still. From the flow: a rotation-plus-scale M, the scroll phase and a
+//     hashed offset, stored in the table.
 //   - per water fragment (tdf_normal): for each grid, its tile's table texel, one normal-map
 //     sample at M * (T - centre) + offset, then van Hoesel's blend.
 // Per tile, as van Hoesel: a rotation-plus-scale M from the flow direction and speed, one

@@ -24,7 +24,8 @@ WaterHeights water_heights(std::span<const glm::vec3> surface, float spacing, fl
   grid.origin = lo;
   grid.spacing = std::max(spacing, widest / static_cast<float>(max_samples_per_axis - 1));
   const auto samples = [&](float extent) {
-    return std::min(max_samples_per_axis, static_cast<uint32_t>(std::ceil(extent / grid.spacing)) + 1);
+    return std::min(max_samples_per_axis,
+                    static_cast<uint32_t>(std::ceil(extent / grid.spacing)) + 1);
   };
   grid.columns = samples(hi.x - lo.x);
   grid.rows = samples(hi.y - lo.y);
@@ -35,7 +36,8 @@ WaterHeights water_heights(std::span<const glm::vec3> surface, float spacing, fl
   std::vector<float> seed_distance(count, std::numeric_limits<float>::max());
   for (const glm::vec3& p : surface) {
     const glm::vec2 at = (glm::vec2(p.x, p.z) - grid.origin) / grid.spacing;
-    const auto column = static_cast<uint32_t>(std::clamp(std::lround(at.x), 0L, long{grid.columns} - 1));
+    const auto column =
+        static_cast<uint32_t>(std::clamp(std::lround(at.x), 0L, long{grid.columns} - 1));
     const auto row = static_cast<uint32_t>(std::clamp(std::lround(at.y), 0L, long{grid.rows} - 1));
     const size_t i = size_t{row} * grid.columns + column;
     const float d = glm::distance(at, glm::vec2(column, row));

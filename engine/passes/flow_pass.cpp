@@ -45,9 +45,10 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
   desc.attributes = {{SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
                      {SIVIFLOW_ATTR_WATER_DEPTH, 1, VK_FORMAT_R32_SFLOAT, 0}};
   SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, desc, &pipeline_));
-  SIVIFLOW_TRY(create_layouts(gpu, kTileBindings, VK_SHADER_STAGE_COMPUTE_BIT, sizeof(gpu::FlowTileConstants),
-                              &tiles_set_layout_, &tiles_layout_));
-  SIVIFLOW_TRY(create_compute_pipeline(gpu, cache, "flow_tiles.comp", tiles_layout_, &tiles_pipeline_));
+  SIVIFLOW_TRY(create_layouts(gpu, kTileBindings, VK_SHADER_STAGE_COMPUTE_BIT,
+                              sizeof(gpu::FlowTileConstants), &tiles_set_layout_, &tiles_layout_));
+  SIVIFLOW_TRY(
+      create_compute_pipeline(gpu, cache, "flow_tiles.comp", tiles_layout_, &tiles_pipeline_));
   if (!with_floor) return Status::success();
   // The same geometry, depth test, colour format and blending as the water, so the floor shades
   // exactly its pixels and writes them as the water does.
@@ -89,10 +90,12 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   std::array<VkDescriptorPool, 2> pools{};
   std::array<VkDescriptorSet, 2> sets{};
   Status allocated = allocate_sets(gpu, set_layout_, material_bindings, 1, &pools[0], &sets[0]);
-  if (allocated.ok()) allocated = allocate_sets(gpu, tiles_set_layout_, kTileBindings, 1, &pools[1], &sets[1]);
+  if (allocated.ok())
+    allocated = allocate_sets(gpu, tiles_set_layout_, kTileBindings, 1, &pools[1], &sets[1]);
   if (!allocated.ok()) {
     for (VkDescriptorPool pool : pools) {
-      if (pool != VK_NULL_HANDLE) vk.vkDestroyDescriptorPool(vk.device, pool, gpu.allocation_callbacks);
+      if (pool != VK_NULL_HANDLE)
+        vk.vkDestroyDescriptorPool(vk.device, pool, gpu.allocation_callbacks);
     }
     return allocated;
   }
@@ -104,16 +107,16 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   set_ = sets[0];
   tiles_set_ = sets[1];
   const VkImageLayout read = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  const std::array<VkDescriptorImageInfo, kBindingCount> material{{
-      {nearest_, textures.flow, read},
-      {nearest_, textures.aux, read},
-      {linear_clamp_, textures.reflection, textures.reflection_layout},
-      {linear_repeat_, textures.normal_map, read},
-      {nearest_, textures.tile_table, read}}};
-  const std::array<VkDescriptorImageInfo, kTileBindings.size()> tiles{{
-      {nearest_, textures.flow, read},
-      {nearest_, textures.water_heights, read},
-      {VK_NULL_HANDLE, textures.tile_table, VK_IMAGE_LAYOUT_GENERAL}}};
+  const std::array<VkDescriptorImageInfo, kBindingCount> material{
+      {{nearest_, textures.flow, read},
+       {nearest_, textures.aux, read},
+       {linear_clamp_, textures.reflection, textures.reflection_layout},
+       {linear_repeat_, textures.normal_map, read},
+       {nearest_, textures.tile_table, read}}};
+  const std::array<VkDescriptorImageInfo, kTileBindings.size()> tiles{
+      {{nearest_, textures.flow, read},
+       {nearest_, textures.water_heights, read},
+       {VK_NULL_HANDLE, textures.tile_table, VK_IMAGE_LAYOUT_GENERAL}}};
   std::vector<VkWriteDescriptorSet> writes;
   const auto write = [&writes](VkDescriptorSet set, std::span<const VkDescriptorType> types,
                                std::span<const VkDescriptorImageInfo> images) {
@@ -129,7 +132,8 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   };
   write(set_, material_bindings, material);
   write(tiles_set_, kTileBindings, tiles);
-  vk.vkUpdateDescriptorSets(vk.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  vk.vkUpdateDescriptorSets(vk.device, static_cast<uint32_t>(writes.size()), writes.data(), 0,
+                            nullptr);
   return Status::success();
 }
 
@@ -169,9 +173,10 @@ void FlowPass::declare_tiles(FrameGraph& graph, const gpu::FlowTileConstants* co
     const DeviceTable& vk = ctx.table();
     const VkCommandBuffer cmd = ctx.cmd();
     vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tiles_pipeline_);
-    vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tiles_layout_, 0, 1, &tiles_set_, 0, nullptr);
-    vk.vkCmdPushConstants(cmd, tiles_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::FlowTileConstants),
-                          constants);
+    vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tiles_layout_, 0, 1,
+                               &tiles_set_, 0, nullptr);
+    vk.vkCmdPushConstants(cmd, tiles_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                          sizeof(gpu::FlowTileConstants), constants);
     const VkExtent2D extent = ctx.extent(table);
     vk.vkCmdDispatch(cmd, (extent.width + kTileGroupSide - 1) / kTileGroupSide,
                      (extent.height + kTileGroupSide - 1) / kTileGroupSide, 1);

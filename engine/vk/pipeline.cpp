@@ -148,8 +148,8 @@ Status vk_status(VkResult result, const char* call) {
   return Status::error(std::string(call) + " failed: " + result_name(result), result);
 }
 
-Status create_compute_pipeline(const GpuContext& gpu, VkPipelineCache cache, std::string_view shader,
-                               VkPipelineLayout layout, VkPipeline* out) {
+Status create_compute_pipeline(const GpuContext& gpu, VkPipelineCache cache,
+                               std::string_view shader, VkPipelineLayout layout, VkPipeline* out) {
   const DeviceTable& vk = *gpu.table;
   VkShaderModule module = VK_NULL_HANDLE;
   SIVIFLOW_TRY(create_module(gpu, shader, &module));
@@ -163,8 +163,9 @@ Status create_compute_pipeline(const GpuContext& gpu, VkPipelineCache cache, std
       vk.vkCreateComputePipelines(vk.device, cache, 1, &info, gpu.allocation_callbacks, out);
   vk.vkDestroyShaderModule(vk.device, module, gpu.allocation_callbacks);
   if (result != VK_SUCCESS) {
-    return Status::error("vkCreateComputePipelines (" + std::string(shader) + ") failed: " + result_name(result),
-                         result);
+    return Status::error(
+        "vkCreateComputePipelines (" + std::string(shader) + ") failed: " + result_name(result),
+        result);
   }
   return Status::success();
 }
@@ -174,7 +175,8 @@ Status create_layouts(const GpuContext& gpu, std::span<const VkDescriptorType> b
                       VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout) {
   const DeviceTable& vk = *gpu.table;
   std::vector<VkDescriptorSetLayoutBinding> set_bindings(bindings.size());
-  for (uint32_t i = 0; i < bindings.size(); ++i) set_bindings[i] = {i, bindings[i], 1, stages, nullptr};
+  for (uint32_t i = 0; i < bindings.size(); ++i)
+    set_bindings[i] = {i, bindings[i], 1, stages, nullptr};
   VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
   set_info.bindingCount = static_cast<uint32_t>(set_bindings.size());
   set_info.pBindings = set_bindings.data();
@@ -190,9 +192,11 @@ Status create_layouts(const GpuContext& gpu, std::span<const VkDescriptorType> b
                    "vkCreatePipelineLayout");
 }
 
-Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count, uint32_t push_constant_bytes,
-                          VkDescriptorSetLayout* set_layout, VkPipelineLayout* layout) {
-  const std::vector<VkDescriptorType> samplers(sampler_count, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
+Status create_pass_layout(const GpuContext& gpu, uint32_t sampler_count,
+                          uint32_t push_constant_bytes, VkDescriptorSetLayout* set_layout,
+                          VkPipelineLayout* layout) {
+  const std::vector<VkDescriptorType> samplers(sampler_count,
+                                               VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
   return create_layouts(gpu, samplers, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                         push_constant_bytes, set_layout, layout);
 }
@@ -203,8 +207,9 @@ Status allocate_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
   const DeviceTable& vk = *gpu.table;
   std::vector<VkDescriptorPoolSize> sizes;
   for (VkDescriptorType type : bindings) {
-    const auto same = std::find_if(sizes.begin(), sizes.end(),
-                                   [type](const VkDescriptorPoolSize& size) { return size.type == type; });
+    const auto same =
+        std::find_if(sizes.begin(), sizes.end(),
+                     [type](const VkDescriptorPoolSize& size) { return size.type == type; });
     if (same != sizes.end()) {
       same->descriptorCount += set_count;
     } else {
@@ -228,7 +233,8 @@ Status allocate_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
 Status allocate_sampler_sets(const GpuContext& gpu, VkDescriptorSetLayout set_layout,
                              uint32_t sampler_count, uint32_t set_count, VkDescriptorPool* pool,
                              VkDescriptorSet* sets) {
-  const std::vector<VkDescriptorType> samplers(sampler_count, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
+  const std::vector<VkDescriptorType> samplers(sampler_count,
+                                               VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
   return allocate_sets(gpu, set_layout, samplers, set_count, pool, sets);
 }
 

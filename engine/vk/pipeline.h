@@ -1,5 +1,6 @@
-// Graphics pipelines for dynamic rendering and compute pipelines, built from the SPIR-V embedded at build time, and the
-// small objects every pass creates with them: layouts, samplers, descriptor sets.
+// Graphics pipelines for dynamic rendering and compute pipelines, built from the SPIR-V embedded
+// at build time, and the small objects every pass creates with them: layouts, samplers,
+// descriptor sets.
 #pragma once
 
 #include <cstdint>
@@ -34,8 +35,8 @@ struct GraphicsPipelineDesc {
 Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
                                 const GraphicsPipelineDesc& desc, VkPipeline* out);
 
-Status create_compute_pipeline(const GpuContext& gpu, VkPipelineCache cache, std::string_view shader,
-                               VkPipelineLayout layout, VkPipeline* out);
+Status create_compute_pipeline(const GpuContext& gpu, VkPipelineCache cache,
+                               std::string_view shader, VkPipelineLayout layout, VkPipeline* out);
 
 // The result of a Vulkan call as a Status naming the call: "vkCreateSampler failed: ...".
 Status vk_status(VkResult result, const char* call);

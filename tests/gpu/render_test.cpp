@@ -80,7 +80,8 @@ class RenderTest : public GpuTest {
       const auto* reflection = static_cast<const float*>(slot.readback[6].data);
       out.reflection.assign(reflection, reflection + size_t{width} * height * 4);
       const auto* tiles = static_cast<const uint32_t*>(slot.readback[7].data);
-      out.tile_table.assign(tiles, tiles + renderer_->readback_bytes(ReadbackImage::kTileTable) / sizeof(uint32_t));
+      out.tile_table.assign(
+          tiles, tiles + renderer_->readback_bytes(ReadbackImage::kTileTable) / sizeof(uint32_t));
       frames.push_back(std::move(out));
       slot.pending = false;
     };
@@ -355,7 +356,8 @@ TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
       const glm::vec2 within = glm::fract(at);
       // Off screen, or so near a texel edge that GPU rounding may pick the neighbour: skipped.
       if (at.x < 0.0f || at.y < 0.0f || at.x >= texels.x || at.y >= texels.y ||
-          glm::any(glm::lessThan(within, glm::vec2(0.02f))) || glm::any(glm::greaterThan(within, glm::vec2(0.98f)))) {
+          glm::any(glm::lessThan(within, glm::vec2(0.02f))) ||
+          glm::any(glm::greaterThan(within, glm::vec2(0.98f)))) {
         continue;
       }
       gpu::FlowTexel texel{};
@@ -375,13 +377,59 @@ TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
       if (cos_angle > std::cos(glm::radians(0.5f)) && std::abs(glm::length(ab) - scale) < 1e-4f) {
         ++agreeing;
       } else {
-        ADD_FAILURE() << "lattice point (" << lattice.x << ", " << lattice.y << "): flow (" << flow.x
-                      << ", " << flow.z << "), table (" << ab.x << ", " << ab.y << ")";
+        ADD_FAILURE() << "lattice point (" << lattice.x << ", " << lattice.y << "): flow ("
+                      << flow.x << ", " << flow.z << "), table (" << ab.x << ", " << ab.y << ")";
       }
     }
   }
   EXPECT_GT(checked, 100u);
   EXPECT_EQ(agreeing, checked);
+}
+
+// On a river longer than the tile table reaches (1.6 km against 768 m), the table's window lies
+// ahead of the camera: every tile of every water pixel within its reach is one the table holds
+// (water farther away, where a tile is a pixel or two, takes the tiles a table size nearer).
+TEST_F(RenderTest, TileTableWindowHoldsEveryTileInViewOfALongRiver) {
+  SceneFile scene;
+  const Status parsed = parse_scene_file(
+      R"({"version":1,"river":{"procedural":{"length":1600,"meander_amplitude":1}},)"
+      R"("camera":{"keys":[{"t":0,"position":[0,6,-400],"target":[0,0,-305]}]}})",
+      "long.json", ".", &scene);
+  ASSERT_TRUE(parsed.ok()) << parsed.message();
+  CreateInfo info = make_create_info(kWidth, kHeight);
+  info.scene = &scene;
+  ASSERT_TRUE(Renderer::create(info, &renderer_).ok());
+  const std::vector<Frame> frames = render(0, 1);
+  ASSERT_EQ(frames.size(), 1u);
+  const Frame& frame = frames[0];
+  const TileTableLayout& table = renderer_->tile_table_layout();
+  ASSERT_EQ(table.height, SIVIFLOW_TILE_TABLE_MAX);  // the river (along z) does not fit: a window
+  const glm::mat4 to_world = glm::inverse(view_proj_of(renderer_->scene_camera(0.0), kWidth, kHeight));
+  const glm::ivec2 lo(table.corner_x, table.corner_z);
+  const glm::ivec2 hi = lo + glm::ivec2(table.width, table.height) - 1;
+  size_t water = 0;
+  float farthest = 0.0f;
+  size_t outside = 0;
+  for (uint32_t y = 0; y < kHeight; ++y) {
+    for (uint32_t x = 0; x < kWidth; ++x) {
+      const size_t i = size_t{y} * kWidth + x;
+      if (frame.water_mask[i] != 1.0f) continue;
+      ++water;
+      const glm::vec4 ndc(2.0f * (x + 0.5f) / kWidth - 1.0f, 2.0f * (y + 0.5f) / kHeight - 1.0f,
+                          frame.depth[i], 1.0f);
+      const glm::vec4 world = to_world * ndc;
+      const float ahead = world.z / world.w + 400.0f;
+      farthest = std::max(farthest, ahead);
+      if (ahead > 0.5f * table.tile_size_m * float(table.height - 4)) continue;  // beyond reach
+      const glm::vec2 u = glm::vec2(world.x, world.z) / world.w / table.tile_size_m;
+      // The four tiles' centres, in half tiles, span floor(2u) - 1 .. floor(2u) + 1.
+      const glm::ivec2 centre(glm::floor(2.0f * u));
+      if (glm::any(glm::lessThan(centre - 1, lo)) || glm::any(glm::greaterThan(centre + 1, hi))) ++outside;
+    }
+  }
+  EXPECT_GT(water, 1000u);
+  EXPECT_GT(farthest, 500.0f) << "the view reaches far down the river";
+  EXPECT_EQ(outside, 0u) << "of " << water << " water pixels";
 }
 
 TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {

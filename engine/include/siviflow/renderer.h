@@ -118,9 +118,9 @@ struct ExternalImage {
 // What CreateInfo::enable_readback copies each frame into host-visible buffers, tightly packed
 // rows, top-left origin:
 enum class ReadbackImage : uint32_t {
-  kColor,      // the output, in its format's texels
-  kDepth,      // 32-bit float window depth, 0 near .. 1 far (sky: 1)
-  kWaterMask,  // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
+  kColor,        // the output, in its format's texels
+  kDepth,        // 32-bit float window depth, 0 near .. 1 far (sky: 1)
+  kWaterMask,    // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
   kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h), flow_texture_layout()
   kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)
   kNormal,       // RGBA32F: the final water normal in world space (xyz) on water, 0 elsewhere
@@ -130,10 +130,11 @@ enum class ReadbackImage : uint32_t {
 inline constexpr uint32_t kReadbackImageCount = 8;
 
 // The tile table of the water material (shaders/shared.h): its size and which lattice points
-// the last updated frame put in it. Texel (x, y) holds lattice point
-// corner + ((x, y) - corner) mod size, the world point (i, j) * tile_size_m / 2 in x, z.
+// the last updated frame put in it (the corner moves with the camera on rivers larger than the
+// table: decode a read-back table before updating the next frame). Texel (x, y) holds lattice
+// point corner + ((x, y) - corner) mod size, the world point (i, j) * tile_size_m / 2 in x, z.
 struct TileTableLayout {
-  uint32_t width = 0;   // texels, a power of two
+  uint32_t width = 0;  // texels, a power of two
   uint32_t height = 0;
   int32_t corner_x = 0;  // lattice point of the window's corner
   int32_t corner_z = 0;
