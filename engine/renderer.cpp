@@ -80,6 +80,13 @@ Status invalid(const std::string& message) {
   return Status::error("siviflow::Renderer: " + message, VK_ERROR_INITIALIZATION_FAILED);
 }
 
+// The bytes of a contiguous container, for the static upload.
+template <typename Items>
+std::vector<uint8_t> bytes_of(const Items& items) {
+  const auto* first = reinterpret_cast<const uint8_t*>(items.data());
+  return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
+}
+
 // The longest triangle edge of a mesh, seen from above.
 float longest_edge_xz(const std::vector<glm::vec3>& positions,
                       const std::vector<uint32_t>& indices) {
@@ -318,10 +325,6 @@ Status Renderer::Impl::take_scene() {
 }
 
 Status Renderer::Impl::create_static_resources() {
-  const auto bytes_of = [](const auto& items) {
-    const auto* first = reinterpret_cast<const uint8_t*>(items.data());
-    return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
-  };
   SceneGeometry geometry = river_from_file ? build_riverbed_geometry(river_input.mesh, obstacles)
                                            : build_scene_geometry(river, obstacles);
   // Sized once: the draws point into it.
@@ -412,8 +415,7 @@ void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
     texels[i] = heights.steps[i] <= reach_steps ? heights.heights[i]
                                                 : static_cast<float>(SIVIFLOW_FAR_FROM_WATER);
   }
-  const auto* first = reinterpret_cast<const uint8_t*>(texels.data());
-  image.texels.assign(first, first + texels.size() * sizeof(float));
+  image.texels = bytes_of(texels);
   image.mip_offsets = {0};
 }
 
@@ -1007,7 +1009,6 @@ const char* readback_image_name(ReadbackImage image) {
 
 const ParticleField& Renderer::particle_field() const { return impl_->simulation.particle_field(); }
 const TileTableLayout& Renderer::tile_table_layout() const { return impl_->tile_table; }
-
 const FlowTextureLayout& Renderer::flow_texture_layout() const { return impl_->simulation.layout(); }
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 

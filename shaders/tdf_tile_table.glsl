@@ -5,11 +5,7 @@
 
 #include "shared.h"
 
-// ---- Tunables (one place) ----------------------------------------------------------------------
-// Seconds; the CPU passes time modulo this. Define it in shared.h to share it with C++.
-#ifndef SIVIFLOW_TDF_TIME_PERIOD
-#define SIVIFLOW_TDF_TIME_PERIOD 64.0
-#endif
+// ---- Tunables (one place; the scroll period SIVIFLOW_TDF_TIME_PERIOD is in shared.h) ------
 const float kTdfRepeatTiles = 3.5;       // normal-map repeat in tiles at scale 1 (van Hoesel 35/10)
 const float kTdfScaleStill = 1.0;        // map repeats per repeat length in still water
 const float kTdfScaleFast = 1.5;         // ... in fast water: shorter, choppier ripples

@@ -13,6 +13,10 @@ namespace {
 // Bindings 0..4 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
 // normal map, tile table.
 constexpr uint32_t kBindingCount = 5;
+constexpr std::array<VkDescriptorType, kBindingCount> kMaterialBindings = {
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
 // Bindings of shaders/flow_tiles.comp: flow texture, water heights, tile table.
 constexpr std::array<VkDescriptorType, 3> kTileBindings = {
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -24,7 +28,9 @@ constexpr uint32_t kTileGroupSide = 8;  // flow_tiles.comp's local size
 Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
                         VkFormat depth_format, bool with_aovs, bool with_floor) {
   with_aovs_ = with_aovs;
-  SIVIFLOW_TRY(create_pass_layout(gpu, kBindingCount, sizeof(gpu::FlowConstants), &set_layout_, &layout_));
+  SIVIFLOW_TRY(create_layouts(gpu, kMaterialBindings,
+                              VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                              sizeof(gpu::FlowConstants), &set_layout_, &layout_));
   // Flow and aux are integer or exact data read with texelFetch: nearest, never filtered.
   SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &nearest_));
   SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &linear_clamp_));
@@ -83,13 +89,9 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
                                const std::function<void(VkDescriptorPool)>& retire) {
   const DeviceTable& vk = *gpu.table;
   // New sets first: on failure the current ones stay valid.
-  const std::array<VkDescriptorType, kBindingCount> material_bindings{
-      VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-      VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-      VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
   std::array<VkDescriptorPool, 2> pools{};
   std::array<VkDescriptorSet, 2> sets{};
-  Status allocated = allocate_sets(gpu, set_layout_, material_bindings, 1, &pools[0], &sets[0]);
+  Status allocated = allocate_sets(gpu, set_layout_, kMaterialBindings, 1, &pools[0], &sets[0]);
   if (allocated.ok())
     allocated = allocate_sets(gpu, tiles_set_layout_, kTileBindings, 1, &pools[1], &sets[1]);
   if (!allocated.ok()) {
@@ -130,7 +132,7 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
       writes.push_back(w);
     }
   };
-  write(set_, material_bindings, material);
+  write(set_, kMaterialBindings, material);
   write(tiles_set_, kTileBindings, tiles);
   vk.vkUpdateDescriptorSets(vk.device, static_cast<uint32_t>(writes.size()), writes.data(), 0,
                             nullptr);
