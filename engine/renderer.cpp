@@ -11,13 +11,13 @@
 
 #include "passes/passes.h"
 #include "scene/default_scene.h"
-#include "scene/detail_texture.h"
 #include "scene/river_simulation.h"
-#include "scene/scene_objects.h"
 #include "scene/water_normal_map.h"
 #include "siviflow/scene_file.h"
 #include "siviflow/scene_river.h"
 #include "sim/water_heights.h"
+#include "static_assets.h"
+#include "view_math.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
@@ -30,17 +30,16 @@ namespace {
 constexpr uint32_t kDefaultFramesInFlight = 2;
 constexpr uint32_t kMaxFramesInFlight = 8;
 constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
-constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkFormat kDefaultDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkDeviceSize kDefaultStagingBytes = 8ull << 20;
 constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we copy
 // Layouts documented in shaders/shared.h.
 constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
 constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr VkFormat kNormalMapFormat = VK_FORMAT_R8G8B8A8_UNORM;
-constexpr VkFormat kDetailFormat = VK_FORMAT_R8G8B8A8_UNORM;
-constexpr VkFormat kBaseColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
-constexpr float kDefaultReflectionScale = 0.5f;
-constexpr uint32_t kMaxTimedPasses = 16;  // reflection target size relative to the output
+constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
+constexpr uint32_t kMaxTimedPasses = 16;
 
 // Tunables of the water's look, in one place.
 constexpr float kReflectionDistortion = 0.04f;    // screen uv offset per unit of normal tilt
@@ -64,20 +63,22 @@ uint32_t texel_bytes(VkFormat format) {
   }
 }
 
-
-// The constants that draw a model placed at `offset` with the scene shaders, which work in the
-// model's coordinates: clip and fog see the same distances as for the translated model.
-gpu::SceneConstants translated(const gpu::SceneConstants& constants, glm::vec3 offset) {
-  gpu::SceneConstants moved = constants;
-  moved.view_proj = constants.view_proj * glm::translate(glm::mat4(1.0f), offset);
-  moved.camera_position = constants.camera_position - glm::vec4(offset, 0.0f);
-  moved.clip_plane.w += glm::dot(glm::vec3(constants.clip_plane), offset);
-  moved.fog.z += offset.y;  // height fog needs the world height, not the model's
-  return moved;
+bool is_host_depth_format(VkFormat format) {
+  return format == VK_FORMAT_D32_SFLOAT || format == VK_FORMAT_D24_UNORM_S8_UINT ||
+         format == VK_FORMAT_D32_SFLOAT_S8_UINT;
 }
 
 Status invalid(const std::string& message) {
   return Status::error("siviflow::Renderer: " + message, VK_ERROR_INITIALIZATION_FAILED);
+}
+
+// An error in what the caller passed: no Vulkan result stands behind it.
+Status argument_error(const std::string& message) {
+  return Status::error("siviflow::Renderer: " + message);
+}
+
+std::string extent_text(VkExtent2D extent) {
+  return std::to_string(extent.width) + "x" + std::to_string(extent.height);
 }
 
 // The bytes of a contiguous container, for the static upload.
@@ -102,6 +103,17 @@ float longest_edge_xz(const std::vector<glm::vec3>& positions,
 
 }  // namespace
 
+View camera_view(const Camera& camera, VkExtent2D extent) {
+  View view;
+  const float aspect = static_cast<float>(extent.width) / static_cast<float>(std::max(1u, extent.height));
+  view.projection = glm::perspectiveRH_ZO(glm::radians(camera.fov_y_deg), aspect,
+                                          camera.near_plane, camera.far_plane);
+  view.projection[1][1] *= -1.0f;  // Vulkan's clip space has +Y down
+  view.view = glm::lookAtRH(camera.position, camera.target, glm::vec3(0.0f, 1.0f, 0.0f));
+  view.viewport = {{0, 0}, extent};
+  return view;
+}
+
 const char* version_string() { return "siviflow 0.1.0"; }
 
 struct Renderer::Impl {
@@ -109,69 +121,19 @@ struct Renderer::Impl {
   DeviceTable table;
   GpuContext gpu;
   FrameRing ring;
-  ProceduralRiver river{default_river_params()};  // the default scene's, or the scene file's
-  bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
   RiverInput river_input;         // handed to the simulation by create_static_resources
   std::vector<float> particle_heights;  // this frame's live particles' heights
   FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
-  std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is this frame
-  SceneObjects objects;             // the scene file's glTF objects, drawn where they stand
-  std::vector<Obstacle> object_obstacles;  // footprints of the objects marked obstacle
-  SceneCamera camera_path;          // keys empty: the default camera gliding downstream
-  SceneLook look = default_scene_look();
+  std::vector<Obstacle> obstacles;  // the scene's, then the footprints of objects marked obstacle
   RiverSimulation simulation;  // the river's flow, particles and flow textures, on the CPU
   double last_time = 0.0;
 
-  // Geometry and textures that never change: copied to the GPU once by the static graph, then
-  // only read by the frame graph, so later frames carry no upload barriers for them.
-  enum StaticBufferId {
-    kSceneVertices, kSceneIndices, kRiverVertices, kRiverDepths, kRiverIndices, kStaticBufferCount
-  };
-  struct StaticBuffer {
-    const char* name;
-    Access read_as;  // how the frame graph reads it
-    VkBufferUsageFlags usage;
-    std::vector<uint8_t> bytes;  // kept until staged for the first frame
-    Buffer buffer;
-    BufferHandle in_frame_graph;
-  };
-  std::array<StaticBuffer, kStaticBufferCount> static_buffers{{
-      {"scene vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
-      {"scene indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, {}, {}, {}},
-      {"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
-      {"river depths", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, {}, {}, {}},
-      {"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, {}, {}, {}}}};
-  enum StaticImageId { kDetail, kNormalMap, kWaterHeights, kFirstBaseColor };
-  struct StaticImage {
-    const char* name;
-    VkFormat format;
-    VkExtent2D extent;
-    std::vector<uint8_t> texels;         // every mip level, kept until staged
-    std::vector<size_t> mip_offsets;     // into texels
-    Image image;
-    ImageHandle in_frame_graph;
-    Access read_as = Access::SampledFragment;  // how the frame graph reads it
-  };
-  // The detail texture, the water normal map, the water heights, then the objects' base-colour
-  // textures.
-  std::vector<StaticImage> static_images{
-      {"ground detail", kDetailFormat, {}, {}, {}, {}, {}},
-      {"water normal map", kNormalMapFormat, {}, {}, {}, {}, {}},
-      {"water heights", FlowPass::kWaterHeightsFormat, {}, {}, {}, {}, {}, Access::SampledCompute}};
-  // What the scene and reflection passes draw: the static scene, and the moving boulder with
-  // its own constants (translated to where its obstacle is this frame).
-  std::vector<SceneDraw> scene_draws;
-  std::vector<SceneDraw> reflection_draws;
-  std::vector<glm::vec3> obstacle_offsets;  // this frame's obstacle centres
-  std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main view, then mirrored
+  // Geometry and textures that never change, uploaded in the first frame.
+  enum StaticBufferId : uint32_t { kRiverVertices, kRiverIndices };
+  enum StaticImageId : uint32_t { kNormalMap, kWaterHeights };
+  StaticAssets assets;
   uint32_t river_index_count = 0;
-  ScenePass scene_pass;
   FlowPass flow_pass;
-
-  FrameGraph static_graph;
-  BufferHandle static_staging;
-  UploadList static_uploads;
-  Buffer static_staging_buffer;  // sized for the static data; freed when its slot comes round
 
   // Images the frame graph declares; created after it compiles, with the usage it derived.
   struct FrameImage {
@@ -185,13 +147,17 @@ struct Renderer::Impl {
   FrameGraph graph;
   BufferHandle frame_staging;  // the slot's staging block: this frame's flow textures
   UploadList frame_uploads;    // flow texture and particle aux, every frame
-  ImageHandle output;
+  ImageHandle host_color;      // imported per frame: the host's colour and depth
+  ImageHandle host_depth;
+  ImageHandle reflection_depth;
   std::vector<ReadbackCopy> readbacks;  // one per ReadbackImage when readback is enabled
   FrameBindings bindings;
-  gpu::SceneConstants constants{};
-  gpu::SceneConstants reflection_constants{};
   gpu::FlowConstants flow_constants{};
   gpu::FlowTileConstants tile_constants{};
+  ViewMath view;        // of the frame being prepared
+  glm::mat4 view_view{1.0f};  // its world -> view matrix
+  VkRect2D viewport{};  // in the host's images
+  ReflectionView reflection_view{};
   // The tile table's lattice (shaders/shared.h): the points the water heights cover, and the
   // table's size, a power of two per axis.
   glm::ivec2 lattice_lo{0};
@@ -205,7 +171,6 @@ struct Renderer::Impl {
   float timestamp_period_ns = 1.0f;
   uint64_t timestamp_mask = ~uint64_t{0};  // the queue's valid timestamp bits
 
-  bool static_data_uploaded = false;
   bool unusable = false;  // a resize failed half-way
   bool frame_begun = false;
   bool frame_updated = false;
@@ -213,20 +178,19 @@ struct Renderer::Impl {
   Status validate_info(const CreateInfo& create);
   Status take_scene();
   Status create_static_resources();
-  Status declare_static_graph();
   Status declare_graph();
   ImageHandle frame_image(ImageHandle handle, bool persistent = false);
   Status create_frame_images();
   const Image* find_frame_image(ImageHandle handle) const;
-  Status stage_static_data();
   void make_tile_lattice(const std::vector<glm::vec3>& surface,
                          const std::vector<uint32_t>& indices);
-  glm::ivec2 tile_window(const Camera& camera) const;
-  Status simulate(const Camera& camera, double time_seconds);
+  glm::ivec2 tile_window() const;
+  Status simulate(const View& host_view, double time_seconds);
   float visible_water_level();
-  Status record_static_upload(VkCommandBuffer cmd);
+  Status check_inputs(const FrameInputs& inputs) const;
+  Status bind_frame(const FrameInputs& inputs);
   Status create_query_pools();
-  void declare_host_reflection(ScenePass::Handles* mirrored);
+  void declare_reflection(ImageHandle* color);
   void retire_frame_images();
   void destroy();
 };
@@ -249,6 +213,11 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
   if (texel_bytes(info.color_format) == 0) {
     return invalid("CreateInfo::color_format " + std::to_string(info.color_format) +
                    " is not an RGBA8, RGBA16F or RGBA32F format");
+  }
+  if (info.depth_format == VK_FORMAT_UNDEFINED) info.depth_format = kDefaultDepthFormat;
+  if (!is_host_depth_format(info.depth_format)) {
+    return invalid("CreateInfo::depth_format " + std::to_string(info.depth_format) +
+                   " is not D32_SFLOAT, D24_UNORM_S8_UINT or D32_SFLOAT_S8_UINT");
   }
   if (info.staging_bytes_per_slot == 0) info.staging_bytes_per_slot = kDefaultStagingBytes;
 
@@ -295,11 +264,21 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
     return Status::error("siviflow::Renderer: color_format cannot be rendered to on this device",
                          VK_ERROR_FORMAT_NOT_SUPPORTED);
   }
+  table.vkGetPhysicalDeviceFormatProperties(info.physical_device, info.depth_format, &format_props);
+  const VkFormatFeatureFlags depth_needs =
+      VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
+  if ((format_props.optimalTilingFeatures & depth_needs) != depth_needs) {
+    return Status::error("siviflow::Renderer: CreateInfo::depth_format " +
+                             std::to_string(info.depth_format) +
+                             " cannot be both a depth attachment and sampled on this device",
+                         VK_ERROR_FORMAT_NOT_SUPPORTED);
+  }
   return Status::success();
 }
 
 Status Renderer::Impl::take_scene() {
   if (info.scene == nullptr) {
+    const ProceduralRiver river(default_river_params());
     obstacles = default_scene_obstacles(river);
     return procedural_river_input(river, &river_input);
   }
@@ -311,77 +290,39 @@ Status Renderer::Impl::take_scene() {
     TriangleMesh gltf;
     SIVIFLOW_TRY(in_scene(load_river_mesh(scene.river.gltf, scene.river.mesh, &gltf)));
     SIVIFLOW_TRY(in_scene(gltf_river_input(std::move(gltf), &river_input)));
-    river_from_file = true;
   } else {
     SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(scene.river.procedural)));
-    river = ProceduralRiver(scene.river.procedural);
-    SIVIFLOW_TRY(in_scene(procedural_river_input(river, &river_input)));
+    SIVIFLOW_TRY(in_scene(procedural_river_input(ProceduralRiver(scene.river.procedural), &river_input)));
   }
   flow_params = scene.flow;
   obstacles = scene.obstacles;
-  camera_path = scene.camera;
-  SIVIFLOW_TRY(load_scene_objects(scene, &objects));
-  return scene_object_obstacles(scene, river_input.mesh.positions, &object_obstacles);
+  std::vector<Obstacle> object_obstacles;
+  SIVIFLOW_TRY(scene_object_obstacles(scene, river_input.mesh.positions, &object_obstacles));
+  obstacles.insert(obstacles.end(), object_obstacles.begin(), object_obstacles.end());
+  return Status::success();
 }
 
 Status Renderer::Impl::create_static_resources() {
-  SceneGeometry geometry = river_from_file ? build_riverbed_geometry(river_input.mesh, obstacles)
-                                           : build_scene_geometry(river, obstacles);
-  // Sized once: the draws point into it.
-  obstacle_constants.resize(2 * obstacles.size());
-  scene_draws = {{0, geometry.static_index_count, &constants}};
-  reflection_draws = {{0, geometry.static_index_count, &reflection_constants}};
-  for (size_t i = 0; i < geometry.obstacle_boulders.size(); ++i) {
-    const SceneGeometry::Instance& boulder = geometry.obstacle_boulders[i];
-    scene_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i]});
-    reflection_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i + 1]});
-  }
-  // The objects after the valley, in world space: drawn with the view's own constants.
-  const auto first_object_vertex = static_cast<uint32_t>(geometry.vertices.size());
-  const auto first_object_index = static_cast<uint32_t>(geometry.indices.size());
-  geometry.vertices.insert(geometry.vertices.end(), objects.vertices.begin(), objects.vertices.end());
-  for (uint32_t index : objects.indices) geometry.indices.push_back(first_object_vertex + index);
-  for (const SceneObjects::Draw& draw : objects.draws) {
-    scene_draws.push_back({first_object_index + draw.first_index, draw.index_count, &constants, draw.texture + 1});
-    reflection_draws.push_back(
-        {first_object_index + draw.first_index, draw.index_count, &reflection_constants, draw.texture + 1});
-  }
-  for (BaseColorTexture& texture : objects.textures) {
-    static_images.push_back({"base colour", kBaseColorFormat, {texture.width, texture.height},
-                             std::move(texture.texels), std::move(texture.mip_offsets), {}, {}});
-  }
-  objects = SceneObjects{};  // copied into the static data
-  static_buffers[kSceneVertices].bytes = bytes_of(geometry.vertices);
-  static_buffers[kSceneIndices].bytes = bytes_of(geometry.indices);
-  std::vector<Obstacle> flow_obstacles = obstacles;
-  flow_obstacles.insert(flow_obstacles.end(), object_obstacles.begin(), object_obstacles.end());
-  SIVIFLOW_TRY(simulation.create(std::move(river_input), flow_params, std::move(flow_obstacles),
+  SIVIFLOW_TRY(simulation.create(std::move(river_input), flow_params, std::move(obstacles),
                                  info.seed, {info.extent.width, info.extent.height}));
   const RiverMesh& surface = simulation.mesh();
   river_index_count = static_cast<uint32_t>(surface.indices.size());
-  static_buffers[kRiverVertices].bytes = bytes_of(surface.positions);
-  static_buffers[kRiverDepths].bytes = bytes_of(surface.depth);
-  static_buffers[kRiverIndices].bytes = bytes_of(surface.indices);
-  make_tile_lattice(surface.positions, surface.indices);
-
-  DetailTexture detail = make_detail_texture();
-  static_images[kDetail].extent = {detail.size, detail.size};
-  static_images[kDetail].texels = std::move(detail.texels);
-  static_images[kDetail].mip_offsets = {0};
+  assets.add_buffer({"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                     bytes_of(surface.positions)});
+  assets.add_buffer({"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                     bytes_of(surface.indices)});
   WaterNormalMap normal_map = make_water_normal_map();
-  static_images[kNormalMap].extent = {normal_map.size, normal_map.size};
-  static_images[kNormalMap].texels = std::move(normal_map.texels);
-  static_images[kNormalMap].mip_offsets = std::move(normal_map.mip_offsets);
+  assets.add_image({"water normal map", kNormalMapFormat, {normal_map.size, normal_map.size},
+                    std::move(normal_map.texels), std::move(normal_map.mip_offsets)});
+  make_tile_lattice(surface.positions, surface.indices);
 
   // Every frame's flow textures must fit a slot's staging block.
   info.staging_bytes_per_slot = std::max(info.staging_bytes_per_slot,
                                          VkDeviceSize{simulation.layout().total_bytes} + kStagingAlignment);
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
-  for (StaticBuffer& b : static_buffers) {
-    SIVIFLOW_TRY(create_buffer(gpu, b.bytes.size(), b.usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                               false, b.name, &b.buffer));
-  }
-  return Status::success();
+  SIVIFLOW_TRY(assets.create(gpu));
+  return flow_pass.create(gpu, info.pipeline_cache, info.color_format, info.depth_format,
+                          info.frames_in_flight, info.enable_readback, info.enable_timing);
 }
 
 // The water heights around the river, and the tile table that covers their lattice points (or
@@ -403,8 +344,6 @@ void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
   tile_table.height = table_side(lattice_hi.y - lattice_lo.y + 1);
   tile_table.tile_size_m = kTdfTileMetres;
   tile_constants.heights = glm::vec4(heights.origin, heights.spacing, kTdfTileMetres);
-  StaticImage& image = static_images[kWaterHeights];
-  image.extent = {heights.columns, heights.rows};
   // A tile centre is within a tile of water it covers, and water within its longest triangle
   // edge of a vertex: samples farther than both are no tile's. Steps go along the axes, so a
   // distance d takes up to d sqrt(2) / spacing of them, plus one for the vertex's own sample.
@@ -415,58 +354,27 @@ void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
     texels[i] = heights.steps[i] <= reach_steps ? heights.heights[i]
                                                 : static_cast<float>(SIVIFLOW_FAR_FROM_WATER);
   }
-  image.texels = bytes_of(texels);
-  image.mip_offsets = {0};
+  assets.add_image({"water heights", FlowPass::kWaterHeightsFormat, {heights.columns, heights.rows},
+                    bytes_of(texels), {0}, Access::SampledCompute});
 }
 
 // The lattice point of the tile table's window corner: the river's first point when the table
 // holds them all, else a window reaching as far ahead of the camera as it can (what lies behind
 // is not seen), kept over the river. Water beyond the window, farther than the table's reach
 // (768 m at SIVIFLOW_TILE_TABLE_MAX), takes the tiles of points a table size away.
-glm::ivec2 Renderer::Impl::tile_window(const Camera& camera) const {
+glm::ivec2 Renderer::Impl::tile_window() const {
   const glm::ivec2 size(tile_table.width, tile_table.height);
   const float half_tile = 0.5f * kTdfTileMetres;
-  const glm::vec2 position = glm::vec2(camera.position.x, camera.position.z) / half_tile;
-  glm::vec2 forward(camera.target.x - camera.position.x, camera.target.z - camera.position.z);
+  const glm::vec2 position = glm::vec2(view.camera_position.x, view.camera_position.z) / half_tile;
+  // The view looks down its -Z axis: the world direction of that axis is the third row of the
+  // view matrix's rotation, negated (read from the inverse's third column).
+  const glm::mat4 to_world = glm::inverse(view_view);
+  glm::vec2 forward(-to_world[2][0], -to_world[2][2]);
   forward = glm::length(forward) > 0.0f ? glm::normalize(forward) : glm::vec2(0.0f);
   // The window's centre half a window ahead, less a tile, so the camera's own tiles stay in it.
   const glm::vec2 ahead = forward * (0.5f * glm::vec2(size) - 2.0f);
   const glm::ivec2 centre(glm::round(position + ahead));
   return glm::clamp(centre - size / 2, lattice_lo, glm::max(lattice_lo, lattice_hi - size + 1));
-}
-
-Status Renderer::Impl::declare_static_graph() {
-  static_staging = static_graph.import_buffer({"static staging", 0}, ResourceState{});
-  for (const StaticBuffer& b : static_buffers) {
-    const BufferHandle handle = static_graph.import_buffer({b.name, b.buffer.size}, ResourceState{},
-                                                           state_of(b.read_as));
-    static_uploads.buffers.push_back({0, handle, b.buffer.size});
-  }
-  std::vector<ImageHandle> image_handles;
-  for (const StaticImage& i : static_images) {
-    const ImageHandle handle = static_graph.import_image({i.name, i.format, i.extent, {}},
-                                                         ResourceState{}, state_of(i.read_as));
-    image_handles.push_back(handle);
-    for (uint32_t level = 0; level < i.mip_offsets.size(); ++level) {
-      const VkExtent2D extent{std::max(1u, i.extent.width >> level), std::max(1u, i.extent.height >> level)};
-      static_uploads.images.push_back({0, handle, extent, level});
-    }
-  }
-  add_upload_pass(static_graph, static_staging, &static_uploads);
-  SIVIFLOW_TRY(static_graph.compile());
-  for (size_t n = 0; n < static_images.size(); ++n) {
-    StaticImage& i = static_images[n];
-    // The frame graph only samples the static images.
-    const VkImageUsageFlags usage = static_graph.image_usage(image_handles[n]) | VK_IMAGE_USAGE_SAMPLED_BIT;
-    SIVIFLOW_TRY(create_image(gpu, i.format, i.extent, usage, i.name, &i.image,
-                              static_cast<uint32_t>(i.mip_offsets.size())));
-  }
-  SIVIFLOW_TRY(scene_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat));
-  SIVIFLOW_TRY(flow_pass.create(gpu, info.pipeline_cache, info.color_format, kDepthFormat,
-                                info.enable_readback, info.enable_timing));
-  std::vector<VkImageView> base_colors;
-  for (size_t n = kFirstBaseColor; n < static_images.size(); ++n) base_colors.push_back(static_images[n].image.view);
-  return scene_pass.set_textures(gpu, static_images[kDetail].image.view, base_colors);
 }
 
 ImageHandle Renderer::Impl::frame_image(ImageHandle handle, bool persistent) {
@@ -480,17 +388,8 @@ Status Renderer::Impl::declare_graph() {
       std::max(1u, static_cast<uint32_t>(std::lround(extent.width * kDefaultReflectionScale))),
       std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
   frame_images.clear();
-  for (StaticBuffer& b : static_buffers) {
-    b.in_frame_graph = graph.import_buffer({b.name, b.buffer.size}, state_of(b.read_as),
-                                           state_of(b.read_as));
-  }
-  for (StaticImage& i : static_images) {
-    i.in_frame_graph = graph.import_image({i.name, i.format, i.extent, {}}, state_of(i.read_as),
-                                          state_of(i.read_as));
-  }
+  assets.import_into(graph);
   VkClearValue transparent{};
-  VkClearValue far_depth{};
-  far_depth.depthStencil = {1.0f, 0};
 
   // upload: this frame's flow texture and particle aux data, through the slot's staging block.
   const FlowTextureLayout& layout = simulation.layout();
@@ -505,53 +404,37 @@ Status Renderer::Impl::declare_graph() {
   frame_uploads.images = {{0, flow_texture, flow_extent, 0}, {0, particle_aux, aux_extent, 0}};
   add_upload_pass(graph, frame_staging, &frame_uploads);
 
-  // reflection: the scene mirrored about the water plane, clipped below it.
-  ScenePass::Handles mirrored;
-  mirrored.color = frame_image(graph.create_image({"reflection", info.color_format, reflection_extent, transparent}));
-  mirrored.depth = frame_image(graph.create_image({"reflection depth", kDepthFormat, reflection_extent, far_depth}));
-  mirrored.vertices = static_buffers[kSceneVertices].in_frame_graph;
-  mirrored.indices = static_buffers[kSceneIndices].in_frame_graph;
-  mirrored.detail = static_images[kDetail].in_frame_graph;
-  for (size_t n = kFirstBaseColor; n < static_images.size(); ++n) {
-    mirrored.base_colors.push_back(static_images[n].in_frame_graph);
-  }
-  if (info.reflection != nullptr) {
-    declare_host_reflection(&mirrored);
-  } else {
-    scene_pass.declare(graph, "reflection", &reflection_draws, &mirrored);
-  }
+  // reflection: the host's world mirrored about the water plane, clipped below it.
+  ImageHandle reflection =
+      frame_image(graph.create_image({"reflection", info.color_format, reflection_extent, transparent}));
+  reflection_depth = frame_image(
+      graph.create_image({"reflection depth", kReflectionDepthFormat, reflection_extent, {}}));
+  declare_reflection(&reflection);
 
-  // scene: sky, terrain, riverbed and objects into the host's output.
-  // The host states the output's real states per frame; these are overridden in record().
-  output = graph.import_image({"output", info.color_format, extent, transparent}, ResourceState{},
-                              state_of(Access::SampledFragment));
-  ScenePass::Handles scene;
-  scene.color = output;
-  scene.depth = frame_image(graph.create_image({"depth", kDepthFormat, extent, far_depth}));
-  scene.vertices = static_buffers[kSceneVertices].in_frame_graph;
-  scene.indices = static_buffers[kSceneIndices].in_frame_graph;
-  scene.detail = static_images[kDetail].in_frame_graph;
-  scene.base_colors = mirrored.base_colors;
-  scene_pass.declare(graph, "scene", &scene_draws, &scene);
+  // The host's images, in the states the host states per frame (record()); their declared
+  // extent is the view's, the viewport is placed inside them when recording.
+  host_color = graph.import_image({"host colour", info.color_format, extent, {}}, ResourceState{},
+                                  state_of(Access::SampledFragment));
+  host_depth = graph.import_image({"host depth", info.depth_format, extent, {}}, ResourceState{},
+                                  state_of(Access::DepthAttachmentRead));
 
-  // flow: the water material over the scene.
+  // flow: the water material over the host's colour.
   FlowPass::Handles water;
-  water.color = scene.color;
-  water.depth = scene.depth;
+  water.color = host_color;
+  water.depth = host_depth;
   water.flow = frame_uploads.images[0].destination;
   water.aux = frame_uploads.images[1].destination;
-  water.reflection = mirrored.color;
-  water.normal_map = static_images[kNormalMap].in_frame_graph;
-  water.vertices = static_buffers[kRiverVertices].in_frame_graph;
-  water.depths = static_buffers[kRiverDepths].in_frame_graph;
-  water.indices = static_buffers[kRiverIndices].in_frame_graph;
+  water.reflection = reflection;
+  water.normal_map = assets.image_handle(kNormalMap);
+  water.vertices = assets.buffer_handle(kRiverVertices);
+  water.indices = assets.buffer_handle(kRiverIndices);
   if (info.enable_readback) {
     water.mask = frame_image(graph.create_image({"water mask", FlowPass::kMaskFormat, extent, transparent}));
     water.normal = frame_image(graph.create_image({"water normal", FlowPass::kNormalFormat, extent, transparent}));
     water.reflection_sample = frame_image(
         graph.create_image({"reflection sample", FlowPass::kReflectionFormat, extent, transparent}));
   }
-  water.water_heights = static_images[kWaterHeights].in_frame_graph;
+  water.water_heights = assets.image_handle(kWaterHeights);
   water.tile_table = frame_image(graph.create_image(
       {"tile table", FlowPass::kTileTableFormat, {tile_table.width, tile_table.height}, {}}));
   flow_pass.declare_tiles(graph, &tile_constants, &water);
@@ -564,7 +447,7 @@ Status Renderer::Impl::declare_graph() {
 
   if (info.enable_readback) {
     const ImageHandle images[kReadbackImageCount] = {water.color,
-                                                     scene.depth,
+                                                     host_depth,
                                                      water.mask,
                                                      frame_uploads.images[0].destination,
                                                      frame_uploads.images[1].destination,
@@ -576,7 +459,7 @@ Status Renderer::Impl::declare_graph() {
       const BufferHandle buffer = graph.import_buffer(
           {readback_image_name(static_cast<ReadbackImage>(i)), 0}, ResourceState{},
           state_of(Access::HostRead));
-      readbacks.push_back({images[i], buffer});
+      readbacks.push_back({images[i], buffer, {}});
     }
     add_readback_pass(graph, &readbacks);
   }
@@ -586,10 +469,10 @@ Status Renderer::Impl::declare_graph() {
   FlowPass::Textures textures;
   textures.flow = find_frame_image(flow_texture)->view;
   textures.aux = find_frame_image(particle_aux)->view;
-  textures.reflection = find_frame_image(mirrored.color)->view;
-  textures.normal_map = static_images[kNormalMap].image.view;
+  textures.reflection = find_frame_image(reflection)->view;
+  textures.normal_map = assets.image(kNormalMap).view;
   textures.tile_table = find_frame_image(water.tile_table)->view;
-  textures.water_heights = static_images[kWaterHeights].image.view;
+  textures.water_heights = assets.image(kWaterHeights).view;
   return flow_pass.bind_textures(gpu, textures, [this](VkDescriptorPool pool) {
     ring.defer_deletion_until_all_slots([gpu_context = gpu, pool] {
       gpu_context.table->vkDestroyDescriptorPool(gpu_context.table->device, pool,
@@ -598,19 +481,19 @@ Status Renderer::Impl::declare_graph() {
   });
 }
 
-void Renderer::Impl::declare_host_reflection(ScenePass::Handles* mirrored) {
+// Cleared colour (transparent: "nothing reflected") and depth (the far value of the frame's
+// convention), then the host's callback, if any, draws its world mirrored.
+void Renderer::Impl::declare_reflection(ImageHandle* color) {
   PassBuilder pass = graph.add_pass("reflection", PassKind::Graphics);
-  mirrored->color = pass.color_write(mirrored->color, LoadOp::Clear);
-  mirrored->depth = pass.depth_write(mirrored->depth, LoadOp::Clear);
-  const ImageHandle color = mirrored->color;
-  pass.record([this, color](const PassContext& ctx) {
-    ReflectionView view{};
-    std::memcpy(view.view_proj, &reflection_constants.view_proj[0][0], sizeof(view.view_proj));
-    std::memcpy(view.clip_plane, &reflection_constants.clip_plane[0], sizeof(view.clip_plane));
-    std::memcpy(view.camera_position, &reflection_constants.camera_position[0], sizeof(view.camera_position));
-    view.extent = ctx.extent(color);
-    set_viewport(ctx.table(), ctx.cmd(), view.extent);
-    info.reflection(ctx.cmd(), view, info.reflection_user);
+  *color = pass.color_write(*color, LoadOp::Clear);
+  reflection_depth = pass.depth_write(reflection_depth, LoadOp::Clear);
+  if (info.reflection == nullptr) return;
+  const ImageHandle target = *color;
+  pass.record([this, target](const PassContext& ctx) {
+    ReflectionView mirrored = reflection_view;
+    mirrored.extent = ctx.extent(target);
+    set_viewport(ctx.table(), ctx.cmd(), mirrored.extent);
+    info.reflection(ctx.cmd(), mirrored, info.reflection_user);
     return Status::success();
   });
 }
@@ -642,61 +525,11 @@ void Renderer::Impl::retire_frame_images() {
   frame_images.clear();
 }
 
-Status Renderer::Impl::stage_static_data() {
-  VkDeviceSize total = 0;
-  for (const StaticImage& i : static_images) total += i.texels.size();
-  for (const StaticBuffer& b : static_buffers) total += b.bytes.size();
-  SIVIFLOW_TRY(create_buffer(gpu, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true,
-                             "static staging", &static_staging_buffer));
-  auto* bytes = static_cast<uint8_t*>(static_staging_buffer.mapped);
-  // Images first: every copy offset into them stays a multiple of their 4-byte texels.
-  VkDeviceSize offset = 0;
-  size_t upload = 0;
-  for (StaticImage& i : static_images) {
-    std::memcpy(bytes + offset, i.texels.data(), i.texels.size());
-    for (size_t level = 0; level < i.mip_offsets.size(); ++level) {
-      static_uploads.images[upload++].staging_offset = offset + i.mip_offsets[level];
-    }
-    offset += i.texels.size();
-    i.texels = std::vector<uint8_t>();  // the staging copy is the only one needed from now on
-  }
-  for (size_t n = 0; n < static_buffers.size(); ++n) {
-    std::vector<uint8_t>& source = static_buffers[n].bytes;
-    std::memcpy(bytes + offset, source.data(), source.size());
-    static_uploads.buffers[n].staging_offset = offset;
-    offset += source.size();
-    source = std::vector<uint8_t>();
-  }
-  return Status::success();
-}
-
-Status Renderer::Impl::record_static_upload(VkCommandBuffer cmd) {
-  FrameBindings static_bindings;
-  static_bindings.bind_buffer(static_staging, static_staging_buffer.buffer);
-  for (size_t n = 0; n < static_buffers.size(); ++n) {
-    static_bindings.bind_buffer(static_uploads.buffers[n].destination, static_buffers[n].buffer.buffer);
-  }
-  size_t upload = 0;
-  for (const StaticImage& i : static_images) {
-    static_bindings.bind_image(static_uploads.images[upload].destination, i.image.image, i.image.view);
-    upload += i.mip_offsets.size();
-  }
-  SIVIFLOW_TRY(static_graph.execute(table, cmd, static_bindings));
-  // The GPU reads the staging buffer until this slot's frame completes; free it after that.
-  Buffer retired = static_staging_buffer;
-  static_staging_buffer = Buffer{};
-  ring.defer_deletion([gpu_context = gpu, retired]() mutable { destroy_buffer(gpu_context, &retired); });
-  return Status::success();
-}
-
 void Renderer::Impl::destroy() {
   if (gpu.table == nullptr) return;  // failed before any Vulkan object existed
-  scene_pass.destroy(gpu);
   flow_pass.destroy(gpu);
   for (FrameImage& f : frame_images) destroy_image(gpu, &f.image);
-  for (StaticImage& i : static_images) destroy_image(gpu, &i.image);
-  for (StaticBuffer& b : static_buffers) destroy_buffer(gpu, &b.buffer);
-  destroy_buffer(gpu, &static_staging_buffer);
+  assets.destroy(gpu);
   for (VkQueryPool pool : query_pools) table.vkDestroyQueryPool(table.device, pool, gpu.allocation_callbacks);
   ring.destroy();
 }
@@ -729,7 +562,6 @@ Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) 
   Status status = impl->validate_info(info);
   if (status.ok()) status = impl->take_scene();
   if (status.ok()) status = impl->create_static_resources();
-  if (status.ok()) status = impl->declare_static_graph();
   if (status.ok()) status = impl->declare_graph();
   if (status.ok() && info.enable_timing) status = impl->create_query_pools();
   if (!status.ok()) {
@@ -754,65 +586,62 @@ Status Renderer::begin_frame(uint32_t slot) {
   return Status::success();
 }
 
-Status Renderer::Impl::simulate(const Camera& camera, double time_seconds) {
-  if (!std::isfinite(time_seconds) || camera.near_plane <= 0.0f ||
-      camera.far_plane <= camera.near_plane || camera.fov_y_deg <= 0.0f ||
-      camera.fov_y_deg >= 180.0f || camera.position == camera.target) {
-    return Status::error("Renderer: invalid camera or time");
+Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
+  if (!std::isfinite(time_seconds)) {
+    return argument_error("time " + std::to_string(time_seconds) + " is not finite");
+  }
+  ViewMath math;
+  SIVIFLOW_TRY(derive_view_math(host_view.view, host_view.projection, &math));
+  VkRect2D rect = host_view.viewport;
+  if (rect.extent.width == 0 && rect.extent.height == 0) rect.extent = info.extent;
+  if (rect.extent.width != info.extent.width || rect.extent.height != info.extent.height) {
+    return argument_error("View::viewport extent " + extent_text(rect.extent) +
+                          " differs from the configured view size " + extent_text(info.extent) +
+                          " (resize() first)");
+  }
+  if (rect.offset.x < 0 || rect.offset.y < 0) {
+    return argument_error("View::viewport offset (" + std::to_string(rect.offset.x) + ", " +
+                          std::to_string(rect.offset.y) + ") is negative");
   }
   const float dt = simulation.next_frame() == 0 ? 0.0f : static_cast<float>(time_seconds - last_time);
-  if (dt < 0.0f) return Status::error("Renderer: time went backwards");
-  const float aspect = static_cast<float>(info.extent.width) / static_cast<float>(info.extent.height);
-  glm::mat4 projection = glm::perspectiveRH_ZO(glm::radians(camera.fov_y_deg), aspect,
-                                               camera.near_plane, camera.far_plane);
-  projection[1][1] *= -1.0f;  // Vulkan's clip space has +Y down
-  const glm::mat4 view = glm::lookAtRH(camera.position, camera.target, glm::vec3(0.0f, 1.0f, 0.0f));
-  const glm::vec4 sun(glm::normalize(look.sun_direction), look.sun_disc_intensity);
-  const glm::vec4 fog(look.fog_density, look.fog_height_falloff, 0.0f, 0.0f);
-  constants.view_proj = projection * view;
-  constants.camera_position = glm::vec4(camera.position, 1.0f);
-  constants.sun_direction = sun;
-  constants.clip_plane = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);  // main view: nothing clipped
-  constants.fog = fog;
-
+  if (dt < 0.0f) return argument_error("time went backwards");
   SIVIFLOW_TRY(simulation.set_time(time_seconds));
-  SIVIFLOW_TRY(simulation.simulate(constants.view_proj, dt));
+  SIVIFLOW_TRY(simulation.simulate(math.view_proj, dt));
+  view = math;
+  view_view = host_view.view;
+  viewport = rect;
 
-  // The reflection renders the scene mirrored about the water plane y = h from the real camera,
-  // so the flow pass samples it at its own screen position; only what is above the water stays.
+  // The reflection is the world mirrored about the water plane y = h, seen from the real
+  // camera, so the flow pass samples it at its own screen position; only what is above the
+  // water stays.
   const float h = visible_water_level();
-  glm::mat4 mirror(1.0f);
-  mirror[1][1] = -1.0f;
-  mirror[3][1] = 2.0f * h;
-  reflection_constants = constants;
-  reflection_constants.view_proj = constants.view_proj * mirror;
-  reflection_constants.camera_position = glm::vec4(camera.position.x, 2.0f * h - camera.position.y,
-                                                   camera.position.z, 1.0f);
-  reflection_constants.clip_plane = glm::vec4(0.0f, 1.0f, 0.0f, -h + kReflectionClipBias);
+  const glm::mat4 mirrored = mirrored_view_proj(view.view_proj, h);
+  const glm::vec3 mirrored_camera = mirrored_point(view.camera_position, h);
+  const glm::vec4 clip_plane(0.0f, 1.0f, 0.0f, -h + kReflectionClipBias);
+  std::memcpy(reflection_view.view_proj, &mirrored[0][0], sizeof(reflection_view.view_proj));
+  std::memcpy(reflection_view.clip_plane, &clip_plane[0], sizeof(reflection_view.clip_plane));
+  std::memcpy(reflection_view.camera_position, &mirrored_camera[0],
+              sizeof(reflection_view.camera_position));
+  reflection_view.reverse_z = view.reverse_z;
 
+  const SceneLook look = default_scene_look();
   const FlowTextureLayout& layout = simulation.layout();
-  flow_constants.view_proj = constants.view_proj;
-  flow_constants.camera_position = glm::vec4(camera.position, 0.0f);
-  flow_constants.sun_direction = sun;
+  flow_constants.view_proj = view.view_proj;
+  flow_constants.camera_position = glm::vec4(view.camera_position, view.depth_ratio_constant);
+  flow_constants.sun_direction = glm::vec4(glm::normalize(look.sun_direction), 0.0f);
   flow_constants.water = glm::vec4(h, kReflectionDistortion, kTdfTileMetres,
                                    static_cast<float>(layout.texel_px));
-  flow_constants.screen = glm::vec4(info.extent.width, info.extent.height,
+  flow_constants.screen = glm::vec4(rect.offset.x, rect.offset.y,
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
-  tile_constants.view_proj = constants.view_proj;
-  const glm::ivec2 corner = tile_window(camera);
+  tile_constants.view_proj = view.view_proj;
+  const glm::ivec2 corner = tile_window();
   tile_table.corner_x = corner.x;
   tile_table.corner_z = corner.y;
   tile_constants.lattice = glm::vec4(corner, tile_table.width, tile_table.height);
   tile_constants.screen =
       glm::vec4(info.extent.width, info.extent.height, static_cast<float>(layout.texel_px),
                 static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
-  // The obstacles where they are this frame, each drawn as a translated boulder.
-  for (size_t i = 0; i < obstacles.size(); ++i) {
-    const glm::vec3 offset = simulation.obstacle_centre(i);
-    obstacle_constants[2 * i] = translated(constants, offset);
-    obstacle_constants[2 * i + 1] = translated(reflection_constants, offset);
-  }
   last_time = time_seconds;
   return Status::success();
 }
@@ -832,12 +661,12 @@ float Renderer::Impl::visible_water_level() {
   return *middle;
 }
 
-Status Renderer::simulate(const Camera& camera, double time_seconds) {
+Status Renderer::simulate(const View& view, double time_seconds) {
   if (impl_->frame_begun) return Status::error("Renderer::simulate called between begin_frame and record");
-  return impl_->simulate(camera, time_seconds);
+  return impl_->simulate(view, time_seconds);
 }
 
-Status Renderer::update(const Camera& camera, double time_seconds) {
+Status Renderer::update(const View& view, double time_seconds) {
   Impl& r = *impl_;
   if (!r.frame_begun) return Status::error("Renderer::update called before begin_frame");
   if (r.frame_updated) return Status::error("Renderer::update called twice for one frame");
@@ -845,63 +674,131 @@ Status Renderer::update(const Camera& camera, double time_seconds) {
   const FlowTextureLayout& layout = r.simulation.layout();
   StagingAllocation staging;
   SIVIFLOW_TRY(r.ring.allocate_staging(layout.total_bytes, kStagingAlignment, &staging));
-  SIVIFLOW_TRY(r.simulate(camera, time_seconds));
+  SIVIFLOW_TRY(r.simulate(view, time_seconds));
   SIVIFLOW_TRY(r.simulation.pack({static_cast<std::byte*>(staging.data), layout.total_bytes}));
   r.frame_uploads.images[0].staging_offset = staging.offset + layout.flow_offset;
   r.frame_uploads.images[1].staging_offset = staging.offset + layout.aux_offset;
-  if (!r.static_data_uploaded && r.static_staging_buffer.buffer == VK_NULL_HANDLE) {
-    SIVIFLOW_TRY(r.stage_static_data());
-  }
+  if (!r.assets.uploaded() && !r.assets.staged()) SIVIFLOW_TRY(r.assets.stage(r.gpu));
   r.frame_updated = true;
+  return Status::success();
+}
+
+// The host's word on an image against the configuration: an error names the image and the
+// value, before any command is recorded.
+Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
+  const auto check = [this](const ExternalImage& image, const char* name, VkFormat format) {
+    const std::string field = std::string("FrameInputs::") + name;
+    if (image.image == VK_NULL_HANDLE || image.view == VK_NULL_HANDLE) {
+      return argument_error(field + " needs an image and a view");
+    }
+    if (image.final.layout == VK_IMAGE_LAYOUT_UNDEFINED) {
+      return argument_error(field + ".final.layout must not be UNDEFINED");
+    }
+    if (image.format != format) {
+      return argument_error(field + ".format " + std::to_string(image.format) +
+                            " differs from the configured " + std::to_string(format));
+    }
+    const uint64_t right = uint64_t{static_cast<uint32_t>(viewport.offset.x)} + viewport.extent.width;
+    const uint64_t bottom = uint64_t{static_cast<uint32_t>(viewport.offset.y)} + viewport.extent.height;
+    if (image.extent.width < right || image.extent.height < bottom) {
+      return argument_error(field + ".extent " + extent_text(image.extent) +
+                            " does not contain the view's viewport (" +
+                            std::to_string(viewport.offset.x) + ", " +
+                            std::to_string(viewport.offset.y) + ") + " +
+                            extent_text(viewport.extent));
+    }
+    return Status::success();
+  };
+  if (info.enable_readback && (viewport.offset.x != 0 || viewport.offset.y != 0)) {
+    return argument_error("with readback, View::viewport must start at the images' origin");
+  }
+  SIVIFLOW_TRY(check(inputs.color, "color", info.color_format));
+  SIVIFLOW_TRY(check(inputs.depth, "depth", info.depth_format));
+  for (uint32_t i = 0; i < readbacks.size(); ++i) {
+    if (inputs.readback.buffers[i] == VK_NULL_HANDLE) {
+      return argument_error(std::string("readback is enabled but FrameInputs::readback has no ") +
+                            readback_image_name(static_cast<ReadbackImage>(i)) + " buffer");
+    }
+  }
+  return Status::success();
+}
+
+// Binds this frame's resources: the static assets, the frame images, the host's images with
+// their states, a view of the host depth's depth aspect for sampling, the readback buffers.
+Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
+  FrameBindings& b = bindings;
+  b.reset();
+  assets.bind(b);
+  for (const FrameImage& f : frame_images) {
+    b.bind_image(f.handle, f.image.image, f.image.view);
+    // Persistent images start without contents (only the upload writes them, whole).
+    if (frame_images_new && f.persistent) b.set_incoming(f.handle, ResourceState{});
+  }
+  VkClearValue far{};
+  far.depthStencil = {far_depth(view.reverse_z), 0};
+  b.set_clear(reflection_depth, far);
+  const auto bind_host = [&b](ImageHandle handle, const ExternalImage& image) {
+    b.bind_image(handle, image.image, image.view);
+    b.set_incoming(handle, {image.current.stage, image.current.access, image.current.layout});
+    b.set_outgoing(handle, {image.final.stage, image.final.access, image.final.layout});
+  };
+  bind_host(host_color, inputs.color);
+  bind_host(host_depth, inputs.depth);
+  // The water renders over the view's part of the host's images only.
+  b.set_render_area(host_color, viewport);
+  b.bind_buffer(frame_staging, ring.staging_buffer());
+  for (uint32_t i = 0; i < readbacks.size(); ++i) {
+    b.bind_buffer(readbacks[i].buffer, inputs.readback.buffers[i]);
+    // The host's images are read back over the view's viewport only.
+    const bool host_image = i == static_cast<uint32_t>(ReadbackImage::kColor) ||
+                            i == static_cast<uint32_t>(ReadbackImage::kDepth);
+    readbacks[i].region = host_image ? viewport : VkRect2D{};
+  }
+
+  // The host's view may cover stencil too: the material samples depth alone, through a view of
+  // its own, freed when this slot comes round again.
+  VkImageViewCreateInfo view_info{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  view_info.image = inputs.depth.image;
+  view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
+  view_info.format = info.depth_format;
+  view_info.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+  VkImageView depth_view = VK_NULL_HANDLE;
+  SIVIFLOW_TRY(vk_status(
+      table.vkCreateImageView(table.device, &view_info, gpu.allocation_callbacks, &depth_view),
+      "vkCreateImageView (host depth)"));
+  ring.defer_deletion([gpu_context = gpu, depth_view] {
+    gpu_context.table->vkDestroyImageView(gpu_context.table->device, depth_view,
+                                          gpu_context.allocation_callbacks);
+  });
+  flow_pass.set_frame(gpu, {current_slot, depth_view, view.reverse_z, viewport});
   return Status::success();
 }
 
 Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   Impl& r = *impl_;
-  if (!r.frame_updated) return Status::error("Renderer::record called before begin_frame and update");
-  if (inputs.output.image == VK_NULL_HANDLE || inputs.output.view == VK_NULL_HANDLE) {
-    return Status::error("Renderer::record: FrameInputs::output needs an image and a view");
-  }
-  if (inputs.output.final.layout == VK_IMAGE_LAYOUT_UNDEFINED) {
-    return Status::error("Renderer::record: FrameInputs::output.final.layout must not be UNDEFINED");
-  }
-  for (uint32_t i = 0; i < r.readbacks.size(); ++i) {
-    if (inputs.readback.buffers[i] == VK_NULL_HANDLE) {
-      return Status::error(std::string("Renderer::record: readback is enabled but FrameInputs::readback has no ") +
-                           readback_image_name(static_cast<ReadbackImage>(i)) + " buffer");
+  const auto logged = [&r](const Status& status) {
+    if (!status.ok() && r.info.log != nullptr) {
+      r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
     }
+    return status;
+  };
+  if (!r.frame_updated) {
+    return logged(Status::error("siviflow::Renderer: record called before begin_frame and update"));
   }
-  if (!r.static_data_uploaded) SIVIFLOW_TRY(r.record_static_upload(cmd));
-  FrameBindings& b = r.bindings;
-  b.reset();
-  for (const Impl::StaticBuffer& sb : r.static_buffers) b.bind_buffer(sb.in_frame_graph, sb.buffer.buffer);
-  for (const Impl::StaticImage& si : r.static_images) b.bind_image(si.in_frame_graph, si.image.image, si.image.view);
-  for (const Impl::FrameImage& f : r.frame_images) {
-    b.bind_image(f.handle, f.image.image, f.image.view);
-    // Persistent images start without contents (only the upload writes them, whole).
-    if (r.frame_images_new && f.persistent) b.set_incoming(f.handle, ResourceState{});
-  }
-  b.bind_image(r.output, inputs.output.image, inputs.output.view);
-  b.set_incoming(r.output, {inputs.output.current.stage, inputs.output.current.access,
-                            inputs.output.current.layout});
-  b.set_outgoing(r.output, {inputs.output.final.stage, inputs.output.final.access,
-                            inputs.output.final.layout});
-  b.bind_buffer(r.frame_staging, r.ring.staging_buffer());
-  for (uint32_t i = 0; i < r.readbacks.size(); ++i) b.bind_buffer(r.readbacks[i].buffer, inputs.readback.buffers[i]);
+  SIVIFLOW_TRY(logged(r.check_inputs(inputs)));
+  if (!r.assets.uploaded()) SIVIFLOW_TRY(logged(r.assets.record_upload(r.table, cmd)));
+  SIVIFLOW_TRY(logged(r.bind_frame(inputs)));
   FrameGraph::Timestamps timestamps;
   if (!r.query_pools.empty()) {
     const uint32_t passes = static_cast<uint32_t>(r.graph.pass_order().size());
-    if (passes > kMaxTimedPasses) return Status::error("Renderer::record: too many passes to time");
+    if (passes > kMaxTimedPasses) return logged(argument_error("too many passes to time"));
     timestamps.pool = r.query_pools[r.current_slot];
     r.table.vkCmdResetQueryPool(cmd, timestamps.pool, 0, 2 * passes);
     r.timed_passes[r.current_slot] = passes;
   }
-  const Status status = r.graph.execute(r.table, cmd, b, r.query_pools.empty() ? nullptr : &timestamps);
-  if (!status.ok()) {
-    if (r.info.log != nullptr) r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
-    return status;
-  }
-  r.static_data_uploaded = true;
+  SIVIFLOW_TRY(logged(
+      r.graph.execute(r.table, cmd, r.bindings, r.query_pools.empty() ? nullptr : &timestamps)));
+  if (!r.assets.uploaded()) r.assets.finish_upload(r.ring, r.gpu);
   r.frame_images_new = false;
   r.frame_begun = false;
   r.frame_updated = false;
@@ -916,8 +813,7 @@ Status Renderer::resize(VkExtent2D extent) {
   r.table.vkGetPhysicalDeviceProperties2(r.info.physical_device, &props);
   const uint32_t limit = props.properties.limits.maxImageDimension2D;
   if (extent.width > limit || extent.height > limit) {
-    return invalid("resize: extent " + std::to_string(extent.width) + "x" +
-                   std::to_string(extent.height) + " exceeds the device limit of " +
+    return invalid("resize: extent " + extent_text(extent) + " exceeds the device limit of " +
                    std::to_string(limit));
   }
   // The particles live in screen space: a new viewport starts them afresh at frame 0. This can
@@ -935,32 +831,6 @@ Status Renderer::resize(VkExtent2D extent) {
   }
   r.unusable = !status.ok();
   return status;
-}
-
-Camera Renderer::scene_camera(double time_seconds) const {
-  const SceneCamera& path = impl_->camera_path;
-  if (path.keys.empty()) {
-    Camera camera = impl_->river_from_file ? river_overview_camera(impl_->simulation.mesh().positions)
-                                           : default_camera(impl_->river, time_seconds);
-    if (impl_->info.scene != nullptr) camera.fov_y_deg = path.fov_y_deg;
-    return camera;
-  }
-  // Linear between keys, held before the first and after the last.
-  Camera camera;
-  camera.fov_y_deg = path.fov_y_deg;
-  const auto after = std::find_if(path.keys.begin(), path.keys.end(),
-                                  [&](const CameraKey& key) { return key.t > time_seconds; });
-  if (after == path.keys.begin() || after == path.keys.end()) {
-    const CameraKey& key = after == path.keys.begin() ? path.keys.front() : path.keys.back();
-    camera.position = key.position;
-    camera.target = key.target;
-    return camera;
-  }
-  const CameraKey& a = *(after - 1);
-  const float u = static_cast<float>((time_seconds - a.t) / (after->t - a.t));
-  camera.position = glm::mix(a.position, after->position, u);
-  camera.target = glm::mix(a.target, after->target, u);
-  return camera;
 }
 
 VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {

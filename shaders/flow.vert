@@ -5,12 +5,9 @@
 // The river surface, drawn over the scene with the water material.
 layout(push_constant) uniform Push { FlowConstants flow; };
 layout(location = SIVIFLOW_ATTR_POSITION) in vec3 in_position;
-layout(location = SIVIFLOW_ATTR_WATER_DEPTH) in float in_depth;
 layout(location = 0) out vec3 out_world;
-layout(location = 1) out float out_depth;
 
 void main() {
   out_world = in_position;
-  out_depth = in_depth;
   gl_Position = flow.view_proj * vec4(in_position, 1.0);
 }

@@ -5,7 +5,7 @@
 // The flow pass's floor, for `siviflow bench`: drawn with the water's geometry, depth test and
 // blending into the same colour format (flow.vert), so over the same pixels and written the same
 // way, the same texture reads as the water material (1 flow texel fetch, 1 aux fetch, 4 tile
-// table fetches, 1 reflection and 4 normal-map reads with gradients) and next to no arithmetic,
+// table fetches, 1 host depth fetch, 1 reflection and 4 normal-map reads with gradients) and next to no arithmetic,
 // so flow / floor tells what the material's own maths costs.
 layout(push_constant) uniform Push { FlowConstants flow; };
 layout(set = 0, binding = 0) uniform usampler2D flow_texture;
@@ -13,19 +13,20 @@ layout(set = 0, binding = 1) uniform sampler2D particle_aux;
 layout(set = 0, binding = 2) uniform sampler2D reflection_map;
 layout(set = 0, binding = 3) uniform sampler2D normal_map;
 layout(set = 0, binding = 4) uniform usampler2D tile_table;
+layout(set = 0, binding = 5) uniform sampler2D host_depth;
 layout(location = 0) in vec3 in_world;
-layout(location = 1) in float in_depth;
 layout(location = 0) out vec4 out_value;
 
 void main() {
-  uint slots = texelFetch(flow_texture, ivec2(gl_FragCoord.xy / flow.water.w), 0).r;
+  vec2 pixel = gl_FragCoord.xy - flow.screen.xy;
+  uint slots = texelFetch(flow_texture, ivec2(pixel / flow.water.w), 0).r;
   // The four tiles' texels around the fragment, as the material addresses them.
   ivec2 lattice = ivec2(floor(2.0 * in_world.xz / flow.water.z));
   ivec2 wrap = textureSize(tile_table, 0) - 1;
   for (int i = 0; i < 4; ++i) slots += texelFetch(tile_table, (lattice + ivec2(i & 1, i >> 1)) & wrap, 0).r;
   vec4 aux = texelFetch(particle_aux, ivec2(int(slots % SIVIFLOW_AUX_WIDTH), 0), 0);
-  vec2 uv = gl_FragCoord.xy * flow.screen.zw;
-  vec3 sum = texture(reflection_map, uv).rgb;
+  vec2 uv = pixel * flow.screen.zw;
+  vec3 sum = texture(reflection_map, uv).rgb + texelFetch(host_depth, ivec2(gl_FragCoord.xy), 0).r;
   // Normal-map coordinates at the material's map scale (its mid-speed scale), with the world
   // position's gradients, so the reads come from the same mip levels as the material's.
   vec2 tile = in_world.xz * (0.5 * (kTdfScaleStill + kTdfScaleFast) / (kTdfRepeatTiles * flow.water.z));
@@ -33,5 +34,5 @@ void main() {
   vec2 dy = dFdy(tile);
   for (int i = 0; i < 4; ++i) sum += textureGrad(normal_map, tile + 0.25 * float(i), dx, dy).rgb;
   // Every read kept alive, blended over the target like the water.
-  out_value = vec4(0.5) + (sum.x + sum.y + sum.z + aux.x + float(slots) + in_depth) * 1e-6;
+  out_value = vec4(0.5) + (sum.x + sum.y + sum.z + aux.x + float(slots)) * 1e-6;
 }

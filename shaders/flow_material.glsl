@@ -10,9 +10,9 @@ layout(set = 0, binding = 1) uniform sampler2D particle_aux;    // shared.h layo
 layout(set = 0, binding = 2) uniform sampler2D reflection_map;  // the mirrored scene
 layout(set = 0, binding = 3) uniform sampler2D normal_map;      // tileable ripples, mipmapped
 layout(set = 0, binding = 4) uniform usampler2D tile_table;     // this frame's, flow_tiles.comp
+layout(set = 0, binding = 5) uniform sampler2D host_depth;      // what the host drew, texelFetch
 
 layout(location = 0) in vec3 in_world;
-layout(location = 1) in float in_depth;
 layout(location = 0) out vec4 out_color;
 #ifdef SIVIFLOW_FLOW_AOVS
 layout(location = 1) out float out_mask;
@@ -29,37 +29,52 @@ const float kShoreFadeMetres = 0.12;     // water thinner than this fades out at
 const float kRippleStrength = 0.55;      // van Hoesel's 0.3 transp^2 scale, brighter for rivers
 const float kFresnelF0 = 0.02;           // water at normal incidence
 const float kFadeInfluence = 0.25;       // how much a fading particle calms its cell
+const vec3 kSkyFallback = vec3(0.46, 0.60, 0.78);  // reflected where the reflection is empty
+const float kMaxWaterPath = 1.0e4;       // metres: the host's far plane or sky behind the water
 
 void main() {
   // The particle covering this pixel, and by its slot its speed, depth, slope, fade (slot 0, no
   // particle, reads the aux texture's all-zero texel 0: no branch needed). Its flow reaches the
   // ripples through the tile table.
-  uint own = texelFetch(flow_texture, ivec2(gl_FragCoord.xy * (1.0 / flow.water.w)), 0).r;
+  vec2 pixel = gl_FragCoord.xy - flow.screen.xy;  // in the view's viewport
+  uint own = texelFetch(flow_texture, ivec2(pixel * (1.0 / flow.water.w)), 0).r;
   float fade = texelFetch(particle_aux, ivec2(own % SIVIFLOW_AUX_WIDTH,
                                                own / SIVIFLOW_AUX_WIDTH), 0).a;
 
+  // The water the view ray crosses: from the surface to what the host drew behind it. Both
+  // depths lie on this pixel's ray, where view distances go as (depth - k).
+  vec3 to_eye = flow.camera_position.xyz - in_world;
+  float eye_distance = length(to_eye);
+  to_eye /= eye_distance;
+  float behind = texelFetch(host_depth, ivec2(gl_FragCoord.xy), 0).r;
+  float k = flow.camera_position.w;
+  float path = clamp(eye_distance * ((gl_FragCoord.z - k) / (behind - k) - 1.0), 0.0, kMaxWaterPath);
+  float below = path * abs(to_eye.y);  // the depth of the bed under the surface there
+
   // Shallow water ripples less, so the shore is calm. A fading particle only eases its cell's
   // ripples part of the way: a full fade would print the particles' cells on the water.
-  float shore = smoothstep(0.0, kShoreFadeMetres, in_depth);
+  float shore = smoothstep(0.0, kShoreFadeMetres, below);
   float transparency = shore * mix(1.0 - kFadeInfluence, 1.0, fade);
   TdfResult tdf = tdf_normal(in_world, vec3(0.0, 1.0, 0.0),
                              kRippleStrength * transparency * transparency, flow.water.z,
                              tile_table, normal_map);
   vec3 n = tdf.normal;
 
-  // Reflection: the mirrored scene at this pixel, offset by the normal's tilt (paper §4.3).
-  vec3 to_eye = normalize(flow.camera_position.xyz - in_world);
-  vec2 uv = gl_FragCoord.xy * flow.screen.zw + tdf.tilt * flow.water.y;
-  vec3 reflection = texture(reflection_map, clamp(uv, vec2(0.0), vec2(1.0))).rgb;
+  // Reflection: the mirrored scene at this pixel, offset by the normal's tilt (paper §4.3); a
+  // plain sky where the host's reflection drew nothing.
+  vec2 uv = pixel * flow.screen.zw + tdf.tilt * flow.water.y;
+  vec4 mirrored = texture(reflection_map, clamp(uv, vec2(0.0), vec2(1.0)));
+  vec3 reflection = mix(kSkyFallback, mirrored.rgb, mirrored.a);
   float cos_theta = max(dot(n, to_eye), 0.0);
   float grazing = 1.0 - cos_theta;
   float grazing_sq = grazing * grazing;
   float fresnel = kFresnelF0 + (1.0 - kFresnelF0) * grazing_sq * grazing_sq * grazing;
 
-  // Depth-based colour and absorption: clear in the shallows, dark and opaque in the deep.
+  // Colour and absorption by the water the light crosses: clear in the shallows, dark and
+  // opaque in the deep.
   float light = 0.35 + 0.65 * max(dot(n, flow.sun_direction.xyz), 0.0);  // a unit vector already
-  vec3 body = mix(kShallowColour, kDeepColour, 1.0 - exp(-kAbsorptionPerMetre * in_depth)) * light;
-  float opacity = 1.0 - exp(-kOpacityPerMetre * in_depth);
+  vec3 body = mix(kShallowColour, kDeepColour, 1.0 - exp(-kAbsorptionPerMetre * path)) * light;
+  float opacity = 1.0 - exp(-kOpacityPerMetre * path);
   vec3 colour = mix(body, reflection, fresnel);
   float alpha = clamp(mix(opacity, 1.0, fresnel), 0.0, 1.0) * shore;
   out_color = vec4(colour, alpha);

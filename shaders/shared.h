@@ -48,7 +48,8 @@ struct SceneConstants {
   vec4 sun_direction;       // xyz unit vector towards the sun, w sun disc intensity
   vec4 clip_plane;          // world-space plane (n, d): gl_ClipDistance = dot(n, p) + d
   vec4 fog;                 // x density per metre, y height falloff, z height of the model's
-                            // origin (translated instances), w unused
+                            // origin (translated instances), w the far plane's window depth
+                            // (1, or 0 under reverse-Z)
 };
 
 // River particles: flow texture and auxiliary data (paper §3.2; packed by sim/flow_textures.h
@@ -97,12 +98,13 @@ static_assert(offsetof(ParticleAux, fade) == 12);
 
 // Push constants of the flow pass (the water material).
 struct FlowConstants {
-  mat4 view_proj;        // world -> clip of the main view
-  vec4 camera_position;  // xyz world position, w unused
+  mat4 view_proj;        // world -> clip of the host's view
+  vec4 camera_position;  // xyz world position, w the projection's P[2][2] / P[2][3]: along a
+                         // pixel's ray, view distances are in the ratio of (depth - w)
   vec4 sun_direction;    // xyz unit vector towards the sun
   vec4 water;            // x water level (m), y reflection distortion (uv per unit normal tilt),
                          // z TDF tile size (m), w flow texel size (pixels)
-  vec4 screen;           // xy output size (pixels), zw 1 / size
+  vec4 screen;           // xy the viewport's offset in the host's images (pixels), zw 1 / its size
 };
 
 // The flow pass's tile table (shaders/flow_tiles.comp, read by tiled_directional_flow.glsl).
@@ -137,10 +139,6 @@ struct FlowTileConstants {
 // in double): floats keep sub-millisecond steps, and every TDF scroll rate makes whole cycles per
 // period, so the wrap is seamless.
 #define SIVIFLOW_TDF_TIME_PERIOD 64.0
-
-// Vertex input of the flow pass: the river surface positions (binding 0) and water depth per
-// vertex (binding 1, one float).
-#define SIVIFLOW_ATTR_WATER_DEPTH 1
 
 #ifdef __cplusplus
 static_assert(sizeof(FlowConstants) == 128);

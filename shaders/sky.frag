@@ -8,6 +8,9 @@ layout(location = 0) in vec4 in_far_point;
 layout(location = 0) out vec4 out_color;
 
 void main() {
-  vec3 direction = normalize(in_far_point.xyz / in_far_point.w - scene.camera_position.xyz);
+  // The far point minus the camera, times w (its sign undone): also a direction when the far
+  // point is at infinity (w = 0, an infinite reverse-Z projection).
+  vec3 direction = normalize(in_far_point.xyz - scene.camera_position.xyz * in_far_point.w) *
+                   (in_far_point.w < 0.0 ? -1.0 : 1.0);
   out_color = vec4(sky_radiance(direction, scene.sun_direction.xyz, scene.sun_direction.w), 1.0);
 }

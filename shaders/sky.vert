@@ -9,6 +9,7 @@ layout(location = 0) out vec4 out_far_point;
 
 void main() {
   vec2 ndc = vec2(float((gl_VertexIndex << 1) & 2), float(gl_VertexIndex & 2)) * 2.0 - 1.0;
-  out_far_point = inverse(scene.view_proj) * vec4(ndc, 1.0, 1.0);
-  gl_Position = vec4(ndc, 1.0, 1.0);  // on the far plane: only where no terrain was drawn first
+  float far_depth = scene.fog.w;  // 1, or 0 under reverse-Z (an infinite far plane: w = 0 below)
+  out_far_point = inverse(scene.view_proj) * vec4(ndc, far_depth, 1.0);
+  gl_Position = vec4(ndc, far_depth, 1.0);  // on the far plane: only where nothing was drawn
 }

@@ -19,6 +19,7 @@
 #include "shaders/shared.h"
 #include "siviflow/atomic_file.h"
 #include "siviflow/headless_context.h"
+#include "siviflow/host_frame.h"
 #include "siviflow/image_files.h"
 #include "siviflow/renderer.h"
 #include "siviflow/scene_file.h"
@@ -29,6 +30,7 @@ namespace {
 constexpr const char* kCommand = "capture";
 constexpr uint32_t kFramesInFlight = 2;
 constexpr VkFormat kOutputFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 // Colour (RGBA16F) + depth (D32) images and their readback copies, per frame in flight.
 constexpr uint64_t kBytesPerPixel = 2 * (8 + 4);
 // Lavapipe does not enforce its 2 GiB heap (reliability notes), so the capture enforces a budget.
@@ -171,7 +173,7 @@ float linear_depth(float window_depth, float near_plane, float far_plane) {
 }
 
 struct SlotTargets {
-  HostImage output;
+  HostTargets targets;
   HostBuffer readback[kReadbackImageCount];
   bool pending = false;  // a submitted frame whose readback has not been copied out yet
   uint32_t frame = 0;
@@ -212,6 +214,7 @@ class Capture {
   CaptureOptions options_;
   std::optional<SceneFile> scene_;
   std::unique_ptr<HeadlessContext> context_;
+  std::unique_ptr<World> world_;
   std::unique_ptr<Renderer> renderer_;
   Status write_particles_csv(const std::string& path) const;
 
@@ -248,18 +251,28 @@ Status Capture::run() {
   info.enable_readback = true;
   info.seed = options_.seed;
   info.scene = scene_.has_value() ? &*scene_ : nullptr;
+  WorldCreateInfo world_info = context_->world_create_info(kOutputFormat, kDepthFormat);
+  world_info.frames_in_flight = kFramesInFlight;
+  world_info.scene = info.scene;
+  SIVIFLOW_TRY(World::create(world_info, &world_));
+  info.depth_format = kDepthFormat;
+  info.reflection = &World::draw_reflection;
+  info.reflection_user = world_.get();
   SIVIFLOW_TRY(Renderer::create(info, &renderer_));
+  const VkExtent2D extent{options_.size.width, options_.size.height};
   // The particles carry state from frame to frame: a shard starting at frame A first advances
   // the simulation through frames 0..A-1, without rendering, so that its frames equal a full run's.
   for (uint32_t frame = 0; frame < options_.first_frame; ++frame) {
     const double time = static_cast<double>(frame) / options_.fps;
-    SIVIFLOW_TRY(renderer_->simulate(renderer_->scene_camera(time), time));
+    SIVIFLOW_TRY(renderer_->simulate(camera_view(world_->scene_camera(time), extent), time));
   }
 
   std::vector<SlotTargets> slots(kFramesInFlight);
-  const VkExtent2D extent{options_.size.width, options_.size.height};
+  const ImageState readable{VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
   for (SlotTargets& slot : slots) {
-    SIVIFLOW_TRY(context_->create_target_image(kOutputFormat, extent, &slot.output));
+    SIVIFLOW_TRY(
+        create_host_targets(*context_, kOutputFormat, kDepthFormat, extent, readable, &slot.targets));
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
       SIVIFLOW_TRY(context_->create_readback_buffer(
           renderer_->readback_bytes(static_cast<ReadbackImage>(i)), &slot.readback[i]));
@@ -278,18 +291,15 @@ Status Capture::run() {
     if (have_finished) copy_out(slot);
     const double time = static_cast<double>(frame) / options_.fps;
     SIVIFLOW_TRY(renderer_->begin_frame(index));
-    slot.camera = renderer_->scene_camera(time);
-    SIVIFLOW_TRY(renderer_->update(slot.camera, time));
+    slot.camera = world_->scene_camera(time);
+    const View view = camera_view(slot.camera, extent);
+    SIVIFLOW_TRY(renderer_->update(view, time));
     const std::span<const Particle> particles = renderer_->particle_field().particles();
     slot.particles.assign(particles.begin(), particles.end());
-    FrameInputs inputs;
-    inputs.output.image = slot.output.image;
-    inputs.output.view = slot.output.view;
-    inputs.output.current = ImageState{};  // contents discarded: we overwrite every pixel
-    inputs.output.final = {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
-                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-    for (uint32_t i = 0; i < kReadbackImageCount; ++i) inputs.readback.buffers[i] = slot.readback[i].buffer;
-    SIVIFLOW_TRY(renderer_->record(cmd, inputs));
+    ReadbackTargets readback;
+    for (uint32_t i = 0; i < kReadbackImageCount; ++i) readback.buffers[i] = slot.readback[i].buffer;
+    SIVIFLOW_TRY(record_world_and_water(cmd, index, *world_, *renderer_, view, time, readback,
+                                        &slot.targets));
     SIVIFLOW_TRY(context_->end_slot_and_submit(index));
     slot.pending = true;
     slot.frame = frame;

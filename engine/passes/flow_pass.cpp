@@ -10,13 +10,14 @@
 namespace siviflow {
 namespace {
 
-// Bindings 0..4 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
-// normal map, tile table.
-constexpr uint32_t kBindingCount = 5;
+// Bindings 0..5 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
+// normal map, tile table, host depth.
+constexpr uint32_t kBindingCount = 6;
+constexpr uint32_t kHostDepthBinding = 5;
 constexpr std::array<VkDescriptorType, kBindingCount> kMaterialBindings = {
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
 // Bindings of shaders/flow_tiles.comp: flow texture, water heights, tile table.
 constexpr std::array<VkDescriptorType, 3> kTileBindings = {
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -26,8 +27,10 @@ constexpr uint32_t kTileGroupSide = 8;  // flow_tiles.comp's local size
 }  // namespace
 
 Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
-                        VkFormat depth_format, bool with_aovs, bool with_floor) {
+                        VkFormat depth_format, uint32_t slot_count, bool with_aovs,
+                        bool with_floor) {
   with_aovs_ = with_aovs;
+  slot_count_ = slot_count;
   SIVIFLOW_TRY(create_layouts(gpu, kMaterialBindings,
                               VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                               sizeof(gpu::FlowConstants), &set_layout_, &layout_));
@@ -44,12 +47,10 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
   if (with_aovs) desc.extra_color_formats = {kMaskFormat, kNormalFormat, kReflectionFormat};
   desc.depth_format = depth_format;
   desc.depth_write = false;
-  desc.depth_compare = VK_COMPARE_OP_LESS_OR_EQUAL;
+  desc.dynamic_depth_compare = true;  // the host's depth convention, per frame
   desc.alpha_blend = true;
-  desc.bindings = {{0, sizeof(float) * 3, VK_VERTEX_INPUT_RATE_VERTEX},
-                   {1, sizeof(float), VK_VERTEX_INPUT_RATE_VERTEX}};
-  desc.attributes = {{SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
-                     {SIVIFLOW_ATTR_WATER_DEPTH, 1, VK_FORMAT_R32_SFLOAT, 0}};
+  desc.bindings = {{0, sizeof(float) * 3, VK_VERTEX_INPUT_RATE_VERTEX}};
+  desc.attributes = {{SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
   SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, desc, &pipeline_));
   SIVIFLOW_TRY(create_layouts(gpu, kTileBindings, VK_SHADER_STAGE_COMPUTE_BIT,
                               sizeof(gpu::FlowTileConstants), &tiles_set_layout_, &tiles_layout_));
@@ -90,10 +91,12 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   const DeviceTable& vk = *gpu.table;
   // New sets first: on failure the current ones stay valid.
   std::array<VkDescriptorPool, 2> pools{};
-  std::array<VkDescriptorSet, 2> sets{};
-  Status allocated = allocate_sets(gpu, set_layout_, kMaterialBindings, 1, &pools[0], &sets[0]);
+  std::vector<VkDescriptorSet> sets(slot_count_);
+  VkDescriptorSet tiles_set = VK_NULL_HANDLE;
+  Status allocated = allocate_sets(gpu, set_layout_, kMaterialBindings, slot_count_, &pools[0],
+                                   sets.data());
   if (allocated.ok())
-    allocated = allocate_sets(gpu, tiles_set_layout_, kTileBindings, 1, &pools[1], &sets[1]);
+    allocated = allocate_sets(gpu, tiles_set_layout_, kTileBindings, 1, &pools[1], &tiles_set);
   if (!allocated.ok()) {
     for (VkDescriptorPool pool : pools) {
       if (pool != VK_NULL_HANDLE)
@@ -106,10 +109,11 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   }
   pool_ = pools[0];
   tiles_pool_ = pools[1];
-  set_ = sets[0];
-  tiles_set_ = sets[1];
+  sets_ = std::move(sets);
+  tiles_set_ = tiles_set;
   const VkImageLayout read = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  const std::array<VkDescriptorImageInfo, kBindingCount> material{
+  // The host depth (binding 5) is written per frame, into the slot's own set.
+  const std::array<VkDescriptorImageInfo, kHostDepthBinding> material{
       {{nearest_, textures.flow, read},
        {nearest_, textures.aux, read},
        {linear_clamp_, textures.reflection, textures.reflection_layout},
@@ -122,7 +126,7 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   std::vector<VkWriteDescriptorSet> writes;
   const auto write = [&writes](VkDescriptorSet set, std::span<const VkDescriptorType> types,
                                std::span<const VkDescriptorImageInfo> images) {
-    for (uint32_t i = 0; i < types.size(); ++i) {
+    for (uint32_t i = 0; i < images.size(); ++i) {
       VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
       w.dstSet = set;
       w.dstBinding = i;
@@ -132,11 +136,25 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
       writes.push_back(w);
     }
   };
-  write(set_, kMaterialBindings, material);
+  for (VkDescriptorSet set : sets_) write(set, kMaterialBindings, material);
   write(tiles_set_, kTileBindings, tiles);
   vk.vkUpdateDescriptorSets(vk.device, static_cast<uint32_t>(writes.size()), writes.data(), 0,
                             nullptr);
   return Status::success();
+}
+
+void FlowPass::set_frame(const GpuContext& gpu, const Frame& frame) {
+  frame_ = frame;
+  // The slot's previous frame is done (the host waited on it), so its set may change.
+  const VkDescriptorImageInfo image{nearest_, frame.host_depth,
+                                    VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL};
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = sets_[frame.slot];
+  w.dstBinding = kHostDepthBinding;
+  w.descriptorCount = 1;
+  w.descriptorType = kMaterialBindings[kHostDepthBinding];
+  w.pImageInfo = &image;
+  gpu.table->vkUpdateDescriptorSets(gpu.table->device, 1, &w, 0, nullptr);
 }
 
 void FlowPass::declare(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
@@ -149,17 +167,17 @@ void FlowPass::declare(FrameGraph& graph, const gpu::FlowConstants* constants, u
     handles->reflection_sample = pass.color_write(handles->reflection_sample, LoadOp::Clear);
   }
   pass.depth_read(handles->depth);
+  pass.sampled_fragment(handles->depth);
   pass.sampled_fragment(handles->flow);
   pass.sampled_fragment(handles->aux);
   pass.sampled_fragment(handles->reflection);
   pass.sampled_fragment(handles->normal_map);
   pass.sampled_fragment(handles->tile_table);
   pass.vertex_read(handles->vertices);
-  pass.vertex_read(handles->depths);
   pass.index_read(handles->indices);
   const Handles h = *handles;
   pass.record([this, h, constants, index_count](const PassContext& ctx) {
-    draw_river(ctx, pipeline_, h, ctx.extent(h.color), constants, index_count);
+    draw_river(ctx, pipeline_, h, constants, index_count);
     return Status::success();
   });
 }
@@ -191,35 +209,38 @@ void FlowPass::declare_floor(FrameGraph& graph, const gpu::FlowConstants* consta
   PassBuilder pass = graph.add_pass("flow floor", PassKind::Graphics);
   const ImageHandle written = pass.color_write(target, LoadOp::DontCare);
   pass.depth_read(inputs.depth);
+  pass.sampled_fragment(inputs.depth);
   pass.sampled_fragment(inputs.flow);
   pass.sampled_fragment(inputs.aux);
   pass.sampled_fragment(inputs.reflection);
   pass.sampled_fragment(inputs.normal_map);
   pass.sampled_fragment(inputs.tile_table);
   pass.vertex_read(inputs.vertices);
-  pass.vertex_read(inputs.depths);
   pass.index_read(inputs.indices);
   pass.side_effect();
   const Handles h = inputs;
-  pass.record([this, h, written, constants, index_count](const PassContext& ctx) {
-    draw_river(ctx, floor_pipeline_, h, ctx.extent(written), constants, index_count);
+  pass.record([this, h, constants, index_count](const PassContext& ctx) {
+    draw_river(ctx, floor_pipeline_, h, constants, index_count);
     return Status::success();
   });
 }
 
 void FlowPass::draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h,
-                          VkExtent2D extent, const gpu::FlowConstants* constants,
-                          uint32_t index_count) const {
+                          const gpu::FlowConstants* constants, uint32_t index_count) const {
   const DeviceTable& vk = ctx.table();
   const VkCommandBuffer cmd = ctx.cmd();
-  set_viewport(vk, cmd, extent);
-  vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &set_, 0, nullptr);
+  set_viewport(vk, cmd, frame_.viewport);
+  vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1,
+                             &sets_[frame_.slot], 0, nullptr);
   vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                         sizeof(gpu::FlowConstants), constants);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-  const VkBuffer streams[2] = {ctx.buffer(h.vertices), ctx.buffer(h.depths)};
-  const VkDeviceSize offsets[2] = {0, 0};
-  vk.vkCmdBindVertexBuffers(cmd, 0, 2, streams, offsets);
+  // Not written, only tested: water in front of (or level with) what the host drew.
+  vk.vkCmdSetDepthCompareOp(cmd, frame_.reverse_z ? VK_COMPARE_OP_GREATER_OR_EQUAL
+                                                  : VK_COMPARE_OP_LESS_OR_EQUAL);
+  const VkBuffer vertices = ctx.buffer(h.vertices);
+  const VkDeviceSize offset = 0;
+  vk.vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
   vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
   vk.vkCmdDrawIndexed(cmd, index_count, 1, 0, 0, 0);
 }

@@ -48,7 +48,7 @@ struct UploadList {
 // imported staging buffer. `list` is read again when the pass records.
 void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list);
 
-// ---- scene: sky, terrain, riverbed and objects ----
+// ---- scene: sky, terrain, riverbed and objects (the built-in world, siviflow/world.h) ----
 
 // One indexed draw of the scene pipeline with its own push constants.
 struct SceneDraw {
@@ -78,10 +78,20 @@ class ScenePass {
     ImageHandle detail;
     std::vector<ImageHandle> base_colors;  // in the order of set_textures
   };
-  // Declares a pass drawing the scene's `draws` then the sky (the main view as "scene", the
-  // mirrored view as "reflection"); the new versions of colour and depth go back into `handles`.
+  // The view a declared pass draws: its depth convention (the clear value is the caller's) and
+  // its viewport.
+  struct Frame {
+    bool reverse_z = false;
+    VkRect2D viewport{};
+  };
+  // Declares a pass clearing colour and depth, then drawing the scene's `draws` and the sky;
+  // the new versions of colour and depth go back into `handles`. `draws` and `frame` are read
+  // when the pass records.
   void declare(FrameGraph& graph, const char* pass_name, const std::vector<SceneDraw>* draws,
-               Handles* handles);
+               const Frame* frame, Handles* handles);
+  // Records `draws` then the sky into the rendering begun by the caller (viewport set).
+  void draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices, VkBuffer indices,
+            const std::vector<SceneDraw>& draws, bool reverse_z) const;
 
  private:
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
@@ -111,9 +121,10 @@ class FlowPass {
   static constexpr VkFormat kTileTableFormat = VK_FORMAT_R32G32B32A32_UINT;  // shaders/shared.h
   static constexpr VkFormat kWaterHeightsFormat = VK_FORMAT_R32_SFLOAT;
 
-  // with_floor: also the bench's floor pipeline (declare_floor).
+  // One material descriptor set per frame slot (the host's depth changes per frame); with_floor:
+  // also the bench's floor pipeline (declare_floor).
   Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
-                VkFormat depth_format, bool with_aovs, bool with_floor);
+                VkFormat depth_format, uint32_t slot_count, bool with_aovs, bool with_floor);
   void destroy(const GpuContext& gpu);
 
   struct Textures {
@@ -130,9 +141,20 @@ class FlowPass {
   Status bind_textures(const GpuContext& gpu, const Textures& textures,
                        const std::function<void(VkDescriptorPool)>& retire);
 
+  // What the next recording of the passes draws with: the frame slot (whose previous frame the
+  // host has waited for), a view of the host depth's depth aspect, the depth convention and
+  // the viewport in the host's images.
+  struct Frame {
+    uint32_t slot = 0;
+    VkImageView host_depth = VK_NULL_HANDLE;
+    bool reverse_z = false;
+    VkRect2D viewport{};
+  };
+  void set_frame(const GpuContext& gpu, const Frame& frame);
+
   struct Handles {
-    ImageHandle color;       // the scene colour: loaded, blended over
-    ImageHandle depth;       // the scene depth: tested, not written
+    ImageHandle color;       // the host's colour: loaded, blended over
+    ImageHandle depth;       // the host's depth: tested and sampled, not written
     ImageHandle flow;
     ImageHandle aux;
     ImageHandle reflection;
@@ -140,7 +162,6 @@ class FlowPass {
     ImageHandle tile_table;     // written by declare_tiles (compute), read by the material
     ImageHandle water_heights;  // read by declare_tiles
     BufferHandle vertices;   // river surface positions (vec3)
-    BufferHandle depths;     // water depth per vertex (float)
     BufferHandle indices;
     ImageHandle mask;        // AOVs, written when created with_aovs
     ImageHandle normal;
@@ -158,10 +179,12 @@ class FlowPass {
                      const Handles& inputs, ImageHandle target);
 
  private:
-  void draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h, VkExtent2D extent,
+  void draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h,
                   const gpu::FlowConstants* constants, uint32_t index_count) const;
 
   bool with_aovs_ = false;
+  uint32_t slot_count_ = 1;
+  Frame frame_;
   VkPipeline floor_pipeline_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
@@ -175,15 +198,17 @@ class FlowPass {
   VkSampler linear_clamp_ = VK_NULL_HANDLE;
   VkSampler linear_repeat_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
-  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  std::vector<VkDescriptorSet> sets_;  // per frame slot
 };
 
 // ---- readback: images -> host buffers (tools and tests only) ----
 
 struct ReadbackCopy {
-  ImageHandle image;    // copied whole, tightly packed (depth formats: the depth aspect)
+  ImageHandle image;    // copied tightly packed (depth formats: the depth aspect)
   BufferHandle buffer;  // imported, handed back in the HostRead state; replaced by the written version
+  VkRect2D region{};    // the part copied, read when the pass records; 0x0: the whole image
 };
+// `copies` is read again when the pass records.
 void add_readback_pass(FrameGraph& graph, std::vector<ReadbackCopy>* copies);
 
 }  // namespace siviflow

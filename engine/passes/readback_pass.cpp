@@ -11,12 +11,14 @@ void add_readback_pass(FrameGraph& graph, std::vector<ReadbackCopy>* copies) {
     copy.buffer = pass.transfer_write(copy.buffer);
   }
   pass.side_effect();
-  pass.record([list = *copies](const PassContext& ctx) {
+  pass.record([copies](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
-    for (const ReadbackCopy& copy : list) {
-      const VkExtent2D extent = ctx.extent(copy.image);
+    for (const ReadbackCopy& copy : *copies) {
+      const bool whole = copy.region.extent.width == 0 || copy.region.extent.height == 0;
+      const VkExtent2D extent = whole ? ctx.extent(copy.image) : copy.region.extent;
       VkBufferImageCopy region{};
       region.bufferOffset = ctx.offset(copy.buffer);
+      region.imageOffset = {whole ? 0 : copy.region.offset.x, whole ? 0 : copy.region.offset.y, 0};
       region.imageExtent = {extent.width, extent.height, 1};  // tightly packed rows
       // A depth/stencil image is read through its depth aspect only.
       const VkImageAspectFlags aspect = aspect_of(ctx.format(copy.image));

@@ -22,7 +22,7 @@ Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat 
   sky.color_format = color_format;
   sky.depth_format = depth_format;
   sky.depth_write = false;
-  sky.depth_compare = VK_COMPARE_OP_LESS_OR_EQUAL;  // drawn at the far plane over the clear
+  sky.dynamic_depth_compare = true;  // drawn at the far plane over the clear: less or equal
   SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, sky, &sky_pipeline_));
 
   GraphicsPipelineDesc scene;
@@ -31,6 +31,7 @@ Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat 
   scene.layout = layout_;
   scene.color_format = color_format;
   scene.depth_format = depth_format;
+  scene.dynamic_depth_compare = true;  // the view's depth convention
   scene.bindings = {{0, sizeof(SceneVertex), VK_VERTEX_INPUT_RATE_VERTEX}};
   scene.attributes = {
       {SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SceneVertex, position)},
@@ -82,7 +83,8 @@ Status ScenePass::set_textures(const GpuContext& gpu, VkImageView detail,
 }
 
 void ScenePass::declare(FrameGraph& graph, const char* pass_name,
-                        const std::vector<SceneDraw>* draws, Handles* handles) {
+                        const std::vector<SceneDraw>* draws, const Frame* frame,
+                        Handles* handles) {
   PassBuilder pass = graph.add_pass(pass_name, PassKind::Graphics);
   handles->color = pass.color_write(handles->color, LoadOp::Clear);
   handles->depth = pass.depth_write(handles->depth, LoadOp::Clear);
@@ -91,37 +93,43 @@ void ScenePass::declare(FrameGraph& graph, const char* pass_name,
   pass.sampled_fragment(handles->detail);
   for (ImageHandle base_color : handles->base_colors) pass.sampled_fragment(base_color);
   const Handles h = *handles;
-  pass.record([this, h, draws](const PassContext& ctx) {
-    const DeviceTable& vk = ctx.table();
-    const VkCommandBuffer cmd = ctx.cmd();
-    constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-    set_viewport(vk, cmd, ctx.extent(h.color));
-    // Terrain and objects first, so the sky's fragments are depth-tested away behind them.
-    const VkBuffer vertices = ctx.buffer(h.vertices);
-    const VkDeviceSize offset = 0;
-    vk.vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
-    vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
-    VkPipeline bound = VK_NULL_HANDLE;
-    VkDescriptorSet bound_set = VK_NULL_HANDLE;
-    for (const SceneDraw& draw : *draws) {
-      const VkPipeline pipeline = draw.material == 0 ? scene_pipeline_ : object_pipeline_;
-      if (pipeline != bound) {
-        vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-        bound = pipeline;
-      }
-      if (sets_[draw.material] != bound_set) {
-        bound_set = sets_[draw.material];
-        vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &bound_set, 0, nullptr);
-      }
-      vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), draw.constants);
-      vk.vkCmdDrawIndexed(cmd, draw.index_count, 1, draw.first_index, 0, 0);
-    }
-    // The sky with the view's own constants: those of the first, untranslated draw.
-    vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), draws->front().constants);
-    vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, sky_pipeline_);
-    vk.vkCmdDraw(cmd, 3, 1, 0, 0);
+  pass.record([this, h, draws, frame](const PassContext& ctx) {
+    set_viewport(ctx.table(), ctx.cmd(), frame->viewport);
+    draw(ctx.table(), ctx.cmd(), ctx.buffer(h.vertices), ctx.buffer(h.indices), *draws,
+         frame->reverse_z);
     return Status::success();
   });
+}
+
+void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices,
+                     VkBuffer indices, const std::vector<SceneDraw>& draws, bool reverse_z) const {
+  constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+  // Terrain and objects first, so the sky's fragments are depth-tested away behind them.
+  const VkDeviceSize offset = 0;
+  vk.vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
+  vk.vkCmdBindIndexBuffer(cmd, indices, 0, VK_INDEX_TYPE_UINT32);
+  VkPipeline bound = VK_NULL_HANDLE;
+  VkDescriptorSet bound_set = VK_NULL_HANDLE;
+  for (const SceneDraw& d : draws) {
+    const VkPipeline pipeline = d.material == 0 ? scene_pipeline_ : object_pipeline_;
+    if (pipeline != bound) {
+      vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+      vk.vkCmdSetDepthCompareOp(cmd, reverse_z ? VK_COMPARE_OP_GREATER : VK_COMPARE_OP_LESS);
+      bound = pipeline;
+    }
+    if (sets_[d.material] != bound_set) {
+      bound_set = sets_[d.material];
+      vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &bound_set, 0, nullptr);
+    }
+    vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), d.constants);
+    vk.vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, 0, 0);
+  }
+  // The sky with the view's own constants: those of the first, untranslated draw.
+  vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), draws.front().constants);
+  vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, sky_pipeline_);
+  vk.vkCmdSetDepthCompareOp(cmd, reverse_z ? VK_COMPARE_OP_GREATER_OR_EQUAL
+                                           : VK_COMPARE_OP_LESS_OR_EQUAL);
+  vk.vkCmdDraw(cmd, 3, 1, 0, 0);
 }
 
 }  // namespace siviflow

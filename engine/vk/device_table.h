@@ -56,6 +56,7 @@ namespace siviflow {
   X(vkCmdPushConstants)                \
   X(vkCmdSetViewport)                  \
   X(vkCmdSetScissor)                   \
+  X(vkCmdSetDepthCompareOp)            \
   X(vkCmdDraw)                         \
   X(vkCmdDispatch)                     \
   X(vkCmdDrawIndexed)                  \

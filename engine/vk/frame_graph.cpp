@@ -175,6 +175,12 @@ void FrameBindings::set_incoming(BufferHandle buffer, ResourceState state) {
 void FrameBindings::set_outgoing(ImageHandle image, ResourceState state) {
   if (image.valid()) slot(image.id).outgoing = state;
 }
+void FrameBindings::set_clear(ImageHandle image, VkClearValue clear) {
+  if (image.valid()) slot(image.id).clear = clear;
+}
+void FrameBindings::set_render_area(ImageHandle image, VkRect2D area) {
+  if (image.valid()) slot(image.id).render_area = area;
+}
 void FrameBindings::set_outgoing(BufferHandle buffer, ResourceState state) {
   if (buffer.valid()) slot(buffer.id).outgoing = state;
 }
@@ -741,7 +747,9 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
         info.imageLayout = a.layout;
         info.loadOp = a.load;
         info.storeOp = a.store;
-        info.clearValue = resources_[a.resource].image.clear;
+        const FrameBindings::Bound* bound = bindings.find(a.resource);
+        info.clearValue = bound != nullptr && bound->clear ? *bound->clear
+                                                           : resources_[a.resource].image.clear;
         return info;
       };
       std::vector<VkRenderingAttachmentInfo>& colors = color_scratch_;
@@ -749,8 +757,13 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
       for (const Attachment& a : step.colors) colors.push_back(attachment_info(a));
       VkRenderingAttachmentInfo depth{};
       if (step.depth) depth = attachment_info(*step.depth);
+      VkRect2D area{{0, 0}, step.extent};
+      for (const Attachment& a : step.colors) {
+        const FrameBindings::Bound* bound = bindings.find(a.resource);
+        if (bound != nullptr && bound->render_area) area = *bound->render_area;
+      }
       VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-      rendering.renderArea = {{0, 0}, step.extent};
+      rendering.renderArea = area;
       rendering.layerCount = 1;
       rendering.colorAttachmentCount = static_cast<uint32_t>(colors.size());
       rendering.pColorAttachments = colors.data();

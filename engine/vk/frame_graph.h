@@ -106,6 +106,12 @@ class FrameBindings {
   void set_incoming(BufferHandle buffer, ResourceState state);
   void set_outgoing(ImageHandle image, ResourceState state);
   void set_outgoing(BufferHandle buffer, ResourceState state);
+  // Replaces the declared clear value of an attachment for this execute (a depth convention
+  // chosen per frame).
+  void set_clear(ImageHandle image, VkClearValue clear);
+  // The part of an imported image that passes drawing into it render (and clear) this execute,
+  // when it is not the declared extent: one view in a host's image that holds several.
+  void set_render_area(ImageHandle image, VkRect2D area);
   void reset() { bound_.clear(); }
 
  private:
@@ -118,6 +124,8 @@ class FrameBindings {
     VkDeviceSize offset = 0;
     std::optional<ResourceState> incoming;
     std::optional<ResourceState> outgoing;
+    std::optional<VkClearValue> clear;
+    std::optional<VkRect2D> render_area;
   };
   Bound& slot(uint32_t id);
   const Bound* find(uint32_t id) const { return id < bound_.size() ? &bound_[id] : nullptr; }

@@ -23,6 +23,7 @@ Status FrameRing::init(const GpuContext& gpu, uint32_t slot_count,
                        VkDeviceSize staging_bytes_per_slot) {
   gpu_ = gpu;
   slots_.resize(slot_count);
+  if (staging_bytes_per_slot == 0) return Status::success();  // deletions only
   for (uint32_t i = 0; i < slot_count; ++i) {
     const std::string name = "staging slot " + std::to_string(i);
     SIVIFLOW_TRY(create_buffer(gpu, staging_bytes_per_slot, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,

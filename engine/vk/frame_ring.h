@@ -48,6 +48,7 @@ struct StagingAllocation {
 
 class FrameRing {
  public:
+  // staging_bytes_per_slot 0: no staging blocks, the ring only defers deletions.
   Status init(const GpuContext& gpu, uint32_t slot_count, VkDeviceSize staging_bytes_per_slot);
   void destroy();  // runs every pending deletion; the GPU must be idle for this ring
   // Grows every slot's staging block to at least `bytes`, between frames (not between a slot's

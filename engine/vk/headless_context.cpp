@@ -423,6 +423,20 @@ CreateInfo HeadlessContext::renderer_create_info(VkExtent2D extent, VkFormat col
   return info;
 }
 
+WorldCreateInfo HeadlessContext::world_create_info(VkFormat color_format,
+                                                   VkFormat depth_format) const {
+  WorldCreateInfo info;
+  info.instance = impl_->instance;
+  info.physical_device = impl_->physical_device;
+  info.device = impl_->device;
+  info.get_instance_proc_addr = impl_->get_instance_proc_addr;
+  info.get_device_proc_addr = impl_->host.vkGetDeviceProcAddr;
+  info.color_format = color_format;
+  info.depth_format = depth_format;
+  info.debug_utils = impl_->report.validation_enabled;
+  return info;
+}
+
 Status HeadlessContext::begin_slot(uint32_t slot, VkCommandBuffer* cmd) {
   Impl& s = *impl_;
   while (s.slot_commands.size() <= slot) {
@@ -493,6 +507,17 @@ Status HeadlessContext::create_target_image(VkFormat format, VkExtent2D extent, 
                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
                                 VK_IMAGE_USAGE_SAMPLED_BIT,
                             "host target", &image));
+  impl_->host_images.push_back(image);
+  *out = HostImage{image.image, image.view};
+  return Status::success();
+}
+
+Status HeadlessContext::create_depth_image(VkFormat format, VkExtent2D extent, HostImage* out) {
+  Image image;
+  SIVIFLOW_TRY(create_image(impl_->gpu, format, extent,
+                            VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                                VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                            "host depth", &image));
   impl_->host_images.push_back(image);
   *out = HostImage{image.image, image.view};
   return Status::success();

@@ -102,9 +102,10 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
     blend.attachmentCount = static_cast<uint32_t>(blend_attachments.size());
     blend.pAttachments = blend_attachments.data();
 
-    const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR,
+                                             VK_DYNAMIC_STATE_DEPTH_COMPARE_OP};
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dynamic.dynamicStateCount = 2;
+    dynamic.dynamicStateCount = desc.dynamic_depth_compare ? 3 : 2;
     dynamic.pDynamicStates = dynamic_states;
 
     VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
@@ -253,11 +254,15 @@ Status create_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMo
 }
 
 void set_viewport(const DeviceTable& vk, VkCommandBuffer cmd, VkExtent2D extent) {
-  const VkViewport viewport{0.0f, 0.0f, static_cast<float>(extent.width),
-                            static_cast<float>(extent.height), 0.0f, 1.0f};
-  const VkRect2D scissor{{0, 0}, extent};
+  set_viewport(vk, cmd, VkRect2D{{0, 0}, extent});
+}
+
+void set_viewport(const DeviceTable& vk, VkCommandBuffer cmd, VkRect2D area) {
+  const VkViewport viewport{static_cast<float>(area.offset.x), static_cast<float>(area.offset.y),
+                            static_cast<float>(area.extent.width),
+                            static_cast<float>(area.extent.height), 0.0f, 1.0f};
   vk.vkCmdSetViewport(cmd, 0, 1, &viewport);
-  vk.vkCmdSetScissor(cmd, 0, 1, &scissor);
+  vk.vkCmdSetScissor(cmd, 0, 1, &area);
 }
 
 }  // namespace siviflow

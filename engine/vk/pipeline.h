@@ -27,6 +27,7 @@ struct GraphicsPipelineDesc {
   bool depth_test = true;
   bool depth_write = true;
   VkCompareOp depth_compare = VK_COMPARE_OP_LESS;
+  bool dynamic_depth_compare = false;  // set per draw (vkCmdSetDepthCompareOp): reverse-Z hosts
   VkCullModeFlags cull_mode = VK_CULL_MODE_NONE;
   VkFrontFace front_face = VK_FRONT_FACE_COUNTER_CLOCKWISE;
   bool alpha_blend = false;  // attachment 0: premultiplied-free "over" blending
@@ -65,5 +66,6 @@ Status create_sampler(const GpuContext& gpu, VkFilter filter, VkSamplerAddressMo
 
 // Viewport and scissor covering `extent` (the passes' pipelines keep both dynamic).
 void set_viewport(const DeviceTable& vk, VkCommandBuffer cmd, VkExtent2D extent);
+void set_viewport(const DeviceTable& vk, VkCommandBuffer cmd, VkRect2D area);
 
 }  // namespace siviflow

@@ -11,6 +11,7 @@
 #include <vulkan/vulkan.h>
 
 #include "siviflow/renderer.h"
+#include "siviflow/world.h"
 #include "sim/status.h"
 
 namespace siviflow {
@@ -70,6 +71,8 @@ class HeadlessContext {
   // A renderer CreateInfo for this device, with every handle, the enabled features and debug
   // labels (when validation is on) filled; the caller sets the rest.
   CreateInfo renderer_create_info(VkExtent2D extent, VkFormat color_format) const;
+  // The same for the built-in world (siviflow/world.h).
+  WorldCreateInfo world_create_info(VkFormat color_format, VkFormat depth_format) const;
 
   // One command buffer and fence per frame slot, as a host keeping frames in flight has.
   // begin_slot waits (bounded) for the slot's previous submission, then begins recording.
@@ -80,6 +83,8 @@ class HeadlessContext {
 
   // A colour image usable as a render target and as a copy source.
   Status create_target_image(VkFormat format, VkExtent2D extent, HostImage* out);
+  // A depth image usable as a depth attachment, sampled and as a copy source.
+  Status create_depth_image(VkFormat format, VkExtent2D extent, HostImage* out);
   // A host-visible buffer the GPU can copy into, mapped for reading.
   Status create_readback_buffer(VkDeviceSize size, HostBuffer* out);
 

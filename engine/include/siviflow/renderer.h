@@ -4,10 +4,15 @@
 // CreateInfo (zero-initialised fields take the documented defaults), enables
 // required_device_features() when it creates its device, and per frame:
 //   1. waits on its own fence for the frame slot it is about to reuse, then begin_frame(slot);
-//   2. update(camera, time)   — CPU only: simulation and packing into the slot's staging block;
-//   3. record(cmd, inputs)    — records upload and render passes into the host's command buffer,
-//                               outside any host render pass, and leaves every host image in the
-//                               state the host asked for.
+//   2. update(view, time)     — CPU only: the host's view matrices, simulation and packing into
+//                               the slot's staging block;
+//   3. (the host draws its world into its colour and depth images)
+//   4. record(cmd, inputs)    — records upload, reflection and water passes into the host's
+//                               command buffer, outside any host render pass: the river is blended
+//                               over the host's colour and depth-tested against its depth, and
+//                               every host image is left in the state the host asked for.
+// The renderer draws only the water: no sky, terrain or objects (the built-in world of our tools
+// is a host component of its own, siviflow/world.h).
 // The renderer never submits, never waits idle and never owns a swapchain. It calls Vulkan only
 // through a private function table loaded from the host's vkGet*ProcAddr.
 // Destroy it only when the GPU has finished every frame it recorded.
@@ -19,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan.h>
 
@@ -38,11 +44,14 @@ struct ReflectionView {
   float clip_plane[4];   // world space
   float camera_position[3];  // the mirrored camera, for view-dependent shading
   VkExtent2D extent;     // of the reflection target
+  bool reverse_z;        // the host's projection maps near to 1 and far to 0 (depth cleared to 0)
 };
 // Records the host's world into the reflection target. Called inside the reflection pass, with
-// dynamic rendering begun (colour: CreateInfo::color_format, depth: VK_FORMAT_D32_SFLOAT, both
-// cleared) and viewport and scissor set; the host binds its own pipelines (with that rendering
-// format and gl_ClipDistance against clip_plane) and must not end the rendering.
+// dynamic rendering begun (colour: CreateInfo::color_format, cleared to transparent black;
+// depth: VK_FORMAT_D32_SFLOAT, cleared to the far value of the view's depth convention) and
+// viewport and scissor set; the host binds its own pipelines (with that rendering format and
+// gl_ClipDistance against clip_plane) and must not end the rendering. Where the host leaves
+// the colour's alpha at 0, the water reflects a plain sky colour.
 using ReflectionCallback = void (*)(VkCommandBuffer cmd, const ReflectionView& view, void* user);
 using LogCallback = void (*)(LogLevel level, const char* message, void* user);
 
@@ -57,8 +66,10 @@ struct CreateInfo {
   const VkPhysicalDeviceFeatures2* enabled_features = nullptr;
   uint32_t queue_family_index = 0;     // family of the queue that will run what we record (graphics)
   uint32_t frames_in_flight = 0;       // ring slots; 0 means 2
-  VkFormat color_format = VK_FORMAT_UNDEFINED;  // output image format; 0 means RGBA16F
-  VkExtent2D extent = {0, 0};          // output size in pixels; required
+  VkFormat color_format = VK_FORMAT_UNDEFINED;  // host colour image format; 0 means RGBA16F
+  // Host depth image format: D32_SFLOAT (0 means this), D24_UNORM_S8_UINT or D32_SFLOAT_S8_UINT.
+  VkFormat depth_format = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent = {0, 0};          // the view's size in pixels (its viewport); required
   bool enable_readback = false;        // record copies of the frame's images into host buffers
   uint64_t seed = 0;                   // seed of the river particles' random choices
   // The scene to render (its river, flow, obstacles, objects and camera keys); null: the
@@ -90,6 +101,19 @@ std::vector<std::string> required_device_feature_names();
 // Names of required features a chain (enabled or supported features) does not hold.
 std::vector<std::string> missing_device_features(const VkPhysicalDeviceFeatures2* features);
 
+// A host's view of the river: its matrices and where it lies in the host's images.
+struct View {
+  glm::mat4 view{1.0f};  // world -> view space (right-handed, looking down -Z)
+  // view -> Vulkan clip space (x right, y down, depth 0..1), a perspective projection: standard
+  // or reverse-Z, finite or infinite far plane, off-centre or jittered. The renderer derives
+  // the depth convention from it every frame.
+  glm::mat4 projection{1.0f};
+  // The pixels of the host's images the view covers; its extent must equal CreateInfo::extent.
+  // An extent of 0x0 means {offset, CreateInfo::extent}.
+  VkRect2D viewport{};
+};
+
+// A convenience for hosts without matrices of their own: a position, a target, +Y up.
 struct Camera {
   glm::vec3 position{0.0f, 10.0f, -30.0f};
   glm::vec3 target{0.0f, 0.0f, 0.0f};
@@ -97,6 +121,8 @@ struct Camera {
   float near_plane = 0.1f;
   float far_plane = 1000.0f;
 };
+// The standard-depth view of `camera` over a viewport of `extent` at the images' origin.
+View camera_view(const Camera& camera, VkExtent2D extent);
 
 // An image's synchronisation state: what last touched it and its layout.
 struct ImageState {
@@ -105,21 +131,23 @@ struct ImageState {
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
 };
 
-// A host image we render into. `current` is its state when our commands start (UNDEFINED layout:
-// its contents may be discarded); `final` the state the host wants when they end, which must
-// name a real layout (not UNDEFINED).
+// A host image we use. `current` is its state when our commands start; `final` the state the
+// host wants when they end, which must name a real layout (not UNDEFINED). The format and
+// extent are the host's word for what the image is, checked against the configuration.
 struct ExternalImage {
   VkImage image = VK_NULL_HANDLE;
-  VkImageView view = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;  // depth: covering the depth aspect (and stencil, if any)
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent = {0, 0};
   ImageState current;
   ImageState final;
 };
 
 // What CreateInfo::enable_readback copies each frame into host-visible buffers, tightly packed
-// rows, top-left origin:
+// rows, top-left origin of the view's viewport:
 enum class ReadbackImage : uint32_t {
-  kColor,        // the output, in its format's texels
-  kDepth,        // 32-bit float window depth, 0 near .. 1 far (sky: 1)
+  kColor,        // the host's colour with the water, in its format's texels
+  kDepth,        // the host's depth (the water writes none), its depth aspect's 4-byte texels
   kWaterMask,    // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
   kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h), flow_texture_layout()
   kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)
@@ -148,7 +176,13 @@ struct ReadbackTargets {
 };
 
 struct FrameInputs {
-  ExternalImage output;
+  // The host's colour image, with its world drawn: the water is blended over it (colour
+  // attachment usage; transfer source with readback).
+  ExternalImage color;
+  // The host's depth image of the same frame: the water is depth-tested against it and reads it
+  // for the depth of water behind each pixel (depth attachment and sampled usages; transfer
+  // source with readback). Not written.
+  ExternalImage depth;
   ReadbackTargets readback;
 };
 
@@ -170,23 +204,21 @@ class Renderer {
 
   // The host has waited until the GPU finished the commands last recorded for this slot.
   Status begin_frame(uint32_t slot);
-  // CPU only: camera and simulation time for the frame being prepared: advances the river's
-  // particles one frame (frame next_frame()) and packs the flow textures into the slot's staging
-  // block. The particles carry state from frame to frame: to start at frame N and get the same
-  // pixels as a run from frame 0, simulate() frames 0..N-1 first.
-  Status update(const Camera& camera, double time_seconds);
+  // CPU only: the host's view and simulation time for the frame being prepared: advances the
+  // river's particles one frame (frame next_frame()) and packs the flow textures into the slot's
+  // staging block. The particles carry state from frame to frame: to start at frame N and get
+  // the same pixels as a run from frame 0, simulate() frames 0..N-1 first.
+  Status update(const View& view, double time_seconds);
   // CPU only, outside begin_frame/record: advances the particles one frame without rendering,
   // so that a capture starting at frame N gets the same frame N as one starting at 0.
-  Status simulate(const Camera& camera, double time_seconds);
-  // Records the frame into `cmd` (in the recording state, outside any render pass).
+  Status simulate(const View& view, double time_seconds);
+  // Records the frame into `cmd` (in the recording state, outside any render pass), after the
+  // host's own drawing of colour and depth.
   Status record(VkCommandBuffer cmd, const FrameInputs& inputs);
 
-  // New output size. Call between frames (not between begin_frame and record); images that
+  // New view size. Call between frames (not between begin_frame and record); images that
   // frames in flight still use are freed once every slot has come round again.
   Status resize(VkExtent2D extent);
-
-  // The camera of the scene's own camera path at that time (the default scene glides downstream).
-  Camera scene_camera(double time_seconds) const;
 
   // With CreateInfo::enable_timing: the GPU time of each pass of the frame last recorded in
   // `slot`. Call only after the host waited for that slot's frame.

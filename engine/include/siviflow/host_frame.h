@@ -1,0 +1,34 @@
+// The frame every host of ours (the capture tool, bench, the tests) records, as an engine
+// would: the built-in world into the host's colour and depth, then the water over them through
+// the embedding API. One place, so that every frame we render takes the embedding path.
+#pragma once
+
+#include <cstdint>
+
+#include <vulkan/vulkan.h>
+
+#include "siviflow/headless_context.h"
+#include "siviflow/renderer.h"
+#include "siviflow/world.h"
+#include "sim/status.h"
+
+namespace siviflow {
+
+// One frame slot's colour and depth images, and the states the last frame left them in.
+struct HostTargets {
+  ExternalImage color;  // current: where the last frame left it; final: what the host wants
+  ExternalImage depth;
+};
+
+// Colour (colour attachment, sampled, copy source) and depth images for one slot; the colour
+// ends each frame in `color_final`, the depth read-only.
+Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFormat depth_format,
+                           VkExtent2D extent, ImageState color_final, HostTargets* out);
+
+// Records into `cmd`: the world seen through `view` at `time_seconds`, then the water
+// (renderer.update() for this frame already called). Updates the targets' current states.
+Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
+                              Renderer& renderer, const View& view, double time_seconds,
+                              const ReadbackTargets& readback, HostTargets* targets);
+
+}  // namespace siviflow

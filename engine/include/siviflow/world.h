@@ -1,0 +1,68 @@
+// The built-in world of SiViFlow's tools: sky, terrain, riverbed, a scene file's glTF objects
+// and a boulder at each obstacle. It is a host of the water renderer like any engine's world:
+// it draws into the host's colour and depth (cleared first) before the water is recorded, and
+// draws itself mirrored into the renderer's reflection through the reflection callback.
+//
+// Per frame, on the host's command buffer, with the host having waited for the slot:
+//   world->record(cmd, slot, view, time, color, depth);    // colour and depth of the world
+//   renderer->record(cmd, inputs);                          // the water over them
+// with CreateInfo::reflection = World::draw_reflection and reflection_user = the world.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include <vulkan/vulkan.h>
+
+#include "siviflow/renderer.h"
+#include "siviflow/scene_file.h"
+#include "sim/status.h"
+
+namespace siviflow {
+
+struct WorldCreateInfo {
+  VkInstance instance = VK_NULL_HANDLE;               // the host's, as for the renderer
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;  // required
+  PFN_vkGetDeviceProcAddr get_device_proc_addr = nullptr;      // optional
+  uint32_t frames_in_flight = 0;   // the host's slots; 0 means 2
+  VkFormat color_format = VK_FORMAT_UNDEFINED;  // host colour and reflection target; 0: RGBA16F
+  VkFormat depth_format = VK_FORMAT_UNDEFINED;  // host depth; 0: D32_SFLOAT
+  // The scene whose world to draw (its river's valley or bed, objects, obstacles, camera path);
+  // null: the built-in default scene. Read by create() only.
+  const SceneFile* scene = nullptr;
+  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;              // optional
+  const VkAllocationCallbacks* allocation_callbacks = nullptr;  // optional
+  bool debug_utils = false;  // the host enabled VK_EXT_debug_utils: label the pass
+};
+
+class World {
+ public:
+  static Status create(const WorldCreateInfo& info, std::unique_ptr<World>* out);
+  ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  // The camera of the scene's own path at that time (the default scene glides downstream; a
+  // glTF river without keys is seen from above its upstream end).
+  Camera scene_camera(double time_seconds) const;
+
+  // Records the world seen through `view` at `time_seconds` (obstacles where their keys put
+  // them) into `color` and `depth`, cleared first, and leaves them in their final states. The
+  // depth convention (standard or reverse-Z) is the projection's.
+  Status record(VkCommandBuffer cmd, uint32_t slot, const View& view, double time_seconds,
+                const ExternalImage& color, const ExternalImage& depth);
+
+  // A siviflow::ReflectionCallback (user: this World): draws the world as of the last record(),
+  // mirrored and clipped as `view` says.
+  static void draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, void* world);
+
+  struct Impl;
+
+ private:
+  explicit World(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace siviflow

@@ -1,0 +1,343 @@
+#include "siviflow/world.h"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "passes/passes.h"
+#include "scene/default_scene.h"
+#include "scene/detail_texture.h"
+#include "scene/river_simulation.h"
+#include "scene/scene_objects.h"
+#include "siviflow/scene_river.h"
+#include "static_assets.h"
+#include "view_math.h"
+#include "vk/device_table.h"
+#include "vk/frame_graph.h"
+#include "vk/frame_ring.h"
+#include "vk/gpu_resources.h"
+#include "vk/pipeline.h"
+
+namespace siviflow {
+namespace {
+
+constexpr uint32_t kDefaultFramesInFlight = 2;
+constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kDefaultDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;  // the renderer's
+constexpr VkFormat kDetailFormat = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr VkFormat kBaseColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
+
+Status world_error(const std::string& message) {
+  return Status::error("siviflow::World: " + message);
+}
+
+template <typename Items>
+std::vector<uint8_t> bytes_of(const Items& items) {
+  const auto* first = reinterpret_cast<const uint8_t*>(items.data());
+  return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
+}
+
+// The constants that draw a model placed at `offset` with the scene shaders, which work in the
+// model's coordinates: clip and fog see the same distances as for the translated model.
+gpu::SceneConstants translated(const gpu::SceneConstants& constants, glm::vec3 offset) {
+  gpu::SceneConstants moved = constants;
+  moved.view_proj = constants.view_proj * glm::translate(glm::mat4(1.0f), offset);
+  moved.camera_position = constants.camera_position - glm::vec4(offset, 0.0f);
+  moved.clip_plane.w += glm::dot(glm::vec3(constants.clip_plane), offset);
+  moved.fog.z += offset.y;  // height fog needs the world height, not the model's
+  return moved;
+}
+
+}  // namespace
+
+struct World::Impl {
+  WorldCreateInfo info;
+  DeviceTable table;
+  GpuContext gpu;
+  FrameRing ring;  // deletions only: the static upload's staging buffer
+  ProceduralRiver river{default_river_params()};  // the default scene's, or the scene file's
+  bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
+  RiverMesh river_mesh;          // a glTF river's, for its bed and overview camera
+  std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is at the frame's time
+  SceneCamera camera_path;          // keys empty: the scene's default camera
+  SceneLook look = default_scene_look();
+
+  enum StaticBufferId : uint32_t { kVertices, kIndices };
+  enum StaticImageId : uint32_t { kDetail, kFirstBaseColor };
+  StaticAssets assets;
+  ScenePass main_pass;        // host colour and depth formats
+  ScenePass reflection_pass;  // the renderer's reflection target, when its depth format differs
+  bool own_reflection_pass = false;
+
+  // What the passes draw: the static scene, each obstacle's boulder with its own constants
+  // (translated to where the obstacle is), the objects. Per view: main, then mirrored.
+  std::vector<SceneDraw> main_draws;
+  std::vector<SceneDraw> reflection_draws;
+  gpu::SceneConstants main_constants{};
+  gpu::SceneConstants reflection_constants{};
+  std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main, then mirrored
+  double time = 0.0;  // of the last record(), for the reflection
+  ScenePass::Frame frame;  // the main view's depth convention and viewport
+
+  FrameGraph graph;
+  ImageHandle color;
+  ImageHandle depth;
+  FrameBindings bindings;
+
+  Status load_scene();
+  Status create_resources();
+  Status declare_graph();
+  gpu::SceneConstants view_constants(const glm::mat4& view_proj, const glm::vec3& camera,
+                                     const glm::vec4& clip_plane, bool reverse) const;
+  void place_obstacles(size_t which, const gpu::SceneConstants& constants);
+  void destroy();
+};
+
+Status World::Impl::load_scene() {
+  if (info.scene == nullptr) {
+    obstacles = default_scene_obstacles(river);
+    return Status::success();
+  }
+  const SceneFile& scene = *info.scene;
+  const auto in_scene = [&scene](const Status& status) {
+    return status.ok() ? status : Status::error(scene.path + ": " + status.message(), status.code());
+  };
+  if (scene.river.source == SceneRiver::Source::kGltf) {
+    TriangleMesh gltf;
+    SIVIFLOW_TRY(in_scene(load_river_mesh(scene.river.gltf, scene.river.mesh, &gltf)));
+    RiverInput input;
+    SIVIFLOW_TRY(in_scene(gltf_river_input(std::move(gltf), &input)));
+    river_mesh = std::move(input.mesh);
+    river_from_file = true;
+  } else {
+    SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(scene.river.procedural)));
+    river = ProceduralRiver(scene.river.procedural);
+  }
+  obstacles = scene.obstacles;
+  camera_path = scene.camera;
+  return Status::success();
+}
+
+Status World::Impl::create_resources() {
+  SceneGeometry geometry = river_from_file ? build_riverbed_geometry(river_mesh, obstacles)
+                                           : build_scene_geometry(river, obstacles);
+  SceneObjects objects;
+  if (info.scene != nullptr) SIVIFLOW_TRY(load_scene_objects(*info.scene, &objects));
+  // Sized once: the draws point into it.
+  obstacle_constants.resize(2 * obstacles.size());
+  main_draws = {{0, geometry.static_index_count, &main_constants}};
+  reflection_draws = {{0, geometry.static_index_count, &reflection_constants}};
+  for (size_t i = 0; i < geometry.obstacle_boulders.size(); ++i) {
+    const SceneGeometry::Instance& boulder = geometry.obstacle_boulders[i];
+    main_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i]});
+    reflection_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i + 1]});
+  }
+  // The objects after the valley, in world space: drawn with the view's own constants.
+  const auto first_object_vertex = static_cast<uint32_t>(geometry.vertices.size());
+  const auto first_object_index = static_cast<uint32_t>(geometry.indices.size());
+  geometry.vertices.insert(geometry.vertices.end(), objects.vertices.begin(), objects.vertices.end());
+  for (uint32_t index : objects.indices) geometry.indices.push_back(first_object_vertex + index);
+  for (const SceneObjects::Draw& draw : objects.draws) {
+    main_draws.push_back({first_object_index + draw.first_index, draw.index_count, &main_constants,
+                          draw.texture + 1});
+    reflection_draws.push_back({first_object_index + draw.first_index, draw.index_count,
+                                &reflection_constants, draw.texture + 1});
+  }
+  assets.add_buffer({"world vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                     bytes_of(geometry.vertices)});
+  assets.add_buffer({"world indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                     bytes_of(geometry.indices)});
+  DetailTexture detail = make_detail_texture();
+  assets.add_image({"ground detail", kDetailFormat, {detail.size, detail.size},
+                    std::move(detail.texels), {0}});
+  for (BaseColorTexture& texture : objects.textures) {
+    assets.add_image({"base colour", kBaseColorFormat, {texture.width, texture.height},
+                      std::move(texture.texels), std::move(texture.mip_offsets)});
+  }
+  SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, 0));
+  SIVIFLOW_TRY(assets.create(gpu));
+  std::vector<VkImageView> base_colors;
+  for (uint32_t n = kFirstBaseColor; n < assets.image_count(); ++n) {
+    base_colors.push_back(assets.image(n).view);
+  }
+  SIVIFLOW_TRY(main_pass.create(gpu, info.pipeline_cache, info.color_format, info.depth_format));
+  SIVIFLOW_TRY(main_pass.set_textures(gpu, assets.image(kDetail).view, base_colors));
+  own_reflection_pass = info.depth_format != kReflectionDepthFormat;
+  if (!own_reflection_pass) return Status::success();
+  SIVIFLOW_TRY(reflection_pass.create(gpu, info.pipeline_cache, info.color_format,
+                                      kReflectionDepthFormat));
+  return reflection_pass.set_textures(gpu, assets.image(kDetail).view, base_colors);
+}
+
+Status World::Impl::declare_graph() {
+  assets.import_into(graph);
+  // The host's images: their states and clear depth come per frame.
+  color = graph.import_image({"host colour", info.color_format, {1, 1}, {}}, ResourceState{},
+                             state_of(Access::SampledFragment));
+  depth = graph.import_image({"host depth", info.depth_format, {1, 1}, {}}, ResourceState{},
+                             state_of(Access::DepthAttachmentRead));
+  ScenePass::Handles handles;
+  handles.color = color;
+  handles.depth = depth;
+  handles.vertices = assets.buffer_handle(kVertices);
+  handles.indices = assets.buffer_handle(kIndices);
+  handles.detail = assets.image_handle(kDetail);
+  for (uint32_t n = kFirstBaseColor; n < assets.image_count(); ++n) {
+    handles.base_colors.push_back(assets.image_handle(n));
+  }
+  main_pass.declare(graph, "world", &main_draws, &frame, &handles);
+  return graph.compile();
+}
+
+gpu::SceneConstants World::Impl::view_constants(const glm::mat4& view_proj,
+                                                 const glm::vec3& camera,
+                                                 const glm::vec4& clip_plane, bool reverse) const {
+  gpu::SceneConstants c{};
+  c.view_proj = view_proj;
+  c.camera_position = glm::vec4(camera, 1.0f);
+  c.sun_direction = glm::vec4(glm::normalize(look.sun_direction), look.sun_disc_intensity);
+  c.clip_plane = clip_plane;
+  c.fog = glm::vec4(look.fog_density, look.fog_height_falloff, 0.0f, far_depth(reverse));
+  return c;
+}
+
+// The boulders where their obstacles are at the frame's time; `which` 0 main view, 1 mirrored.
+void World::Impl::place_obstacles(size_t which, const gpu::SceneConstants& constants) {
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    obstacle_constants[2 * i + which] = translated(constants, obstacle_centre_at(obstacles[i], time));
+  }
+}
+
+void World::Impl::destroy() {
+  if (gpu.table == nullptr) return;
+  main_pass.destroy(gpu);
+  reflection_pass.destroy(gpu);
+  assets.destroy(gpu);
+  ring.destroy();
+}
+
+Status World::create(const WorldCreateInfo& info, std::unique_ptr<World>* out) {
+  auto impl = std::make_unique<Impl>();
+  Impl& w = *impl;
+  w.info = info;
+  if (info.instance == VK_NULL_HANDLE || info.physical_device == VK_NULL_HANDLE ||
+      info.device == VK_NULL_HANDLE || info.get_instance_proc_addr == nullptr) {
+    return world_error("WorldCreateInfo needs instance, physical_device, device and "
+                       "get_instance_proc_addr");
+  }
+  if (w.info.frames_in_flight == 0) w.info.frames_in_flight = kDefaultFramesInFlight;
+  if (w.info.color_format == VK_FORMAT_UNDEFINED) w.info.color_format = kDefaultColorFormat;
+  if (w.info.depth_format == VK_FORMAT_UNDEFINED) w.info.depth_format = kDefaultDepthFormat;
+  const char* missing = nullptr;
+  const VkResult loaded =
+      load_device_table(info.instance, info.physical_device, info.device,
+                        info.get_instance_proc_addr, info.get_device_proc_addr, info.debug_utils,
+                        &w.table, &missing);
+  if (loaded != VK_SUCCESS) {
+    return Status::error(std::string("siviflow::World: cannot load ") + missing, loaded);
+  }
+  w.gpu = make_gpu_context(w.table, info.allocation_callbacks);
+  Status status = w.load_scene();
+  if (status.ok()) status = w.create_resources();
+  if (status.ok()) status = w.declare_graph();
+  if (!status.ok()) {
+    w.destroy();
+    return status;
+  }
+  out->reset(new World(std::move(impl)));
+  return Status::success();
+}
+
+World::World(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+World::~World() { impl_->destroy(); }
+
+Camera World::scene_camera(double time_seconds) const {
+  const Impl& w = *impl_;
+  const SceneCamera& path = w.camera_path;
+  if (path.keys.empty()) {
+    Camera camera = w.river_from_file ? river_overview_camera(w.river_mesh.positions)
+                                      : default_camera(w.river, time_seconds);
+    if (w.info.scene != nullptr) camera.fov_y_deg = path.fov_y_deg;
+    return camera;
+  }
+  // Linear between keys, held before the first and after the last.
+  Camera camera;
+  camera.fov_y_deg = path.fov_y_deg;
+  const auto after = std::find_if(path.keys.begin(), path.keys.end(),
+                                  [&](const CameraKey& key) { return key.t > time_seconds; });
+  if (after == path.keys.begin() || after == path.keys.end()) {
+    const CameraKey& key = after == path.keys.begin() ? path.keys.front() : path.keys.back();
+    camera.position = key.position;
+    camera.target = key.target;
+    return camera;
+  }
+  const CameraKey& a = *(after - 1);
+  const float u = static_cast<float>((time_seconds - a.t) / (after->t - a.t));
+  camera.position = glm::mix(a.position, after->position, u);
+  camera.target = glm::mix(a.target, after->target, u);
+  return camera;
+}
+
+Status World::record(VkCommandBuffer cmd, uint32_t slot, const View& view, double time_seconds,
+                     const ExternalImage& color, const ExternalImage& depth) {
+  Impl& w = *impl_;
+  if (color.format != w.info.color_format || depth.format != w.info.depth_format) {
+    return world_error("colour or depth image format differs from WorldCreateInfo's");
+  }
+  ViewMath math;
+  SIVIFLOW_TRY(derive_view_math(view.view, view.projection, &math));
+  SIVIFLOW_TRY(w.ring.begin_slot(slot));
+  if (!w.assets.uploaded()) {
+    if (!w.assets.staged()) SIVIFLOW_TRY(w.assets.stage(w.gpu));
+    SIVIFLOW_TRY(w.assets.record_upload(w.table, cmd));
+  }
+  w.time = time_seconds;
+  w.frame.reverse_z = math.reverse_z;
+  // Nothing clipped in the main view.
+  w.main_constants = w.view_constants(math.view_proj, math.camera_position,
+                                      glm::vec4(0.0f, 0.0f, 0.0f, 1.0f), math.reverse_z);
+  w.place_obstacles(0, w.main_constants);
+
+  FrameBindings& b = w.bindings;
+  b.reset();
+  w.assets.bind(b);
+  const auto bind_host = [&b](ImageHandle handle, const ExternalImage& image) {
+    b.bind_image(handle, image.image, image.view);
+    b.set_incoming(handle, {image.current.stage, image.current.access, image.current.layout});
+    b.set_outgoing(handle, {image.final.stage, image.final.access, image.final.layout});
+  };
+  bind_host(w.color, color);
+  bind_host(w.depth, depth);
+  w.frame.viewport = view.viewport;
+  if (w.frame.viewport.extent.width == 0 && w.frame.viewport.extent.height == 0) {
+    w.frame.viewport.extent = color.extent;
+  }
+  b.set_render_area(w.color, w.frame.viewport);  // the view's part only: cleared, then drawn
+  VkClearValue far{};
+  far.depthStencil = {far_depth(math.reverse_z), 0};
+  b.set_clear(w.depth, far);
+  SIVIFLOW_TRY(w.graph.execute(w.table, cmd, b));
+  if (!w.assets.uploaded()) w.assets.finish_upload(w.ring, w.gpu);
+  return Status::success();
+}
+
+void World::draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, void* world) {
+  Impl& w = *static_cast<World*>(world)->impl_;
+  glm::mat4 view_proj;
+  glm::vec4 clip_plane;
+  glm::vec3 camera;
+  std::memcpy(&view_proj[0][0], view.view_proj, sizeof(view.view_proj));
+  std::memcpy(&clip_plane[0], view.clip_plane, sizeof(view.clip_plane));
+  std::memcpy(&camera[0], view.camera_position, sizeof(view.camera_position));
+  w.reflection_constants = w.view_constants(view_proj, camera, clip_plane, view.reverse_z);
+  w.place_obstacles(1, w.reflection_constants);
+  const ScenePass& pass = w.own_reflection_pass ? w.reflection_pass : w.main_pass;
+  pass.draw(w.table, cmd, w.assets.buffer(Impl::kVertices).buffer,
+            w.assets.buffer(Impl::kIndices).buffer, w.reflection_draws, view.reverse_z);
+}
+
+}  // namespace siviflow

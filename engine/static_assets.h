@@ -1,0 +1,84 @@
+// Geometry and textures that never change: created once, copied to the GPU by a small graph of
+// their own in the first frame, then only read by the frame graph, so later frames carry no
+// upload barriers for them. Shared by the water renderer and the built-in world.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "passes/passes.h"
+#include "sim/status.h"
+#include "vk/access.h"
+#include "vk/frame_graph.h"
+#include "vk/frame_ring.h"
+#include "vk/gpu_resources.h"
+
+namespace siviflow {
+
+class StaticAssets {
+ public:
+  struct BufferSpec {
+    const char* name = "";
+    Access read_as = Access::VertexBufferRead;  // how the frame graph reads it
+    VkBufferUsageFlags usage = 0;
+    std::vector<uint8_t> bytes;  // kept until staged
+  };
+  struct ImageSpec {
+    const char* name = "";
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    VkExtent2D extent{};
+    std::vector<uint8_t> texels;      // every mip level, kept until staged
+    std::vector<size_t> mip_offsets;  // into texels; one per level
+    Access read_as = Access::SampledFragment;
+  };
+  // Before create(): each returns the asset's index.
+  uint32_t add_buffer(BufferSpec spec);
+  uint32_t add_image(ImageSpec spec);
+  // Creates every buffer and image and declares their upload.
+  Status create(const GpuContext& gpu);
+  void destroy(const GpuContext& gpu);
+
+  // Copies every byte into one host-visible staging buffer, once, before the first upload.
+  Status stage(const GpuContext& gpu);
+  bool staged() const { return staging_.buffer != VK_NULL_HANDLE; }
+  bool uploaded() const { return uploaded_; }
+  // Records the copies into `cmd` (after stage()). Until finish_upload() the staging buffer is
+  // kept, so a frame whose recording failed can record the upload again.
+  Status record_upload(const DeviceTable& table, VkCommandBuffer cmd);
+  // The frame that recorded the upload was recorded whole: the staging buffer is freed once
+  // the ring's current slot comes round again.
+  void finish_upload(FrameRing& ring, const GpuContext& gpu);
+
+  // Imports every asset into `graph` in the state it is read in, both ways.
+  void import_into(FrameGraph& graph);
+  void bind(FrameBindings& bindings) const;
+  BufferHandle buffer_handle(uint32_t index) const { return buffers_[index].in_graph; }
+  ImageHandle image_handle(uint32_t index) const { return images_[index].in_graph; }
+  const Buffer& buffer(uint32_t index) const { return buffers_[index].buffer; }
+  const Image& image(uint32_t index) const { return images_[index].image; }
+  size_t image_count() const { return images_.size(); }
+
+ private:
+  struct StaticBuffer {
+    BufferSpec spec;
+    Buffer buffer;
+    BufferHandle in_graph;
+  };
+  struct StaticImage {
+    ImageSpec spec;
+    Image image;
+    ImageHandle in_graph;
+  };
+  std::vector<StaticBuffer> buffers_;
+  std::vector<StaticImage> images_;
+  FrameGraph upload_graph_;
+  BufferHandle staging_handle_;
+  UploadList uploads_;
+  Buffer staging_;
+  bool uploaded_ = false;
+};
+
+}  // namespace siviflow

@@ -1,0 +1,69 @@
+#include "view_math.h"
+
+#include <cmath>
+
+#include <glm/matrix.hpp>
+
+namespace siviflow {
+namespace {
+
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(m[c][r])) return false;
+    }
+  }
+  return true;
+}
+
+Status view_error(const std::string& message) {
+  return Status::error("siviflow::Renderer: " + message);
+}
+
+// Window depth of the view-space point at z (clip z / clip w; P[col][row]).
+float depth_at(const glm::mat4& p, float z) {
+  return (p[2][2] * z + p[3][2]) / (p[2][3] * z + p[3][3]);
+}
+
+}  // namespace
+
+Status derive_view_math(const glm::mat4& view, const glm::mat4& projection, ViewMath* out) {
+  if (!finite(view)) return view_error("View::view has a non-finite element");
+  if (!finite(projection)) return view_error("View::projection has a non-finite element");
+  const float view_det = glm::determinant(view);
+  if (!std::isfinite(view_det) || std::abs(view_det) < 1e-12f) {
+    return view_error("View::view is singular (determinant " + std::to_string(view_det) + ")");
+  }
+  const glm::mat4& p = projection;
+  // Clip w must be +-z and clip z depend on z (and w) alone: then every pixel's depths lie on
+  // one curve of z, which the water's distance behind the surface relies on.
+  if (p[0][3] != 0.0f || p[1][3] != 0.0f || p[3][3] != 0.0f || p[2][3] == 0.0f ||
+      p[0][2] != 0.0f || p[1][2] != 0.0f) {
+    return view_error(
+        "View::projection is not a perspective projection (its last row must be (0, 0, +-1, 0) "
+        "and its depth row (0, 0, a, b))");
+  }
+  if (p[0][0] == 0.0f || p[1][1] == 0.0f || p[3][2] == 0.0f) {
+    return view_error("View::projection is singular");
+  }
+  // Two points in front of the camera (clip w > 0): depth falling with distance is reverse-Z.
+  const float forward = p[2][3] < 0.0f ? -1.0f : 1.0f;
+  out->reverse_z = depth_at(p, 2.0f * forward) < depth_at(p, forward);
+  out->depth_ratio_constant = p[2][2] / p[2][3];
+  out->view_proj = projection * view;
+  out->camera_position = glm::vec3(glm::inverse(view)[3]);
+  return Status::success();
+}
+
+glm::mat4 mirrored_view_proj(const glm::mat4& view_proj, float height) {
+  glm::mat4 mirror(1.0f);
+  mirror[1][1] = -1.0f;
+  mirror[3][1] = 2.0f * height;
+  return view_proj * mirror;
+}
+
+glm::vec3 mirrored_point(const glm::vec3& point, float height) {
+  return {point.x, 2.0f * height - point.y, point.z};
+}
+
+}  // namespace siviflow

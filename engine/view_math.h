@@ -1,0 +1,38 @@
+// The maths of a host's view, pure and without a device: what the water needs to know of the
+// host's projection (its depth convention, how to turn two depths of one pixel into a distance)
+// and the mirrored view of the reflection.
+#pragma once
+
+#include <string>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "sim/status.h"
+
+namespace siviflow {
+
+struct ViewMath {
+  glm::mat4 view_proj{1.0f};
+  glm::vec3 camera_position{0.0f};
+  // Near maps to depth 1 and far to 0: depth tests use GREATER_OR_EQUAL, cleared depth is 0.
+  bool reverse_z = false;
+  // P[2][2] / P[2][3]: along one pixel's ray, view distances are in the ratio of
+  // (depth - depth_ratio_constant) between two depths (see derive_view_math).
+  float depth_ratio_constant = 0.0f;
+};
+
+// Checks that `projection` is a finite perspective projection (clip w = +-view z, depth a
+// function of view z alone) and `view` a finite invertible matrix, and derives the rest. Errors
+// name the matrix and what is wrong with it.
+Status derive_view_math(const glm::mat4& view, const glm::mat4& projection, ViewMath* out);
+
+// The far value of window depth under the convention.
+inline float far_depth(bool reverse_z) { return reverse_z ? 0.0f : 1.0f; }
+
+// The view mirrored about the horizontal plane y = height, and the camera mirrored with it.
+glm::mat4 mirrored_view_proj(const glm::mat4& view_proj, float height);
+glm::vec3 mirrored_point(const glm::vec3& point, float height);
+
+}  // namespace siviflow
