@@ -73,6 +73,19 @@ bool project(const glm::mat4& vp, const glm::vec2& size, const glm::vec3& w, glm
   return std::isfinite(s->x) && std::isfinite(s->y);
 }
 
+// Whether a projection maps the near plane to depth 1 (reverse-Z): the depth-0 point of the
+// centre pixel is at infinity, or farther from the eye than the depth-1 point. The eye is
+// where view_proj sends (0, 0, z, 0) back from: inverse * (0, 0, 1, 0).
+bool is_reverse_z(const glm::dmat4& inv_vp) {
+  const glm::dvec4 zero = inv_vp * glm::dvec4(0.0, 0.0, 0.0, 1.0);
+  const glm::dvec4 one = inv_vp * glm::dvec4(0.0, 0.0, 1.0, 1.0);
+  const glm::dvec4 eye = inv_vp * glm::dvec4(0.0, 0.0, 1.0, 0.0);
+  if (std::fabs(zero.w) <= 1e-12 * std::fabs(one.w)) return true;
+  if (std::fabs(one.w) <= 1e-12 * std::fabs(zero.w)) return false;
+  const glm::dvec3 e = glm::dvec3(eye) / eye.w;
+  return glm::length(glm::dvec3(zero) / zero.w - e) > glm::length(glm::dvec3(one) / one.w - e);
+}
+
 // Whether `a` is `b` up to float rounding: every entry within kStillCameraEpsilon of its column's
 // largest (a column scales one world coordinate, so rounding is relative to it, not to the entry).
 bool same_camera(const glm::mat4& a, const glm::mat4& b) {
@@ -291,6 +304,7 @@ Status check_inputs(const RiverFlowField& river, const ParticleParams& params, f
 struct ParticleField::Frame {
   glm::mat4 vp{1.0f};
   glm::dmat4 inv_vp{1.0};
+  bool reverse_z = false;  // window depth 1 is the near plane, 0 the far
   glm::vec2 size{0.0f};
   uint64_t index = 0;
   Rng rng{0};
@@ -566,8 +580,9 @@ bool ParticleField::try_create(Frame& f, const glm::vec2& screen, uint32_t* inde
   if (f.slots_exhausted || !f.fill.contains(screen)) return false;
   // The pixel's ray from the near plane to the far plane (or towards infinity).
   const double nx = 2.0 * screen.x / f.size.x - 1.0, ny = 2.0 * screen.y / f.size.y - 1.0;
-  const glm::dvec4 a = f.inv_vp * glm::dvec4(nx, ny, 0.0, 1.0);
-  const glm::dvec4 b = f.inv_vp * glm::dvec4(nx, ny, 1.0, 1.0);
+  const double near_depth = f.reverse_z ? 1.0 : 0.0;
+  const glm::dvec4 a = f.inv_vp * glm::dvec4(nx, ny, near_depth, 1.0);
+  const glm::dvec4 b = f.inv_vp * glm::dvec4(nx, ny, 1.0 - near_depth, 1.0);
   const glm::dvec3 origin = glm::dvec3(a) / a.w;
   glm::dvec3 dir;
   float t_max = 1.0f;
@@ -813,6 +828,7 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
     return Status::error("particles: view_proj is singular");
   }
   f.inv_vp = glm::inverse(vpd);
+  f.reverse_z = is_reverse_z(f.inv_vp);
   f.size = glm::vec2(params_.viewport);
   f.index = frame_index;
   f.rng = Rng(frame_seed(params_.seed, frame_index));

@@ -1,11 +1,14 @@
 // Embeds an installed SiViFlow as an engine would: the host owns the device (here the small
-// headless host), the command buffer and the target image; SiViFlow records one frame into it.
+// headless host), the command buffer and its colour and depth images; it draws its world into
+// them (here the built-in one), and SiViFlow records the water over them.
 // Exits 0 only when the frame rendered, read back non-black, with no validation error.
 #include <cstdio>
 #include <memory>
 
 #include <siviflow/headless_context.h>
+#include <siviflow/host_frame.h>
 #include <siviflow/renderer.h>
+#include <siviflow/world.h>
 
 int main() {
   using namespace siviflow;
@@ -16,27 +19,40 @@ int main() {
   Status status = HeadlessContext::create(options, &host);
   if (!status.ok()) return std::fprintf(stderr, "%s\n", status.message().c_str()), 1;
 
-  CreateInfo info = host->renderer_create_info({64, 36}, VK_FORMAT_R8G8B8A8_UNORM);
+  const VkExtent2D extent{64, 36};
+  const VkFormat color = VK_FORMAT_R8G8B8A8_UNORM;
+  const VkFormat depth = VK_FORMAT_D32_SFLOAT;
+  std::unique_ptr<World> world;
+  status = World::create(host->world_create_info(color, depth), &world);
+  if (!status.ok()) return std::fprintf(stderr, "%s\n", status.message().c_str()), 1;
+  CreateInfo info = host->renderer_create_info(extent, color);
+  info.depth_format = depth;
   info.enable_readback = true;
+  info.reflection = &World::draw_reflection;
+  info.reflection_user = world.get();
   std::unique_ptr<Renderer> renderer;
   status = Renderer::create(info, &renderer);
   if (!status.ok()) return std::fprintf(stderr, "%s\n", status.message().c_str()), 1;
 
-  HostImage target;
-  if (!host->create_target_image(VK_FORMAT_R8G8B8A8_UNORM, {64, 36}, &target).ok()) return 1;
+  HostTargets targets;
+  if (!create_host_targets(*host, color, depth, extent,
+                           {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_GENERAL},
+                           &targets).ok()) {
+    return 1;
+  }
   HostBuffer readback[kReadbackImageCount];
-  FrameInputs inputs;
+  ReadbackTargets buffers;
   for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
     if (!host->create_readback_buffer(renderer->readback_bytes(static_cast<ReadbackImage>(i)), &readback[i]).ok()) {
       return 1;
     }
-    inputs.readback.buffers[i] = readback[i].buffer;
+    buffers.buffers[i] = readback[i].buffer;
   }
   VkCommandBuffer cmd = VK_NULL_HANDLE;
-  inputs.output = {target.image, target.view, ImageState{},
-                   {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_GENERAL}};
+  const View view = camera_view(world->scene_camera(0.0), extent);
   if (!host->begin_slot(0, &cmd).ok() || !renderer->begin_frame(0).ok() ||
-      !renderer->update(renderer->scene_camera(0.0), 0.0).ok() || !renderer->record(cmd, inputs).ok() ||
+      !renderer->update(view, 0.0).ok() ||
+      !record_world_and_water(cmd, 0, *world, *renderer, view, 0.0, buffers, &targets).ok() ||
       !host->end_slot_and_submit(0).ok() || !host->wait_slot(0).ok()) {
     return std::fprintf(stderr, "frame failed\n"), 1;
   }
@@ -44,6 +60,7 @@ int main() {
   unsigned long sum = 0;
   for (int i = 0; i < 64 * 36 * 4; ++i) sum += texels[i];
   renderer.reset();
+  world.reset();
   const unsigned errors = host->validation_error_count();
   std::printf("mean texel %.1f, validation errors %u\n", sum / (64.0 * 36 * 4), errors);
   return sum > 0 && errors == 0 ? 0 : 1;

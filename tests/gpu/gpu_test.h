@@ -11,6 +11,7 @@
 
 #include "siviflow/headless_context.h"
 #include "siviflow/renderer.h"
+#include "siviflow/world.h"
 
 namespace siviflow::testing {
 
@@ -27,7 +28,8 @@ class GpuTest : public ::testing::Test {
   }
 
   void TearDown() override {
-    renderer_.reset();  // its destruction is validated too
+    renderer_.reset();  // their destruction is validated too
+    world_.reset();
     if (context_ == nullptr) return;
     std::string messages;
     for (const std::string& message : context_->validation_errors()) messages += message + "\n";
@@ -36,12 +38,30 @@ class GpuTest : public ::testing::Test {
 
   CreateInfo make_create_info(uint32_t width, uint32_t height) const {
     CreateInfo info = context_->renderer_create_info({width, height}, VK_FORMAT_R16G16B16A16_SFLOAT);
+    info.depth_format = VK_FORMAT_D32_SFLOAT;
     info.frames_in_flight = 2;
     info.enable_readback = true;
     return info;
   }
 
+  // The built-in world of info.scene as the host's world (reflected through the callback unless
+  // the info has a callback of its own), then the renderer.
+  Status create_renderer(CreateInfo info) {
+    renderer_.reset();
+    world_.reset();
+    WorldCreateInfo world_info = context_->world_create_info(info.color_format, info.depth_format);
+    world_info.frames_in_flight = info.frames_in_flight;
+    world_info.scene = info.scene;
+    SIVIFLOW_TRY(World::create(world_info, &world_));
+    if (info.reflection == nullptr) {
+      info.reflection = &World::draw_reflection;
+      info.reflection_user = world_.get();
+    }
+    return Renderer::create(info, &renderer_);
+  }
+
   std::unique_ptr<HeadlessContext> context_;
+  std::unique_ptr<World> world_;
   std::unique_ptr<Renderer> renderer_;
 };
 

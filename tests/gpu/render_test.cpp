@@ -11,6 +11,7 @@
 
 #include "gpu_test.h"
 #include "scene/default_scene.h"
+#include "siviflow/host_frame.h"
 #include "shaders/shared.h"
 #include "sim/flow_textures.h"
 #include "view_proj.h"
@@ -41,21 +42,34 @@ class RenderTest : public GpuTest {
   // set each; a slot is waited on only when it is reused) and returns them in order.
   std::vector<Frame> render(uint32_t first, uint32_t end, uint32_t width = kWidth,
                             uint32_t height = kHeight) {
+    return render_views(first, end, width, height, [this, width, height](double time) {
+      return camera_view(world_->scene_camera(time), {width, height});
+    });
+  }
+
+  // The same through the host's own view matrices at each time.
+  template <typename ViewAt>
+  std::vector<Frame> render_views(uint32_t first, uint32_t end, uint32_t width, uint32_t height,
+                                  ViewAt view_at) {
     std::vector<Frame> frames;
     if (renderer_ == nullptr) {
-      const Status status = Renderer::create(make_create_info(width, height), &renderer_);
+      const Status status = create_renderer(make_create_info(width, height));
       EXPECT_TRUE(status.ok()) << status.message();
       if (!status.ok()) return frames;
     }
     struct Slot {
-      HostImage target;
+      HostTargets targets;
       HostBuffer readback[kReadbackImageCount];
-      ImageState state;  // where the host's image was left last time (undefined at first)
       bool pending = false;
     };
     Slot slots[2];
     for (Slot& slot : slots) {
-      EXPECT_TRUE(context_->create_target_image(VK_FORMAT_R16G16B16A16_SFLOAT, {width, height}, &slot.target).ok());
+      EXPECT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT,
+                                      VK_FORMAT_D32_SFLOAT, {width, height},
+                                      {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                      &slot.targets).ok());
       for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
         EXPECT_TRUE(context_->create_readback_buffer(
             renderer_->readback_bytes(static_cast<ReadbackImage>(i)), &slot.readback[i]).ok());
@@ -93,15 +107,14 @@ class RenderTest : public GpuTest {
       if (slot.pending) collect(slot);
       EXPECT_TRUE(renderer_->begin_frame(index).ok());
       const double time = frame / 30.0;
-      EXPECT_TRUE(renderer_->update(renderer_->scene_camera(time), time).ok());
-      FrameInputs inputs;
-      inputs.output = {slot.target.image, slot.target.view, slot.state,
-                       {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                        VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
-      for (uint32_t i = 0; i < kReadbackImageCount; ++i) inputs.readback.buffers[i] = slot.readback[i].buffer;
-      const Status status = renderer_->record(cmd, inputs);
+      const View view = view_at(time);
+      Status status = renderer_->update(view, time);
       EXPECT_TRUE(status.ok()) << status.message();
-      slot.state = inputs.output.final;  // the host's image is now where it asked us to leave it
+      ReadbackTargets readback;
+      for (uint32_t i = 0; i < kReadbackImageCount; ++i) readback.buffers[i] = slot.readback[i].buffer;
+      status = record_world_and_water(cmd, index, *world_, *renderer_, view, time, readback,
+                                      &slot.targets);
+      EXPECT_TRUE(status.ok()) << status.message();
       EXPECT_TRUE(context_->end_slot_and_submit(index).ok());
       slot.pending = true;
     }
@@ -207,7 +220,7 @@ TEST_F(RenderTest, MovingObstacleReroutesTheParticlesFlow) {
   const glm::vec3 in_water = moving.keys.back().centre;  // where it ends, in the river
   RiverMesh mesh;
   ASSERT_TRUE(river.generate_mesh(&mesh).ok());
-  ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
+  ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
   // A camera above the spot, so that particles are dense there (a few per metre).
   Camera above;
   above.position = in_water + glm::vec3(0.0f, 6.0f, -4.0f);
@@ -216,7 +229,7 @@ TEST_F(RenderTest, MovingObstacleReroutesTheParticlesFlow) {
   const auto flow_at_destination = [&](uint32_t last, size_t* count) {
     while (renderer_->next_frame() <= last) {
       const double t = static_cast<double>(renderer_->next_frame()) / 30.0;
-      EXPECT_TRUE(renderer_->simulate(above, t).ok());
+      EXPECT_TRUE(renderer_->simulate(camera_view(above, {kWidth, kHeight}), t).ok());
     }
     double speed = 0.0;
     *count = 0;
@@ -255,12 +268,12 @@ TEST_F(RenderTest, HostCanReplaceWhatTheWaterReflects) {
   ASSERT_EQ(ours.size(), 1u);
   ASSERT_TRUE(context_->wait_idle().ok());
   renderer_.reset();
-  // A host that draws nothing into the reflection: the water reflects the cleared target only.
+  // A host that draws nothing into the reflection: the water reflects a plain sky colour.
   HostReflectionLog log;
   CreateInfo info = make_create_info(kWidth, kHeight);
   info.reflection = &record_nothing;
   info.reflection_user = &log;
-  ASSERT_TRUE(Renderer::create(info, &renderer_).ok());
+  ASSERT_TRUE(create_renderer(info).ok());
   const std::vector<Frame> host = render(0, 1);
   ASSERT_EQ(host.size(), 1u);
   EXPECT_EQ(log.calls, 1);
@@ -269,14 +282,20 @@ TEST_F(RenderTest, HostCanReplaceWhatTheWaterReflects) {
   EXPECT_FLOAT_EQ(log.last.clip_plane[1], 1.0f) << "keeps what is above the water";
   EXPECT_LT(log.last.camera_position[1], 0.0f) << "the mirrored camera is below the water";
   size_t water = 0;
+  size_t same = 0;
+  const float* plain = nullptr;  // the sky colour of the first water pixel, all others equal it
   for (size_t i = 0; i < host.front().water_mask.size(); ++i) {
     if (host.front().water_mask[i] != 1.0f) continue;
     ++water;
-    EXPECT_EQ(host.front().reflection[i * 4 + 2], 0.0f) << "pixel " << i;
-    EXPECT_GT(ours.front().reflection[i * 4 + 2], 0.05f) << "pixel " << i;
+    const float* reflected = &host.front().reflection[i * 4];
+    if (plain == nullptr) plain = reflected;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(reflected[c], plain[c]) << "pixel " << i;
+    EXPECT_GT(reflected[2], reflected[0]) << "a blue sky";
+    if (std::memcmp(&ours.front().reflection[i * 4], reflected, 3 * sizeof(float)) == 0) ++same;
     if (HasFailure()) break;
   }
   EXPECT_GT(water, 100u);
+  EXPECT_LT(same, water / 10) << "our world's reflection differs from the plain sky";
 }
 
 TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
@@ -337,7 +356,7 @@ TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
   const FlowTextureLayout& layout = renderer_->flow_texture_layout();
   std::vector<std::byte> staging(layout.total_bytes);
   std::memcpy(staging.data() + layout.flow_offset, frame.flow_texture.data(), layout.flow_bytes);
-  const glm::mat4 view_proj = view_proj_of(renderer_->scene_camera(1.0 / 30.0), kWidth, kHeight);
+  const glm::mat4 view_proj = view_proj_of(world_->scene_camera(1.0 / 30.0), kWidth, kHeight);
   const float water_level = renderer_->particle_field().particles().front().world.y;  // level river
   const glm::vec2 texels = glm::vec2(kWidth, kHeight) / float(layout.texel_px);
   const glm::ivec2 size(table.width, table.height);
@@ -398,13 +417,13 @@ TEST_F(RenderTest, TileTableWindowHoldsEveryTileInViewOfALongRiver) {
   ASSERT_TRUE(parsed.ok()) << parsed.message();
   CreateInfo info = make_create_info(kWidth, kHeight);
   info.scene = &scene;
-  ASSERT_TRUE(Renderer::create(info, &renderer_).ok());
+  ASSERT_TRUE(create_renderer(info).ok());
   const std::vector<Frame> frames = render(0, 1);
   ASSERT_EQ(frames.size(), 1u);
   const Frame& frame = frames[0];
   const TileTableLayout& table = renderer_->tile_table_layout();
   ASSERT_EQ(table.height, SIVIFLOW_TILE_TABLE_MAX);  // the river (along z) does not fit: a window
-  const glm::mat4 to_world = glm::inverse(view_proj_of(renderer_->scene_camera(0.0), kWidth, kHeight));
+  const glm::mat4 to_world = glm::inverse(view_proj_of(world_->scene_camera(0.0), kWidth, kHeight));
   const glm::ivec2 lo(table.corner_x, table.corner_z);
   const glm::ivec2 hi = lo + glm::ivec2(table.width, table.height) - 1;
   size_t water = 0;
@@ -432,13 +451,82 @@ TEST_F(RenderTest, TileTableWindowHoldsEveryTileInViewOfALongRiver) {
   EXPECT_EQ(outside, 0u) << "of " << water << " water pixels";
 }
 
+// The host's own projections: reverse-Z with an infinite far plane renders the water of a
+// standard projection, and a jittered projection moves it by the jitter.
+TEST_F(RenderTest, ReverseZInfiniteAndJitteredProjectionsRenderTheSameWater) {
+  const auto standard_at = [this](double time) {
+    return camera_view(world_->scene_camera(time), {kWidth, kHeight});
+  };
+  const std::vector<Frame> standard = render_views(0, 2, kWidth, kHeight, standard_at);
+  ASSERT_EQ(standard.size(), 2u);
+  renderer_.reset();
+  // Reverse-Z, infinite far plane: depth = near / distance.
+  const auto reverse_at = [&](double time) {
+    View view = standard_at(time);
+    const Camera camera = world_->scene_camera(time);
+    const float f = 1.0f / std::tan(0.5f * glm::radians(camera.fov_y_deg));
+    view.projection = glm::mat4(0.0f);
+    view.projection[0][0] = f * kHeight / kWidth;
+    view.projection[1][1] = -f;
+    view.projection[2][3] = -1.0f;
+    view.projection[3][2] = camera.near_plane;
+    return view;
+  };
+  const std::vector<Frame> reverse = render_views(0, 2, kWidth, kHeight, reverse_at);
+  ASSERT_EQ(reverse.size(), 2u);
+  size_t water = 0;
+  size_t mask_differs = 0;
+  size_t colour_differs = 0;  // beyond the golden frames' tolerance
+  for (size_t i = 0; i < standard[1].water_mask.size(); ++i) {
+    if (standard[1].water_mask[i] != reverse[1].water_mask[i]) ++mask_differs;
+    water += standard[1].water_mask[i] == 1.0f ? 1 : 0;
+    for (int c = 0; c < 3; ++c) {
+      const float golden = standard[1].rgba[i * 4 + c];
+      if (std::abs(golden - reverse[1].rgba[i * 4 + c]) > 0.02f + 0.02f * std::abs(golden)) {
+        ++colour_differs;
+        break;
+      }
+    }
+  }
+  const size_t pixels = standard[1].water_mask.size();
+  ASSERT_GT(water, 5000u);
+  EXPECT_LT(mask_differs, water / 100) << "the same water pixels";
+  EXPECT_LE(colour_differs, pixels / 200) << "the same colours, of " << pixels << " pixels";
+  EXPECT_EQ(standard[1].flow_texture, reverse[1].flow_texture) << "the same particles";
+  EXPECT_EQ(reverse[1].depth[4 * kWidth + kWidth / 2], 0.0f) << "the sky at reverse-Z's far";
+
+  renderer_.reset();
+  // Jitter of one pixel to the right: the clip-space offset 2 / width in x.
+  const auto jittered_at = [&](double time) {
+    View view = standard_at(time);
+    view.projection[2][0] -= 2.0f / kWidth;  // clip x gains -z * (2 / width): +1 pixel
+    return view;
+  };
+  const std::vector<Frame> jittered = render_views(0, 2, kWidth, kHeight, jittered_at);
+  ASSERT_EQ(jittered.size(), 2u);
+  size_t shifted_same = 0;
+  size_t unshifted_same = 0;
+  size_t counted = 0;
+  for (uint32_t y = 0; y < kHeight; ++y) {
+    for (uint32_t x = 1; x < kWidth; ++x) {
+      const size_t i = size_t{y} * kWidth + x;
+      ++counted;
+      if (jittered[1].water_mask[i] == standard[1].water_mask[i - 1]) ++shifted_same;
+      if (jittered[1].water_mask[i] == standard[1].water_mask[i]) ++unshifted_same;
+    }
+  }
+  EXPECT_GT(shifted_same, counted - counted / 500) << "the water moved one pixel right";
+  EXPECT_LT(unshifted_same, shifted_same);
+}
+
 TEST_F(RenderTest, FramesAreDeterministicWhateverTheFirstFrame) {
   const std::vector<Frame> run = render(0, 4);
   ASSERT_TRUE(context_->wait_idle().ok());
-  renderer_.reset();  // a fresh renderer starting at frame 3, as a shard of a capture would:
-  ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
+  // A fresh renderer starting at frame 3, as a shard of a capture would:
+  ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
   for (uint32_t frame = 0; frame < 3; ++frame) {  // it replays the simulation without rendering
-    ASSERT_TRUE(renderer_->simulate(renderer_->scene_camera(frame / 30.0), frame / 30.0).ok());
+    const View view = camera_view(world_->scene_camera(frame / 30.0), {kWidth, kHeight});
+    ASSERT_TRUE(renderer_->simulate(view, frame / 30.0).ok());
   }
   const std::vector<Frame> shard = render(3, 4);
   ASSERT_EQ(run.size(), 4u);
@@ -463,20 +551,22 @@ TEST_F(RenderTest, ResizeBetweenFramesKeepsFramesInFlightValid) {
   EXPECT_FALSE(renderer_->resize({0, 90}).ok());
 }
 
-TEST_F(RenderTest, FrameGraphRunsSceneThenReadback) {
-  ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
+TEST_F(RenderTest, FrameGraphRunsWaterPassesOnly) {
+  ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
   const std::string dump = renderer_->dump_frame_graph();
   // Static data is uploaded by a one-off graph: the frame graph's upload pass carries only the
-  // flow texture and the particles' aux data, every frame. Then the mirrored scene, the scene,
-  // the water over it, and the copies for the host.
+  // flow texture and the particles' aux data, every frame. Then the mirrored world (the host's
+  // callback), the tile table, the water over the host's colour, and the copies for the host;
+  // no world of our own.
+  EXPECT_EQ(dump.find("pass scene"), std::string::npos) << dump;
   size_t previous = 0;
-  for (const char* pass : {"pass upload", "pass reflection", "pass scene", "pass flow", "pass readback"}) {
+  for (const char* pass : {"pass upload", "pass reflection", "pass flow tiles", "pass flow", "pass readback"}) {
     const size_t at = dump.find(pass);
     ASSERT_NE(at, std::string::npos) << pass << "\n" << dump;
     EXPECT_GE(at, previous) << pass << " out of order\n" << dump;
     previous = at;
   }
-  EXPECT_EQ(dump.find("scene vertices"), std::string::npos) << "static data is not uploaded per frame\n" << dump;
+  EXPECT_EQ(dump.find("river vertices"), std::string::npos) << "static data is not uploaded per frame\n" << dump;
   EXPECT_NE(renderer_->dump_frame_graph_graphviz().find("digraph"), std::string::npos);
 }
 
@@ -517,27 +607,70 @@ TEST_F(RenderTest, BadCreateInfoIsReportedNotCrashed) {
   EXPECT_EQ(renderer_, nullptr);
 }
 
-TEST_F(RenderTest, UndefinedFinalLayoutIsRefused) {
-  ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
-  HostImage target;
-  ASSERT_TRUE(context_->create_target_image(VK_FORMAT_R16G16B16A16_SFLOAT, {kWidth, kHeight}, &target).ok());
+// Each bad host image or view is refused by record() or update() with a message naming the
+// field, before any command is recorded: the command buffer stays empty.
+TEST_F(RenderTest, BadHostImagesAndViewsAreRefusedByName) {
+  ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
+  HostTargets targets;
+  ASSERT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
+                                  {kWidth, kHeight}, {0, 0, VK_IMAGE_LAYOUT_GENERAL}, &targets).ok());
+  const View good = camera_view(world_->scene_camera(0.0), {kWidth, kHeight});
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   ASSERT_TRUE(context_->begin_slot(0, &cmd).ok());
   ASSERT_TRUE(renderer_->begin_frame(0).ok());
-  ASSERT_TRUE(renderer_->update(renderer_->scene_camera(0.0), 0.0).ok());
+
+  View bad = good;
+  bad.view[0][0] = std::nanf("");
+  Status status = renderer_->update(bad, 0.0);
+  EXPECT_NE(status.message().find("View::view has a non-finite"), std::string::npos) << status.message();
+  bad = good;
+  bad.view = glm::mat4(0.0f);
+  status = renderer_->update(bad, 0.0);
+  EXPECT_NE(status.message().find("View::view is singular"), std::string::npos) << status.message();
+  bad = good;
+  bad.projection = glm::orthoRH_ZO(-10.0f, 10.0f, -10.0f, 10.0f, 0.1f, 100.0f);
+  status = renderer_->update(bad, 0.0);
+  EXPECT_NE(status.message().find("View::projection is not a perspective"), std::string::npos) << status.message();
+  bad = good;
+  bad.viewport.extent = {kWidth / 2, kHeight};
+  status = renderer_->update(bad, 0.0);
+  EXPECT_NE(status.message().find("View::viewport extent 160x180"), std::string::npos) << status.message();
+  EXPECT_EQ(renderer_->next_frame(), 0u) << "a refused view advances nothing";
+  ASSERT_TRUE(renderer_->update(good, 0.0).ok());
+
+  const auto refused = [&](FrameInputs inputs, const char* expected) {
+    for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
+      HostBuffer buffer;
+      ASSERT_TRUE(context_->create_readback_buffer(renderer_->readback_bytes(static_cast<ReadbackImage>(i)), &buffer).ok());
+      inputs.readback.buffers[i] = buffer.buffer;
+    }
+    const Status s = renderer_->record(cmd, inputs);
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message().find(expected), std::string::npos) << s.message();
+    EXPECT_EQ(s.code(), Status::kGenericError) << "an argument error, not a Vulkan result";
+  };
   FrameInputs inputs;
-  inputs.output.image = target.image;
-  inputs.output.view = target.view;  // final left zero-initialised: layout UNDEFINED
-  const Status status = renderer_->record(cmd, inputs);
-  EXPECT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("final.layout"), std::string::npos) << status.message();
+  inputs.color = targets.color;
+  inputs.depth = targets.depth;
+  inputs.color.final = {};  // layout UNDEFINED
+  refused(inputs, "FrameInputs::color.final.layout");
+  inputs.color = targets.color;
+  inputs.depth.format = VK_FORMAT_D24_UNORM_S8_UINT;
+  refused(inputs, "FrameInputs::depth.format 129");
+  inputs.depth = targets.depth;
+  inputs.color.extent = {kWidth - 1, kHeight};
+  refused(inputs, "FrameInputs::color.extent 319x180 does not contain");
+  inputs.color = targets.color;
+  inputs.depth.view = VK_NULL_HANDLE;
+  refused(inputs, "FrameInputs::depth needs an image and a view");
   ASSERT_TRUE(context_->end_slot_and_submit(0).ok());  // an empty command buffer is fine
   ASSERT_TRUE(context_->wait_slot(0).ok());
 }
 
 TEST_F(RenderTest, RecordOutOfOrderIsAnError) {
-  ASSERT_TRUE(Renderer::create(make_create_info(kWidth, kHeight), &renderer_).ok());
-  EXPECT_FALSE(renderer_->update(renderer_->scene_camera(0.0), 0.0).ok());  // before begin_frame
+  ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
+  const View view = camera_view(world_->scene_camera(0.0), {kWidth, kHeight});
+  EXPECT_FALSE(renderer_->update(view, 0.0).ok());  // before begin_frame
   EXPECT_FALSE(renderer_->begin_frame(5).ok());                              // slot out of range
 }
 

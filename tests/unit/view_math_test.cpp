@@ -1,0 +1,99 @@
+// The maths of a host's view: depth convention and distances along a pixel's ray derived from
+// the projection, whatever its form; matrices that are not a finite perspective are refused.
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "view_math.h"
+
+namespace siviflow {
+namespace {
+
+const glm::mat4 kView = glm::lookAtRH(glm::vec3(1.0f, 5.0f, -20.0f), glm::vec3(0.0f),
+                                      glm::vec3(0.0f, 1.0f, 0.0f));
+
+glm::mat4 standard(float near_plane, float far_plane) {
+  glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(50.0f), 16.0f / 9.0f, near_plane, far_plane);
+  p[1][1] *= -1.0f;
+  return p;
+}
+
+glm::mat4 reverse_infinite(float near_plane) {
+  glm::mat4 p(0.0f);
+  p[0][0] = 1.2f;
+  p[1][1] = -2.1f;
+  p[2][3] = -1.0f;
+  p[3][2] = near_plane;
+  return p;
+}
+
+// Window depth of a point `distance` in front of the eye along the view axis.
+float depth_of(const glm::mat4& projection, float distance) {
+  const glm::vec4 clip = projection * glm::vec4(0.0f, 0.0f, -distance, 1.0f);
+  return clip.z / clip.w;
+}
+
+// The ratio of the distances of two depths of one pixel, as the flow material computes it.
+float distance_ratio(const ViewMath& math, float far_depth_value, float near_depth_value) {
+  const float k = math.depth_ratio_constant;
+  return (near_depth_value - k) / (far_depth_value - k);
+}
+
+TEST(ViewMath, StandardProjectionIsNotReverseAndRecoversDistances) {
+  ViewMath math;
+  ASSERT_TRUE(derive_view_math(kView, standard(0.1f, 1000.0f), &math).ok());
+  EXPECT_FALSE(math.reverse_z);
+  const glm::mat4 p = standard(0.1f, 1000.0f);
+  EXPECT_NEAR(distance_ratio(math, depth_of(p, 30.0f), depth_of(p, 10.0f)), 3.0f, 1e-3f);
+  EXPECT_NEAR(glm::distance(math.camera_position, glm::vec3(1.0f, 5.0f, -20.0f)), 0.0f, 1e-4f);
+}
+
+TEST(ViewMath, ReverseInfiniteProjectionIsReverseAndRecoversDistances) {
+  ViewMath math;
+  const glm::mat4 p = reverse_infinite(0.1f);
+  ASSERT_TRUE(derive_view_math(kView, p, &math).ok());
+  EXPECT_TRUE(math.reverse_z);
+  EXPECT_FLOAT_EQ(far_depth(true), 0.0f);
+  EXPECT_NEAR(distance_ratio(math, depth_of(p, 30.0f), depth_of(p, 10.0f)), 3.0f, 1e-4f);
+}
+
+TEST(ViewMath, JitteredAndOffCentreProjectionsKeepTheirConvention) {
+  glm::mat4 p = standard(0.5f, 200.0f);
+  p[2][0] += 0.003f;  // jitter
+  p[2][1] -= 0.2f;    // off-centre
+  ViewMath math;
+  ASSERT_TRUE(derive_view_math(kView, p, &math).ok());
+  EXPECT_FALSE(math.reverse_z);
+  EXPECT_NEAR(distance_ratio(math, depth_of(p, 40.0f), depth_of(p, 8.0f)), 5.0f, 1e-3f);
+}
+
+TEST(ViewMath, MirrorReflectsAboutTheWaterPlane) {
+  const glm::vec3 mirrored = mirrored_point(glm::vec3(1.0f, 5.0f, 2.0f), 1.5f);
+  EXPECT_EQ(mirrored, glm::vec3(1.0f, -2.0f, 2.0f));
+  const glm::mat4 vp = standard(0.1f, 100.0f) * kView;
+  const glm::vec4 above(3.0f, 4.0f, 0.0f, 1.0f);
+  const glm::vec4 below(3.0f, 2.0f * 1.5f - 4.0f, 0.0f, 1.0f);
+  const glm::vec4 a = mirrored_view_proj(vp, 1.5f) * above;
+  const glm::vec4 b = vp * below;
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(a[i], b[i], 1e-4f);
+}
+
+TEST(ViewMath, RefusesWhatIsNotAFinitePerspective) {
+  ViewMath math;
+  Status status = derive_view_math(kView, glm::orthoRH_ZO(-1.0f, 1.0f, -1.0f, 1.0f, 0.1f, 10.0f), &math);
+  EXPECT_NE(status.message().find("View::projection is not a perspective"), std::string::npos) << status.message();
+  glm::mat4 nan_view = kView;
+  nan_view[3][0] = std::nanf("");
+  status = derive_view_math(nan_view, standard(0.1f, 10.0f), &math);
+  EXPECT_NE(status.message().find("View::view has a non-finite"), std::string::npos) << status.message();
+  status = derive_view_math(glm::mat4(0.0f), standard(0.1f, 10.0f), &math);
+  EXPECT_NE(status.message().find("View::view is singular"), std::string::npos) << status.message();
+  glm::mat4 flat = standard(0.1f, 10.0f);
+  flat[0][0] = 0.0f;
+  status = derive_view_math(kView, flat, &math);
+  EXPECT_NE(status.message().find("View::projection is singular"), std::string::npos) << status.message();
+}
+
+}  // namespace
+}  // namespace siviflow
