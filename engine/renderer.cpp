@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -277,23 +278,13 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
 }
 
 Status Renderer::Impl::take_scene() {
+  std::optional<ProceduralRiver> procedural;
+  SIVIFLOW_TRY(scene_river_input(info.scene, &river_input, &procedural));
   if (info.scene == nullptr) {
-    const ProceduralRiver river(default_river_params());
-    obstacles = default_scene_obstacles(river);
-    return procedural_river_input(river, &river_input);
+    obstacles = default_scene_obstacles(*procedural);
+    return Status::success();
   }
   const SceneFile& scene = *info.scene;
-  const auto in_scene = [&scene](const Status& status) {
-    return status.ok() ? status : Status::error(scene.path + ": " + status.message(), status.code());
-  };
-  if (scene.river.source == SceneRiver::Source::kGltf) {
-    TriangleMesh gltf;
-    SIVIFLOW_TRY(in_scene(load_river_mesh(scene.river.gltf, scene.river.mesh, &gltf)));
-    SIVIFLOW_TRY(in_scene(gltf_river_input(std::move(gltf), &river_input)));
-  } else {
-    SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(scene.river.procedural)));
-    SIVIFLOW_TRY(in_scene(procedural_river_input(ProceduralRiver(scene.river.procedural), &river_input)));
-  }
   flow_params = scene.flow;
   obstacles = scene.obstacles;
   std::vector<Obstacle> object_obstacles;

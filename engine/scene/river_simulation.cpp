@@ -4,6 +4,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "scene/default_scene.h"
+#include "siviflow/scene_river.h"
 #include "sim/river_surface.h"
 
 namespace siviflow {
@@ -45,6 +47,26 @@ Status gltf_river_input(TriangleMesh gltf, RiverInput* out) {
   }
   *out = std::move(input);
   return Status::success();
+}
+
+Status scene_river_input(const SceneFile* scene, RiverInput* out,
+                         std::optional<ProceduralRiver>* procedural) {
+  if (scene == nullptr) {
+    procedural->emplace(default_river_params());
+    return procedural_river_input(**procedural, out);
+  }
+  const auto in_scene = [scene](const Status& status) {
+    return status.ok() ? status : Status::error(scene->path + ": " + status.message(), status.code());
+  };
+  if (scene->river.source == SceneRiver::Source::kGltf) {
+    TriangleMesh gltf;
+    SIVIFLOW_TRY(in_scene(load_river_mesh(scene->river.gltf, scene->river.mesh, &gltf)));
+    procedural->reset();
+    return in_scene(gltf_river_input(std::move(gltf), out));
+  }
+  SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(scene->river.procedural)));
+  procedural->emplace(scene->river.procedural);
+  return in_scene(procedural_river_input(**procedural, out));
 }
 
 Status RiverSimulation::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,

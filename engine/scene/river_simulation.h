@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include <glm/vec3.hpp>
 
 #include "scene/gltf_import.h"
+#include "siviflow/scene_file.h"
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "sim/procedural_river.h"
@@ -38,6 +40,10 @@ struct RiverInput {
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
 // A glTF river with the depth profile above, and the slope of that riverbed across.
 Status gltf_river_input(TriangleMesh gltf, RiverInput* out);
+// The river of a scene file (null: the default scene's), and the procedural river it was made
+// from, if it was. Errors name the scene file.
+Status scene_river_input(const SceneFile* scene, RiverInput* out,
+                         std::optional<ProceduralRiver>* procedural);
 
 class RiverSimulation {
  public:

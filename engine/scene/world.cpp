@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -61,7 +62,7 @@ struct World::Impl {
   FrameRing ring;  // deletions only: the static upload's staging buffer
   ProceduralRiver river{default_river_params()};  // the default scene's, or the scene file's
   bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
-  RiverMesh river_mesh;          // a glTF river's, for its bed and overview camera
+  RiverMesh river_mesh;          // for a glTF river's bed and overview camera
   std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is at the frame's time
   SceneCamera camera_path;          // keys empty: the scene's default camera
   SceneLook look = default_scene_look();
@@ -98,27 +99,14 @@ struct World::Impl {
 };
 
 Status World::Impl::load_scene() {
-  if (info.scene == nullptr) {
-    obstacles = default_scene_obstacles(river);
-    return Status::success();
-  }
-  const SceneFile& scene = *info.scene;
-  const auto in_scene = [&scene](const Status& status) {
-    return status.ok() ? status : Status::error(scene.path + ": " + status.message(), status.code());
-  };
-  if (scene.river.source == SceneRiver::Source::kGltf) {
-    TriangleMesh gltf;
-    SIVIFLOW_TRY(in_scene(load_river_mesh(scene.river.gltf, scene.river.mesh, &gltf)));
-    RiverInput input;
-    SIVIFLOW_TRY(in_scene(gltf_river_input(std::move(gltf), &input)));
-    river_mesh = std::move(input.mesh);
-    river_from_file = true;
-  } else {
-    SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(scene.river.procedural)));
-    river = ProceduralRiver(scene.river.procedural);
-  }
-  obstacles = scene.obstacles;
-  camera_path = scene.camera;
+  RiverInput input;
+  std::optional<ProceduralRiver> procedural;
+  SIVIFLOW_TRY(scene_river_input(info.scene, &input, &procedural));
+  river_from_file = !procedural.has_value();
+  if (procedural) river = *procedural;
+  river_mesh = std::move(input.mesh);
+  obstacles = info.scene != nullptr ? info.scene->obstacles : default_scene_obstacles(river);
+  if (info.scene != nullptr) camera_path = info.scene->camera;
   return Status::success();
 }
 
