@@ -380,7 +380,53 @@ Status StreamFunction::move_obstacle(size_t index, const glm::vec3& centre) {
     return Status::error(text_format("obstacle %zu: the new centre is not finite", index));
   }
   stats_ = {};
-  move_incremental(index, centre);
+  move_incremental(index, place(index, centre));
+  return Status::success();
+}
+
+Status StreamFunction::add_obstacle(Obstacle obstacle, double time) {
+  if (obstacles_.size() >= kMaxObstacles) {
+    return Status::error(text_format("%zu obstacles already, the limit", obstacles_.size()));
+  }
+  if (!std::isfinite(time)) return Status::error(text_format("flow time %g is not finite", time));
+  SIVIFLOW_TRY(validate_obstacle(obstacle, obstacles_.size()));
+  build_grids();
+  stats_ = {};
+  const glm::vec3 centre = obstacle_centre_at(obstacle, time);
+  obstacles_.push_back(std::move(obstacle));
+  state_.push_back(ObstacleState{});  // not in the water yet: nothing to undo
+  const size_t index = obstacles_.size() - 1;
+  move_incremental(index, place(index, centre));
+  return Status::success();
+}
+
+Status StreamFunction::replace_obstacle(size_t index, Obstacle obstacle, double time) {
+  if (index >= obstacles_.size()) {
+    return Status::error(text_format("no obstacle %zu to replace (there are %zu)", index,
+                                     obstacles_.size()));
+  }
+  if (!std::isfinite(time)) return Status::error(text_format("flow time %g is not finite", time));
+  SIVIFLOW_TRY(validate_obstacle(obstacle, index));
+  stats_ = {};
+  // Out of the water with the old footprint, then in with the new: each step reaches exactly the
+  // vertices its own footprint influences.
+  move_incremental(index, ObstacleState{});
+  const glm::vec3 centre = obstacle_centre_at(obstacle, time);
+  obstacles_[index] = std::move(obstacle);
+  move_incremental(index, place(index, centre));
+  return Status::success();
+}
+
+Status StreamFunction::remove_obstacle(size_t index) {
+  if (index >= obstacles_.size()) {
+    return Status::error(text_format("no obstacle %zu to remove (there are %zu)", index,
+                                     obstacles_.size()));
+  }
+  stats_ = {};
+  move_incremental(index, ObstacleState{});
+  obstacles_.erase(obstacles_.begin() + static_cast<std::ptrdiff_t>(index));
+  state_.erase(state_.begin() + static_cast<std::ptrdiff_t>(index));
+  refresh_active();  // later indices moved down; their order, and so every sum, is unchanged
   return Status::success();
 }
 
@@ -390,12 +436,12 @@ Status StreamFunction::set_time(double t) {
   for (size_t j = 0; j < obstacles_.size(); ++j) {
     if (obstacles_[j].keys.empty()) continue;
     const glm::vec3 c = obstacle_centre_at(obstacles_[j], t);
-    if (c != state_[j].centre) move_incremental(j, c);
+    if (c != state_[j].centre) move_incremental(j, place(j, c));
   }
   return Status::success();
 }
 
-void StreamFunction::move_incremental(size_t j, const glm::vec3& centre) {
+void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) {
   const double s = params_.search_radius;
   // Fresh generation stamps (on wrap-around, clear them).
   auto next_stamp = [&] {
@@ -412,7 +458,6 @@ void StreamFunction::move_incremental(size_t j, const glm::vec3& centre) {
   uint32_t gen = next_stamp();
   scratch_nodes_.clear();
   const ObstacleState old_state = state_[j];
-  const ObstacleState new_state = place(j, centre);
   const bool old_wet = old_state.in_water, new_wet = new_state.in_water;
   if (old_wet || new_wet) {
     glm::dvec2 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());

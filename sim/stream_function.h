@@ -60,6 +60,14 @@ class StreamFunction {
   // new footprint (and the triangles and vertex velocities around them). The result equals a
   // full re-solve, bit for bit. The obstacle keeps its keys: the next set_time() uses them.
   Status move_obstacle(size_t index, const glm::vec3& centre);
+  // Appends an obstacle (keyframed ones placed at `time`) and re-solves only the vertices within
+  // s of its footprint; it takes index obstacles().size() - 1. The result equals a full re-solve.
+  Status add_obstacle(Obstacle obstacle, double time = 0.0);
+  // Gives obstacle `index` a new footprint and centre (a turned polygon, a new radius), re-solving
+  // around the old and the new footprint. On failure nothing changes.
+  Status replace_obstacle(size_t index, Obstacle obstacle, double time = 0.0);
+  // Removes obstacle `index` (later ones move down one) and re-solves around where it was.
+  Status remove_obstacle(size_t index);
   // Places every keyframed obstacle at time t, incrementally.
   Status set_time(double t);
   // Re-solves every vertex for the obstacles where they are now.
@@ -104,7 +112,8 @@ class StreamFunction {
   void build_grids();
   ObstacleState place(size_t obstacle, const glm::vec3& centre) const;
   void refresh_active();
-  void move_incremental(size_t obstacle, const glm::vec3& centre);
+  // Gives obstacle `obstacle` its new state and re-solves the vertices either state reaches.
+  void move_incremental(size_t obstacle, const ObstacleState& new_state);
 
   RiverSurface surface_;
   FlowParams params_;

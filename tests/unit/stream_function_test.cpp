@@ -438,6 +438,53 @@ TEST(StreamFunctionIncremental, KeyframesEqualFullResolveAtAnyTime) {
   }
 }
 
+TEST(StreamFunctionIncremental, AddTurnAndRemoveEqualFullResolve) {
+  // A boat steered at runtime: added, turned (a new polygon), removed, with another obstacle
+  // before and after it in the list; every step equals a fresh solve of the same list.
+  using C = CylinderCase;
+  const TestMesh mesh = test::straight_channel(C::kWidth, 80.0f, 161, 21);
+  const FlowParams params{C::kQ, 1.5f, 12.0f};
+  Obstacle boat;
+  boat.centre = {1.0f, 0.0f, 40.0f};
+  boat.polygon = {{-0.8f, -2.5f}, {0.8f, -2.5f}, {0.8f, 2.5f}, {-0.8f, 2.5f}};
+  Obstacle turned = boat;
+  turned.centre = {0.5f, 0.0f, 41.0f};
+  for (glm::vec2& p : turned.polygon) p = {0.8f * p.x - 0.6f * p.y, 0.6f * p.x + 0.8f * p.y};
+  const Obstacle rock = C::cylinder({-2.0f, 0.0f, 20.0f});
+  const Obstacle stone = C::cylinder({2.0f, 0.0f, 60.0f});
+  const auto full_solve = [&](std::vector<Obstacle> obstacles) {
+    StreamFunction full = make_flow(mesh, params);
+    EXPECT_TRUE(full.set_obstacles(std::move(obstacles)).ok());
+    return full;
+  };
+
+  StreamFunction live = make_flow(mesh, params);
+  ASSERT_TRUE(live.add_obstacle(rock).ok());
+  const size_t touched_by_rock = live.last_update().nodes_resolved;
+  EXPECT_GT(touched_by_rock, 0u);
+  EXPECT_LT(touched_by_rock, live.surface().node_count() / 2);  // local, not a full solve
+  expect_same_field(live, full_solve({rock}));
+  ASSERT_TRUE(live.add_obstacle(boat).ok());
+  ASSERT_TRUE(live.add_obstacle(stone).ok());
+  expect_same_field(live, full_solve({rock, boat, stone}));
+  ASSERT_TRUE(live.replace_obstacle(1, turned).ok());
+  expect_same_field(live, full_solve({rock, turned, stone}));
+  ASSERT_TRUE(live.remove_obstacle(1).ok());
+  ASSERT_EQ(live.obstacles().size(), 2u);
+  expect_same_field(live, full_solve({rock, stone}));
+  ASSERT_TRUE(live.remove_obstacle(0).ok());
+  ASSERT_TRUE(live.remove_obstacle(0).ok());
+  expect_same_field(live, make_flow(mesh, params));  // back to the free flow, bit for bit
+
+  Obstacle flat = boat;
+  flat.polygon = {{0, 0}, {1, 0}, {2, 0}};  // degenerate: no area
+  const Status bad = live.add_obstacle(flat);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_TRUE(live.obstacles().empty());
+  EXPECT_FALSE(live.remove_obstacle(0).ok());
+  EXPECT_FALSE(live.replace_obstacle(0, boat).ok());
+}
+
 TEST(StreamFunction, Deterministic) {
   ProceduralRiverParams params;
   params.length = 80.0f;
