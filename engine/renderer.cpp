@@ -5,24 +5,18 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <optional>
 #include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "passes/passes.h"
+#include "renderer_impl.h"
 #include "scene/default_scene.h"
-#include "scene/river_simulation.h"
 #include "scene/water_normal_map.h"
 #include "siviflow/scene_file.h"
 #include "siviflow/scene_river.h"
 #include "sim/water_heights.h"
-#include "static_assets.h"
-#include "view_math.h"
-#include "vk/device_table.h"
-#include "vk/frame_graph.h"
-#include "vk/frame_ring.h"
-#include "vk/gpu_resources.h"
 #include "vk/pipeline.h"
 
 namespace siviflow {
@@ -42,9 +36,12 @@ constexpr VkFormat kNormalMapFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
 constexpr uint32_t kMaxTimedPasses = 16;
 
-// Tunables of the water's look, in one place.
-constexpr float kReflectionDistortion = 0.04f;    // screen uv offset per unit of normal tilt
-constexpr float kTdfTileMetres = 3.0f;            // Tiled Directional Flow tile size on the water
+// The water heights sit on a fixed grid whatever the tile size: half the default tile apart,
+// reaching over half the largest tile beyond the water (on the samples a one-tile margin had).
+constexpr float kWaterHeightSpacing = 1.5f;
+constexpr float kWaterHeightMargin = 5.0f * kWaterHeightSpacing;
+static_assert(kWaterHeightMargin >= 0.5f * kMaxTileSizeM);
+constexpr float kTdfRepeatTiles = 3.5f;  // normal-map repeat in tiles at ripple scale 1 (van Hoesel 35/10)
 constexpr uint32_t kMaxWaterHeightSamples = 2048;  // per axis: 16 MiB at most, samples widen beyond
 constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
 
@@ -73,11 +70,6 @@ Status invalid(const std::string& message) {
   return Status::error("siviflow::Renderer: " + message, VK_ERROR_INITIALIZATION_FAILED);
 }
 
-// An error in what the caller passed: no Vulkan result stands behind it.
-Status argument_error(const std::string& message) {
-  return Status::error("siviflow::Renderer: " + message);
-}
-
 std::string extent_text(VkExtent2D extent) {
   return std::to_string(extent.width) + "x" + std::to_string(extent.height);
 }
@@ -104,6 +96,10 @@ float longest_edge_xz(const std::vector<glm::vec3>& positions,
 
 }  // namespace
 
+Status argument_error(const std::string& message) {
+  return Status::error("siviflow::Renderer: " + message);
+}
+
 View camera_view(const Camera& camera, VkExtent2D extent) {
   View view;
   const float aspect = static_cast<float>(extent.width) / static_cast<float>(std::max(1u, extent.height));
@@ -117,84 +113,6 @@ View camera_view(const Camera& camera, VkExtent2D extent) {
 
 const char* version_string() { return "siviflow 0.1.0"; }
 
-struct Renderer::Impl {
-  CreateInfo info;
-  DeviceTable table;
-  GpuContext gpu;
-  FrameRing ring;
-  RiverInput river_input;         // handed to the simulation by create_static_resources
-  std::vector<float> particle_heights;  // this frame's live particles' heights
-  FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
-  std::vector<Obstacle> obstacles;  // the scene's, then the footprints of objects marked obstacle
-  RiverSimulation simulation;  // the river's flow, particles and flow textures, on the CPU
-  double last_time = 0.0;
-
-  // Geometry and textures that never change, uploaded in the first frame.
-  enum StaticBufferId : uint32_t { kRiverVertices, kRiverIndices };
-  enum StaticImageId : uint32_t { kNormalMap, kWaterHeights };
-  StaticAssets assets;
-  uint32_t river_index_count = 0;
-  FlowPass flow_pass;
-
-  // Images the frame graph declares; created after it compiles, with the usage it derived.
-  struct FrameImage {
-    ImageHandle handle;
-    Image image;
-    bool persistent = false;  // keeps its contents from frame to frame
-  };
-  std::vector<FrameImage> frame_images;
-  bool frame_images_new = true;  // persistent ones have no previous contents yet
-
-  FrameGraph graph;
-  BufferHandle frame_staging;  // the slot's staging block: this frame's flow textures
-  UploadList frame_uploads;    // flow texture and particle aux, every frame
-  ImageHandle host_color;      // imported per frame: the host's colour and depth
-  ImageHandle host_depth;
-  ImageHandle reflection_depth;
-  std::vector<ReadbackCopy> readbacks;  // one per ReadbackImage when readback is enabled
-  FrameBindings bindings;
-  gpu::FlowConstants flow_constants{};
-  gpu::FlowTileConstants tile_constants{};
-  ViewMath view;        // of the frame being prepared
-  glm::mat4 view_view{1.0f};  // its world -> view matrix
-  VkRect2D viewport{};  // in the host's images
-  ReflectionView reflection_view{};
-  // The tile table's lattice (shaders/shared.h): the points the water heights cover, and the
-  // table's size, a power of two per axis.
-  glm::ivec2 lattice_lo{0};
-  glm::ivec2 lattice_hi{0};
-  TileTableLayout tile_table;  // its corner moves with the camera when the river is larger
-
-  // With CreateInfo::enable_timing: per slot, two timestamps around each pass of the graph.
-  std::vector<VkQueryPool> query_pools;
-  std::vector<uint32_t> timed_passes;  // per slot: passes recorded with timestamps
-  uint32_t current_slot = 0;
-  float timestamp_period_ns = 1.0f;
-  uint64_t timestamp_mask = ~uint64_t{0};  // the queue's valid timestamp bits
-
-  bool unusable = false;  // a resize failed half-way
-  bool frame_begun = false;
-  bool frame_updated = false;
-
-  Status validate_info(const CreateInfo& create);
-  Status take_scene();
-  Status create_static_resources();
-  Status declare_graph();
-  ImageHandle frame_image(ImageHandle handle, bool persistent = false);
-  Status create_frame_images();
-  const Image* find_frame_image(ImageHandle handle) const;
-  void make_tile_lattice(const std::vector<glm::vec3>& surface,
-                         const std::vector<uint32_t>& indices);
-  glm::ivec2 tile_window() const;
-  Status simulate(const View& host_view, double time_seconds);
-  float visible_water_level();
-  Status check_inputs(const FrameInputs& inputs) const;
-  Status bind_frame(const FrameInputs& inputs);
-  Status create_query_pools();
-  void declare_reflection(ImageHandle* color);
-  void retire_frame_images();
-  void destroy();
-};
 
 Status Renderer::Impl::validate_info(const CreateInfo& create) {
   info = create;
@@ -278,6 +196,13 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
 }
 
 Status Renderer::Impl::take_scene() {
+  look = info.look != nullptr ? *info.look : info.scene != nullptr ? info.scene->look : WaterLook{};
+  std::string problem;
+  const std::string field = water_look_error(look, &problem);
+  if (!field.empty()) {
+    return argument_error((info.look != nullptr ? "CreateInfo::look." : "the scene's look.") +
+                          field + " " + problem);
+  }
   std::optional<ProceduralRiver> procedural;
   SIVIFLOW_TRY(scene_river_input(info.scene, &river_input, &procedural));
   if (info.scene == nullptr) {
@@ -296,6 +221,7 @@ Status Renderer::Impl::take_scene() {
 Status Renderer::Impl::create_static_resources() {
   SIVIFLOW_TRY(simulation.create(std::move(river_input), flow_params, std::move(obstacles),
                                  info.seed, {info.extent.width, info.extent.height}));
+  scene_obstacle_count = simulation.obstacle_count();
   const RiverMesh& surface = simulation.mesh();
   river_index_count = static_cast<uint32_t>(surface.indices.size());
   assets.add_buffer({"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
@@ -320,25 +246,27 @@ Status Renderer::Impl::create_static_resources() {
 // as many as SIVIFLOW_TILE_TABLE_MAX allows, then a window around the camera).
 void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
                                        const std::vector<uint32_t>& indices) {
-  const float half_tile = 0.5f * kTdfTileMetres;
   // A tile reaches half a tile beyond the water it covers; the margin keeps its centre inside.
   const WaterHeights heights =
-      water_heights(surface, half_tile, kTdfTileMetres, kMaxWaterHeightSamples);
-  const glm::vec2 far_corner =
-      heights.origin + heights.spacing * glm::vec2(heights.columns - 1, heights.rows - 1);
-  lattice_lo = glm::ivec2(glm::floor(heights.origin / half_tile));
-  lattice_hi = glm::ivec2(glm::ceil(far_corner / half_tile));
+      water_heights(surface, kWaterHeightSpacing, kWaterHeightMargin, kMaxWaterHeightSamples);
+  water_lo = glm::vec2(std::numeric_limits<float>::max());
+  water_hi = glm::vec2(std::numeric_limits<float>::lowest());
+  for (const glm::vec3& p : surface) {
+    water_lo = glm::min(water_lo, glm::vec2(p.x, p.z));
+    water_hi = glm::max(water_hi, glm::vec2(p.x, p.z));
+  }
+  place_tile_lattice();  // at the starting look's tile size, which sizes the table
   const auto table_side = [](int points) {
     return std::min(std::bit_ceil(static_cast<uint32_t>(points)), SIVIFLOW_TILE_TABLE_MAX);
   };
   tile_table.width = table_side(lattice_hi.x - lattice_lo.x + 1);
   tile_table.height = table_side(lattice_hi.y - lattice_lo.y + 1);
-  tile_table.tile_size_m = kTdfTileMetres;
-  tile_constants.heights = glm::vec4(heights.origin, heights.spacing, kTdfTileMetres);
+  tile_constants.heights = glm::vec4(heights.origin, heights.spacing, look.tile_size_m);
   // A tile centre is within a tile of water it covers, and water within its longest triangle
-  // edge of a vertex: samples farther than both are no tile's. Steps go along the axes, so a
-  // distance d takes up to d sqrt(2) / spacing of them, plus one for the vertex's own sample.
-  const float reach = (kTdfTileMetres + longest_edge_xz(surface, indices)) * std::sqrt(2.0f);
+  // edge of a vertex: samples farther than both (at the largest tile) are no tile's. Steps go
+  // along the axes, so a distance d takes up to d sqrt(2) / spacing of them, plus one for the
+  // vertex's own sample.
+  const float reach = (kMaxTileSizeM + longest_edge_xz(surface, indices)) * std::sqrt(2.0f);
   const auto reach_steps = static_cast<uint32_t>(std::ceil(reach / heights.spacing)) + 1;
   std::vector<float> texels(heights.heights.size());
   for (size_t i = 0; i < texels.size(); ++i) {
@@ -349,13 +277,22 @@ void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
                     bytes_of(texels), {0}, Access::SampledCompute});
 }
 
+// The lattice points around the water at the look's tile size: those within a tile of it.
+void Renderer::Impl::place_tile_lattice() {
+  const float tile = look.tile_size_m;
+  const float half_tile = 0.5f * tile;
+  lattice_lo = glm::ivec2(glm::floor((water_lo - tile) / half_tile));
+  lattice_hi = glm::ivec2(glm::ceil((water_hi + tile) / half_tile));
+  tile_table.tile_size_m = tile;
+}
+
 // The lattice point of the tile table's window corner: the river's first point when the table
 // holds them all, else a window reaching as far ahead of the camera as it can (what lies behind
 // is not seen), kept over the river. Water beyond the window, farther than the table's reach
 // (768 m at SIVIFLOW_TILE_TABLE_MAX), takes the tiles of points a table size away.
 glm::ivec2 Renderer::Impl::tile_window() const {
   const glm::ivec2 size(tile_table.width, tile_table.height);
-  const float half_tile = 0.5f * kTdfTileMetres;
+  const float half_tile = 0.5f * look.tile_size_m;
   const glm::vec2 position = glm::vec2(view.camera_position.x, view.camera_position.z) / half_tile;
   // The view looks down its -Z axis: the world direction of that axis is the third row of the
   // view matrix's rotation, negated (read from the inverse's third column).
@@ -615,13 +552,20 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
               sizeof(reflection_view.camera_position));
   reflection_view.reverse_z = view.reverse_z;
 
-  const SceneLook look = default_scene_look();
   const FlowTextureLayout& layout = simulation.layout();
   flow_constants.view_proj = view.view_proj;
   flow_constants.camera_position = glm::vec4(view.camera_position, view.depth_ratio_constant);
   flow_constants.sun_direction = glm::vec4(glm::normalize(look.sun_direction), 0.0f);
-  flow_constants.water = glm::vec4(h, kReflectionDistortion, kTdfTileMetres,
+  flow_constants.water = glm::vec4(h, look.reflection_distortion, look.tile_size_m,
                                    static_cast<float>(layout.texel_px));
+  const float repeat_tiles = kTdfRepeatTiles * look.ripple_scale;
+  frame_look.water_color = glm::vec4(look.water_color, look.absorption_per_metre);
+  frame_look.deep_color = glm::vec4(look.deep_color, look.opacity_per_metre);
+  frame_look.sun_color = glm::vec4(look.sun_color, look.ripple_strength);
+  frame_look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, 0.0f, 0.0f);
+  place_tile_lattice();
+  tile_constants.heights.w = look.tile_size_m;
+  tile_constants.ripples = glm::vec4(repeat_tiles, 0.0f, 0.0f, 0.0f);
   flow_constants.screen = glm::vec4(rect.offset.x, rect.offset.y,
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
@@ -761,7 +705,7 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
     gpu_context.table->vkDestroyImageView(gpu_context.table->device, depth_view,
                                           gpu_context.allocation_callbacks);
   });
-  flow_pass.set_frame(gpu, {current_slot, depth_view, view.reverse_z, viewport});
+  flow_pass.set_frame(gpu, {current_slot, depth_view, view.reverse_z, viewport, frame_look});
   return Status::success();
 }
 

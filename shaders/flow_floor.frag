@@ -14,6 +14,7 @@ layout(set = 0, binding = 2) uniform sampler2D reflection_map;
 layout(set = 0, binding = 3) uniform sampler2D normal_map;
 layout(set = 0, binding = 4) uniform usampler2D tile_table;
 layout(set = 0, binding = 5) uniform sampler2D host_depth;
+layout(set = 0, binding = 6) uniform Look { WaterLookConstants look; };
 layout(location = 0) in vec3 in_world;
 layout(location = 0) out vec4 out_value;
 
@@ -29,7 +30,7 @@ void main() {
   vec3 sum = texture(reflection_map, uv).rgb + texelFetch(host_depth, ivec2(gl_FragCoord.xy), 0).r;
   // Normal-map coordinates at the material's map scale (its mid-speed scale), with the world
   // position's gradients, so the reads come from the same mip levels as the material's.
-  vec2 tile = in_world.xz * (0.5 * (kTdfScaleStill + kTdfScaleFast) / (kTdfRepeatTiles * flow.water.z));
+  vec2 tile = in_world.xz * (0.5 * (kTdfScaleStill + kTdfScaleFast) / (look.surface.y * flow.water.z));
   vec2 dx = dFdx(tile);
   vec2 dy = dFdy(tile);
   for (int i = 0; i < 4; ++i) sum += textureGrad(normal_map, tile + 0.25 * float(i), dx, dy).rgb;

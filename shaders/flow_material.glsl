@@ -11,6 +11,7 @@ layout(set = 0, binding = 2) uniform sampler2D reflection_map;  // the mirrored 
 layout(set = 0, binding = 3) uniform sampler2D normal_map;      // tileable ripples, mipmapped
 layout(set = 0, binding = 4) uniform usampler2D tile_table;     // this frame's, flow_tiles.comp
 layout(set = 0, binding = 5) uniform sampler2D host_depth;      // what the host drew, texelFetch
+layout(set = 0, binding = 6) uniform Look { WaterLookConstants look; };  // siviflow/water_look.h
 
 layout(location = 0) in vec3 in_world;
 layout(location = 0) out vec4 out_color;
@@ -20,14 +21,8 @@ layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_reflection;
 #endif
 
-// Tunables of the water's look.
-const vec3 kShallowColour = vec3(0.10, 0.22, 0.20);
-const vec3 kDeepColour = vec3(0.015, 0.05, 0.07);
-const float kAbsorptionPerMetre = 1.4;   // how fast the water turns from shallow to deep colour
-const float kOpacityPerMetre = 2.2;      // how fast the riverbed disappears with depth
+// Tunables of the material that are not the artist's look (that comes in `look`).
 const float kShoreFadeMetres = 0.12;     // water thinner than this fades out at the banks
-const float kRippleStrength = 0.55;      // van Hoesel's 0.3 transp^2 scale, brighter for rivers
-const float kFresnelF0 = 0.02;           // water at normal incidence
 const float kFadeInfluence = 0.25;       // how much a fading particle calms its cell
 const vec3 kSkyFallback = vec3(0.46, 0.60, 0.78);  // reflected where the reflection is empty
 const float kMaxWaterPath = 1.0e4;       // metres: the host's far plane or sky behind the water
@@ -56,8 +51,8 @@ void main() {
   float shore = smoothstep(0.0, kShoreFadeMetres, below);
   float transparency = shore * mix(1.0 - kFadeInfluence, 1.0, fade);
   TdfResult tdf = tdf_normal(in_world, vec3(0.0, 1.0, 0.0),
-                             kRippleStrength * transparency * transparency, flow.water.z,
-                             tile_table, normal_map);
+                             look.sun_color.w * transparency * transparency, flow.water.z,
+                             look.surface.y, tile_table, normal_map);
   vec3 n = tdf.normal;
 
   // Reflection: the mirrored scene at this pixel, offset by the normal's tilt (paper §4.3); a
@@ -68,13 +63,15 @@ void main() {
   float cos_theta = max(dot(n, to_eye), 0.0);
   float grazing = 1.0 - cos_theta;
   float grazing_sq = grazing * grazing;
-  float fresnel = kFresnelF0 + (1.0 - kFresnelF0) * grazing_sq * grazing_sq * grazing;
+  float f0 = look.surface.x;
+  float fresnel = f0 + (1.0 - f0) * grazing_sq * grazing_sq * grazing;
 
   // Colour and absorption by the water the light crosses: clear in the shallows, dark and
   // opaque in the deep.
-  float light = 0.35 + 0.65 * max(dot(n, flow.sun_direction.xyz), 0.0);  // a unit vector already
-  vec3 body = mix(kShallowColour, kDeepColour, 1.0 - exp(-kAbsorptionPerMetre * path)) * light;
-  float opacity = 1.0 - exp(-kOpacityPerMetre * path);
+  vec3 light = 0.35 + 0.65 * look.sun_color.rgb * max(dot(n, flow.sun_direction.xyz), 0.0);
+  vec3 body = mix(look.water_color.rgb, look.deep_color.rgb,
+                  1.0 - exp(-look.water_color.w * path)) * light;
+  float opacity = 1.0 - exp(-look.deep_color.w * path);
   vec3 colour = mix(body, reflection, fresnel);
   float alpha = clamp(mix(opacity, 1.0, fresnel), 0.0, 1.0) * shore;
   out_color = vec4(colour, alpha);

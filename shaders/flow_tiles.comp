@@ -46,7 +46,8 @@ void main() {
   }
   vec3 flow = found.r == SIVIFLOW_PARTICLE_NONE ? vec3(0.0) : tdf_texel_flow(found);
   float cycles_per_mps =
-      kTdfAdvection * SIVIFLOW_TDF_TIME_PERIOD / (tiles.heights.w * kTdfRepeatTiles);
+      kTdfAdvection * SIVIFLOW_TDF_TIME_PERIOD / (tiles.heights.w * tiles.ripples.x);
   imageStore(tile_table, texel,
-             tdf_encode_tile(lattice, flow, tiles.screen.w / SIVIFLOW_TDF_TIME_PERIOD, cycles_per_mps));
+             tdf_encode_tile(lattice, flow, tiles.screen.w / SIVIFLOW_TDF_TIME_PERIOD, cycles_per_mps,
+                             tiles.ripples.x));
 }

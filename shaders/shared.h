@@ -96,6 +96,16 @@ static_assert(offsetof(ParticleAux, slope) == 8);
 static_assert(offsetof(ParticleAux, fade) == 12);
 #endif
 
+// The water's look (siviflow/water_look.h), the flow material's uniform buffer (std140), one
+// per frame slot.
+struct WaterLookConstants {
+  vec4 water_color;  // rgb linear colour of shallow water, w absorption per metre of view path
+  vec4 deep_color;   // rgb linear colour of deep water, w opacity per metre of view path
+  vec4 sun_color;    // rgb linear multiplier of the sunlit part, w ripple strength
+  vec4 surface;      // x Fresnel reflectance at normal incidence, y normal-map repeat in tiles
+                     // (the ripples' size), zw unused
+};
+
 // Push constants of the flow pass (the water material).
 struct FlowConstants {
   mat4 view_proj;        // world -> clip of the host's view
@@ -133,6 +143,7 @@ struct FlowTileConstants {
                    // w tile size (m)
   vec4 screen;     // xy output size (pixels), z flow texel size (pixels), w scene time in
                    // seconds mod SIVIFLOW_TDF_TIME_PERIOD
+  vec4 ripples;    // x normal-map repeat in tiles (WaterLookConstants.surface.y), yzw unused
 };
 
 // Scene time reaches the tile table pass wrapped to [0, this period) seconds (wrapped on the CPU
@@ -142,10 +153,12 @@ struct FlowTileConstants {
 
 #ifdef __cplusplus
 static_assert(sizeof(FlowConstants) == 128);
-static_assert(sizeof(FlowTileConstants) == 112);
+static_assert(sizeof(FlowTileConstants) == 128);
+static_assert(sizeof(WaterLookConstants) == 64);
 static_assert(offsetof(FlowTileConstants, lattice) == 64);
 static_assert(offsetof(FlowTileConstants, heights) == 80);
 static_assert(offsetof(FlowTileConstants, screen) == 96);
+static_assert(offsetof(FlowTileConstants, ripples) == 112);
 static_assert(offsetof(FlowConstants, camera_position) == 64);
 static_assert(offsetof(FlowConstants, water) == 96);
 static_assert(offsetof(FlowConstants, screen) == 112);

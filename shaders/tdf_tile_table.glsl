@@ -6,7 +6,6 @@
 #include "shared.h"
 
 // ---- Tunables (one place; the scroll period SIVIFLOW_TDF_TIME_PERIOD is in shared.h) ------
-const float kTdfRepeatTiles = 3.5;       // normal-map repeat in tiles at scale 1 (van Hoesel 35/10)
 const float kTdfScaleStill = 1.0;        // map repeats per repeat length in still water
 const float kTdfScaleFast = 1.5;         // ... in fast water: shorter, choppier ripples
 const float kTdfSpeedFast = 1.5;         // m/s at which fast-water scale and roughness are reached
@@ -34,8 +33,10 @@ vec2 tdf_tile_offset(ivec2 cell, int grid) {
 
 // The tile table texel (shared.h) of the tile centred on lattice point `lattice`, whose flow is
 // `flow` (world m/s; zero for still water).
-//   cycles_per_mps: scroll cycles per period per m/s of scaled speed; periods: time / period.
-uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float periods, float cycles_per_mps) {
+//   cycles_per_mps: scroll cycles per period per m/s of scaled speed; periods: time / period;
+//   repeat_tiles: tiles per normal-map repeat at scale 1 (the ripples' size).
+uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float periods, float cycles_per_mps,
+                      float repeat_tiles) {
   // Lattice (2c + 1, .) is grid A's tile c, (2c, .) the grid offset by half a tile, per axis.
   int grid = int((lattice.x & 1) == 0) + 2 * int((lattice.y & 1) == 0);
   ivec2 cell = lattice >> 1;
@@ -44,7 +45,7 @@ uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float periods, float cycles_per_
   float fast = clamp(speed * (1.0 / kTdfSpeedFast), 0.0, 1.0);
   float scale = mix(kTdfScaleStill, kTdfScaleFast, fast);
   // M = scale * R(-angle): the world flow direction maps to the map's +U.
-  vec2 ab = (scale * (1.0 / kTdfRepeatTiles)) * dir;
+  vec2 ab = (scale / repeat_tiles) * dir;
   // Pattern world speed = rate * repeat_m / scale; whole cycles per period keep the wrap seamless.
   float cycles = round(speed * scale * cycles_per_mps * kTdfGridSpeed[grid]);
   float phase = fract(cycles * periods + kTdfGridPhase[grid]);
@@ -55,9 +56,9 @@ uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float periods, float cycles_per_
 
 // R(+angle) scaled by the roughness, which turns a tile's sampled tilt back into world x/z: both
 // follow from (a, b) = scale / repeat * dir, as scale and roughness grow together with speed.
-vec2 tdf_back_rotation(vec2 ab) {
+vec2 tdf_back_rotation(vec2 ab, float repeat_tiles) {
   float inv_k = inversesqrt(dot(ab, ab));  // repeat / scale
-  float fast = (kTdfRepeatTiles / inv_k - kTdfScaleStill) / (kTdfScaleFast - kTdfScaleStill);
+  float fast = (repeat_tiles / inv_k - kTdfScaleStill) / (kTdfScaleFast - kTdfScaleStill);
   return (mix(kTdfStillRoughness, 1.0, fast) * inv_k) * ab;
 }
 

@@ -49,11 +49,11 @@ struct TdfResult {
 
 // One tile of one grid: its normal-map sample, as a tangent tilt along world x/z.
 //   u: the fragment in tile units; lattice: the tile centre's lattice point.
-vec2 tdf_tile_sample(vec2 u, ivec2 lattice, vec2 du_dx, vec2 du_dy, usampler2D tile_table,
-                     sampler2D normal_map) {
+vec2 tdf_tile_sample(vec2 u, ivec2 lattice, vec2 du_dx, vec2 du_dy, float repeat_tiles,
+                     usampler2D tile_table, sampler2D normal_map) {
   uvec4 tile = texelFetch(tile_table, lattice & (textureSize(tile_table, 0) - 1), 0);
   vec2 ab = uintBitsToFloat(tile.rg);
-  vec2 back = tdf_back_rotation(ab);
+  vec2 back = tdf_back_rotation(ab, repeat_tiles);
   mat2 m = mat2(ab.x, -ab.y, ab.y, ab.x);
   vec2 s = m * (u - 0.5 * vec2(lattice)) + uintBitsToFloat(tile.ba);
   vec2 n = textureGrad(normal_map, s, m * du_dx, m * du_dy).rg * 2.0 - 1.0;
@@ -64,9 +64,10 @@ vec2 tdf_tile_sample(vec2 u, ivec2 lattice, vec2 du_dx, vec2 du_dy, usampler2D t
 //   world          fragment on the river surface, world metres (y up)
 //   surface_normal geometric normal of the river surface (unit; (0,1,0) for flat water)
 //   strength       van Hoesel's 0.3 * transp^2: fold fade, shore and depth in (0 = flat mirror)
-//   tile_size_m    tile side in metres (the normal map repeats every kTdfRepeatTiles tiles)
+//   tile_size_m    tile side in metres
+//   repeat_tiles   tiles per normal-map repeat at scale 1, as the tile table was encoded with
 TdfResult tdf_normal(vec3 world, vec3 surface_normal, float strength, float tile_size_m,
-                     usampler2D tile_table, sampler2D normal_map) {
+                     float repeat_tiles, usampler2D tile_table, sampler2D normal_map) {
   vec2 u = world.xz / tile_size_m;
   vec2 du_dx = dFdx(u);
   vec2 du_dy = dFdy(u);
@@ -77,7 +78,7 @@ TdfResult tdf_normal(vec3 world, vec3 surface_normal, float strength, float tile
   vec2 n[4];
   for (int k = 0; k < 4; ++k) {
     ivec2 lattice = 2 * ivec2(floor(u + kOffsets[k])) + kCentres[k];
-    n[k] = tdf_tile_sample(u, lattice, du_dx, du_dy, tile_table, normal_map);
+    n[k] = tdf_tile_sample(u, lattice, du_dx, du_dy, repeat_tiles, tile_table, normal_map);
   }
   // van Hoesel's weights: ff = 1 at the centre of grid A's tile, 0 at its edges (per axis).
   vec2 g = abs(2.0 * fract(u) - 1.0) - 0.5;

@@ -1,6 +1,7 @@
 #include "passes/passes.h"
 
 #include <array>
+#include <cstring>
 #include <span>
 #include <string>
 
@@ -10,14 +11,20 @@
 namespace siviflow {
 namespace {
 
-// Bindings 0..5 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
-// normal map, tile table, host depth.
-constexpr uint32_t kBindingCount = 6;
+// Bindings 0..6 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
+// normal map, tile table, host depth, the look's uniform buffer.
+constexpr uint32_t kBindingCount = 7;
 constexpr uint32_t kHostDepthBinding = 5;
+constexpr uint32_t kLookBinding = 6;
 constexpr std::array<VkDescriptorType, kBindingCount> kMaterialBindings = {
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
+    VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+    VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER};
+// Each slot's look block starts at a multiple of this: the largest minUniformBufferOffsetAlignment
+// the specification allows, so no device query is needed.
+constexpr VkDeviceSize kLookStride = 256;
+static_assert(sizeof(gpu::WaterLookConstants) <= kLookStride);
 // Bindings of shaders/flow_tiles.comp: flow texture, water heights, tile table.
 constexpr std::array<VkDescriptorType, 3> kTileBindings = {
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -35,6 +42,8 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
                               VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                               sizeof(gpu::FlowConstants), &set_layout_, &layout_));
   // Flow and aux are integer or exact data read with texelFetch: nearest, never filtered.
+  SIVIFLOW_TRY(create_buffer(gpu, kLookStride * slot_count, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                             true, "water look", &look_buffer_));
   SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &nearest_));
   SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE, false, &linear_clamp_));
   SIVIFLOW_TRY(create_sampler(gpu, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT, true, &linear_repeat_));
@@ -83,6 +92,7 @@ void FlowPass::destroy(const GpuContext& gpu) {
   for (VkDescriptorSetLayout layout : {set_layout_, tiles_set_layout_}) {
     if (layout != VK_NULL_HANDLE) vk.vkDestroyDescriptorSetLayout(vk.device, layout, callbacks);
   }
+  destroy_buffer(gpu, &look_buffer_);
   *this = FlowPass{};
 }
 
@@ -138,6 +148,17 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   };
   for (VkDescriptorSet set : sets_) write(set, kMaterialBindings, material);
   write(tiles_set_, kTileBindings, tiles);
+  std::vector<VkDescriptorBufferInfo> looks(slot_count_);
+  for (uint32_t slot = 0; slot < slot_count_; ++slot) {
+    looks[slot] = {look_buffer_.buffer, kLookStride * slot, sizeof(gpu::WaterLookConstants)};
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = sets_[slot];
+    w.dstBinding = kLookBinding;
+    w.descriptorCount = 1;
+    w.descriptorType = kMaterialBindings[kLookBinding];
+    w.pBufferInfo = &looks[slot];
+    writes.push_back(w);
+  }
   vk.vkUpdateDescriptorSets(vk.device, static_cast<uint32_t>(writes.size()), writes.data(), 0,
                             nullptr);
   return Status::success();
@@ -145,7 +166,10 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
 
 void FlowPass::set_frame(const GpuContext& gpu, const Frame& frame) {
   frame_ = frame;
-  // The slot's previous frame is done (the host waited on it), so its set may change.
+  // The slot's previous frame is done (the host waited on it), so its set and its look block
+  // may change; host-coherent writes are visible to the commands submitted after them.
+  std::memcpy(static_cast<std::byte*>(look_buffer_.mapped) + kLookStride * frame.slot, &frame.look,
+              sizeof(frame.look));
   const VkDescriptorImageInfo image{nearest_, frame.host_depth,
                                     VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL};
   VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
@@ -207,7 +231,7 @@ void FlowPass::declare_tiles(FrameGraph& graph, const gpu::FlowTileConstants* co
 void FlowPass::declare_floor(FrameGraph& graph, const gpu::FlowConstants* constants,
                              uint32_t index_count, const Handles& inputs, ImageHandle target) {
   PassBuilder pass = graph.add_pass("flow floor", PassKind::Graphics);
-  const ImageHandle written = pass.color_write(target, LoadOp::DontCare);
+  pass.color_write(target, LoadOp::DontCare);  // its new version: nothing reads it
   pass.depth_read(inputs.depth);
   pass.sampled_fragment(inputs.depth);
   pass.sampled_fragment(inputs.flow);

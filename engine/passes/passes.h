@@ -142,13 +142,14 @@ class FlowPass {
                        const std::function<void(VkDescriptorPool)>& retire);
 
   // What the next recording of the passes draws with: the frame slot (whose previous frame the
-  // host has waited for), a view of the host depth's depth aspect, the depth convention and
-  // the viewport in the host's images.
+  // host has waited for), a view of the host depth's depth aspect, the depth convention, the
+  // viewport in the host's images and the water's look.
   struct Frame {
     uint32_t slot = 0;
     VkImageView host_depth = VK_NULL_HANDLE;
     bool reverse_z = false;
     VkRect2D viewport{};
+    gpu::WaterLookConstants look{};
   };
   void set_frame(const GpuContext& gpu, const Frame& frame);
 
@@ -199,6 +200,7 @@ class FlowPass {
   VkSampler linear_repeat_ = VK_NULL_HANDLE;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   std::vector<VkDescriptorSet> sets_;  // per frame slot
+  Buffer look_buffer_;                 // host-visible, one WaterLookConstants block per slot
 };
 
 // ---- readback: images -> host buffers (tools and tests only) ----

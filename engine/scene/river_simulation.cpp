@@ -110,6 +110,30 @@ Status RiverSimulation::set_time(double time_seconds) {
   return Status::success();
 }
 
+Status RiverSimulation::add_obstacle(Obstacle obstacle) {
+  SIVIFLOW_TRY(flow_.add_obstacle(std::move(obstacle)));
+  refresh_velocity();
+  return Status::success();
+}
+
+Status RiverSimulation::replace_obstacle(size_t index, Obstacle obstacle) {
+  SIVIFLOW_TRY(flow_.replace_obstacle(index, std::move(obstacle)));
+  refresh_velocity();
+  return Status::success();
+}
+
+Status RiverSimulation::move_obstacle(size_t index, const glm::vec3& centre) {
+  SIVIFLOW_TRY(flow_.move_obstacle(index, centre));
+  refresh_velocity();
+  return Status::success();
+}
+
+Status RiverSimulation::remove_obstacle(size_t index) {
+  SIVIFLOW_TRY(flow_.remove_obstacle(index));
+  refresh_velocity();
+  return Status::success();
+}
+
 Status RiverSimulation::resize(glm::uvec2 viewport) {
   ParticleParams params = particles_.params();
   params.viewport = viewport;

@@ -57,6 +57,14 @@ class RiverSimulation {
   // moved, so the next simulate() hands the particles the new course.
   Status set_time(double time_seconds);
   glm::vec3 obstacle_centre(size_t index) const { return flow_.obstacle_centre(index); }
+  size_t obstacle_count() const { return flow_.obstacles().size(); }
+
+  // Obstacles placed at runtime, by their index in the flow's list (add appends): each re-solves
+  // the flow only around the old and new footprint, as the next simulate() then carries.
+  Status add_obstacle(Obstacle obstacle);
+  Status replace_obstacle(size_t index, Obstacle obstacle);
+  Status move_obstacle(size_t index, const glm::vec3& centre);
+  Status remove_obstacle(size_t index);
 
   // A new viewport: new particles (from frame 0) and flow textures, on the same river, flow and
   // ray-cast structure. On failure nothing changes.

@@ -277,6 +277,45 @@ Status parse_flow(const Reader& r, const Json& v, FlowParams* out) {
   return Status::success();
 }
 
+// The water's look: every field of WaterLook under its own name, each optional, then the ranges
+// the renderer accepts (so a file the parser takes is one the renderer takes).
+Status parse_look(const Reader& r, const Json& v, WaterLook* out) {
+  SIVIFLOW_TRY(r.object(v, "look"));
+  const struct {
+    const char* name;
+    float WaterLook::*member;
+  } scalars[] = {{"absorption_per_metre", &WaterLook::absorption_per_metre},
+                 {"opacity_per_metre", &WaterLook::opacity_per_metre},
+                 {"ripple_strength", &WaterLook::ripple_strength},
+                 {"ripple_scale", &WaterLook::ripple_scale},
+                 {"tile_size_m", &WaterLook::tile_size_m},
+                 {"reflection_distortion", &WaterLook::reflection_distortion},
+                 {"fresnel_f0", &WaterLook::fresnel_f0}};
+  const struct {
+    const char* name;
+    glm::vec3 WaterLook::*member;
+  } vectors[] = {{"water_color", &WaterLook::water_color},
+                 {"deep_color", &WaterLook::deep_color},
+                 {"sun_direction", &WaterLook::sun_direction},
+                 {"sun_color", &WaterLook::sun_color}};
+  std::vector<std::string_view> allowed;
+  for (const auto& s : scalars) allowed.push_back(s.name);
+  for (const auto& s : vectors) allowed.push_back(s.name);
+  SIVIFLOW_TRY(r.keys(v, "look", allowed));
+  WaterLook look;
+  for (const auto& s : scalars) {
+    if (const Json* x = find(v, s.name)) SIVIFLOW_TRY(r.real(*x, join("look", s.name), &(look.*s.member)));
+  }
+  for (const auto& s : vectors) {
+    if (const Json* x = find(v, s.name)) SIVIFLOW_TRY(r.vec3(*x, join("look", s.name), &(look.*s.member)));
+  }
+  std::string problem;
+  const std::string field = water_look_error(look, &problem);
+  if (!field.empty()) return r.fail(join("look", field), problem);
+  *out = look;
+  return Status::success();
+}
+
 double cross2(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
 
 // Whether the closed segments ab and cd share a point (touching and collinear overlap count).
@@ -516,7 +555,8 @@ Status parse_root(const Reader& r, const Json& root, const std::string& file,
   }
   SIVIFLOW_TRY(
       r.keys(root, "",
-             {"$schema", "version", "river", "flow", "obstacles", "objects", "camera", "render"}));
+             {"$schema", "version", "river", "flow", "obstacles", "objects", "camera", "render",
+              "look"}));
   if (const Json* schema = find(root, "$schema"); schema && !schema->is_string()) {
     return r.fail("$schema", "must be a string");
   }
@@ -533,6 +573,7 @@ Status parse_root(const Reader& r, const Json& root, const std::string& file,
     SIVIFLOW_TRY(parse_objects(r, *x, folder, &scene.objects));
   if (const Json* x = find(root, "camera")) SIVIFLOW_TRY(parse_camera(r, *x, &scene.camera));
   if (const Json* x = find(root, "render")) SIVIFLOW_TRY(parse_render(r, *x, &scene.render));
+  if (const Json* x = find(root, "look")) SIVIFLOW_TRY(parse_look(r, *x, &scene.look));
   *out = std::move(scene);
   return Status::success();
 }

@@ -479,6 +479,55 @@ TEST(SceneFileSchema, ProceduralPropertiesAndDefaultsMatchTheParser) {
   EXPECT_EQ(p.vertices_across, d.vertices_across);
 }
 
+TEST(SceneFileSchema, LookKeysDefaultsAndRangesMatchWaterLook) {
+  const Json schema = load_schema();
+  const Json& look = schema["properties"]["look"]["properties"];
+  EXPECT_EQ(look.size(), 11u) << "WaterLook has 11 fields";
+  // All the schema's defaults, written out, give WaterLook's defaults.
+  Json defaults = Json::object();
+  for (const auto& item : look.items()) defaults[item.key()] = item.value()["default"];
+  SceneFile scene;
+  const Status status = parse(with({{"look", defaults}}), &scene);
+  ASSERT_TRUE(status.ok()) << status.message();
+  const WaterLook d;
+  const WaterLook& l = scene.look;
+  EXPECT_EQ(l.water_color, d.water_color);
+  EXPECT_EQ(l.deep_color, d.deep_color);
+  EXPECT_EQ(l.absorption_per_metre, d.absorption_per_metre);
+  EXPECT_EQ(l.opacity_per_metre, d.opacity_per_metre);
+  EXPECT_EQ(l.ripple_strength, d.ripple_strength);
+  EXPECT_EQ(l.ripple_scale, d.ripple_scale);
+  EXPECT_EQ(l.tile_size_m, d.tile_size_m);
+  EXPECT_EQ(l.reflection_distortion, d.reflection_distortion);
+  EXPECT_EQ(l.fresnel_f0, d.fresnel_f0);
+  EXPECT_EQ(l.sun_direction, d.sun_direction);
+  EXPECT_EQ(l.sun_color, d.sun_color);
+  // Each scalar's schema maximum is accepted, and just past it refused by name and value.
+  for (const auto& item : look.items()) {
+    if (!item.value().contains("maximum")) continue;
+    const double max = item.value()["maximum"].get<double>();
+    EXPECT_TRUE(parse(with({{"look", {{item.key(), max}}}}), &scene).ok()) << item.key();
+    const Status over = parse(with({{"look", {{item.key(), max * 1.5 + 1.0}}}}), &scene);
+    ASSERT_FALSE(over.ok()) << item.key();
+    EXPECT_NE(over.message().find("look." + item.key()), std::string::npos) << over.message();
+    EXPECT_NE(over.message().find("is outside"), std::string::npos) << over.message();
+  }
+}
+
+TEST(SceneFile, LookKeysReachTheLookAndBadOnesAreNamed) {
+  SceneFile scene;
+  ASSERT_TRUE(parse(with({{"look", {{"water_color", {0.3, 0.1, 0.05}}, {"fresnel_f0", 0.1}}}}),
+                    &scene).ok());
+  EXPECT_EQ(scene.look.water_color, glm::vec3(0.3f, 0.1f, 0.05f));
+  EXPECT_EQ(scene.look.fresnel_f0, 0.1f);
+  EXPECT_EQ(scene.look.deep_color, WaterLook{}.deep_color);
+  expect_error(with({{"look", {{"deep_color", {0.1, 2.0, 0.1}}}}}),
+               {"look.deep_color", "component 1", "2 is outside [0, 1]"});
+  expect_error(with({{"look", {{"sun_direction", {0, 0, 0}}}}}),
+               {"look.sun_direction", "non-zero"});
+  expect_error(with({{"look", {{"gloss", 1}}}}), {"look.gloss: unknown key", "fresnel_f0"});
+}
+
 TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {
   const Json schema = load_schema();
   const Json& top = schema["properties"];
@@ -504,11 +553,11 @@ TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {
       EXPECT_TRUE(s.ok()) << section << "." << item.key() << ": " << s.message();
     }
   }
-  for (const char* key :
-       {"version", "river", "flow", "obstacles", "objects", "camera", "render", "$schema"}) {
+  for (const char* key : {"version", "river", "flow", "obstacles", "objects", "camera", "render",
+                          "look", "$schema"}) {
     EXPECT_TRUE(top.contains(key)) << key;
   }
-  EXPECT_EQ(top.size(), 8u) << "a top-level key the parser does not know";
+  EXPECT_EQ(top.size(), 9u) << "a top-level key the parser does not know";
   // Obstacles: a circle or a polygon, exactly one (oneOf), and every listed key parses.
   const Json& obstacle = top["obstacles"]["items"];
   std::set<std::string> obstacle_keys;

@@ -25,10 +25,12 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan.h>
 
 #include "siviflow/scene_file.h"
+#include "siviflow/water_look.h"
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "sim/status.h"
@@ -75,6 +77,9 @@ struct CreateInfo {
   // The scene to render (its river, flow, obstacles, objects and camera keys); null: the
   // built-in default scene. Read by create() only: the renderer copies what it needs.
   const SceneFile* scene = nullptr;
+  // The water's starting look; null: the scene's "look" (or WaterLook's defaults). Read by
+  // create() only; set_look() changes it.
+  const WaterLook* look = nullptr;
   bool enable_timing = false;          // GPU timestamps around every pass (see pass_times()),
                                        // and the flow pass's floor pass, for benchmarks
   VkDeviceSize staging_bytes_per_slot = 0;  // per-slot staging block; 0 means 8 MiB
@@ -123,6 +128,16 @@ struct Camera {
 };
 // The standard-depth view of `camera` over a viewport of `extent` at the images' origin.
 View camera_view(const Camera& camera, VkExtent2D extent);
+
+// An obstacle the host places at runtime (a boat the player steers, a log): its footprint on the
+// water seen from above, which the flow goes round (its outline becomes a streamline).
+struct WaterObstacle {
+  glm::vec3 centre{0.0f};  // world position; the footprint lies around it in x and z
+  float radius = 0.0f;     // a circle of this radius (metres) when `polygon` is empty
+  // A polygon footprint: (x, z) offsets from the centre, 3 .. 4096 points, simple, either winding.
+  std::vector<glm::vec2> polygon;
+  float rotation_rad = 0.0f;  // turns the polygon about +Y as glm::rotate does (+X towards -Z)
+};
 
 // An image's synchronisation state: what last touched it and its layout.
 struct ImageState {
@@ -215,6 +230,20 @@ class Renderer {
   // Records the frame into `cmd` (in the recording state, outside any render pass), after the
   // host's own drawing of colour and depth.
   Status record(VkCommandBuffer cmd, const FrameInputs& inputs);
+
+  // Runtime obstacles. Each call re-solves the flow only around the old and new footprints
+  // (the result equals a fresh solve) and the next update() carries the new flow. Call outside
+  // begin_frame/record. An obstacle with a non-finite or degenerate footprint, or an unknown id,
+  // is an error naming the field or id, and nothing changes.
+  Status add_obstacle(const WaterObstacle& obstacle, uint32_t* id);
+  // Moves obstacle `id` to `centre`, its polygon turned to `rotation_rad`.
+  Status move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad = 0.0f);
+  Status remove_obstacle(uint32_t id);
+
+  // The water's look from the next update() on. A field out of its range (water_look.h) is an
+  // error naming it and its value, and the look stays as it was.
+  Status set_look(const WaterLook& look);
+  const WaterLook& look() const;
 
   // New view size. Call between frames (not between begin_frame and record); images that
   // frames in flight still use are freed once every slot has come round again.

@@ -13,7 +13,8 @@
 //     "objects":   [ { "gltf": "duck.glb", "translation": [..], "rotation": [x,y,z,w],
 //                      "scale": [..], "obstacle": true } ],
 //     "camera":    { "fov_y_deg": 50, "keys": [ { "t": 0.0, "position": [..], "target": [..] } ] },
-//     "render":    { "size": [1280, 720], "fps": 30, "seed": 1 } }
+//     "render":    { "size": [1280, 720], "fps": 30, "seed": 1 },
+//     "look":      { "water_color": [r,g,b], "absorption_per_metre": 1.4, ... } }   WaterLook
 //
 // Defaults of everything optional (metres, seconds, degrees; glTF axes: +Y up):
 //   river.mesh              first mesh of the file
@@ -34,6 +35,8 @@
 //   camera.fov_y_deg        kDefaultCameraFovYDeg (50)
 //   camera.keys             none: the built-in camera that glides down the river
 //   render.size             [1280, 720];  fps 30;  seed 1
+//   look.*                  each field of WaterLook (siviflow/water_look.h), by its name, with
+//                           that struct's default and range
 //
 // Rules: unknown keys and duplicate keys are errors; numbers must be finite; key lists are
 // strictly increasing in t; `gltf` paths are relative to the scene file's folder (absolute paths
@@ -50,6 +53,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
+#include "siviflow/water_look.h"
 #include "sim/obstacle.h"
 #include "sim/procedural_river.h"
 #include "sim/status.h"
@@ -115,6 +119,7 @@ struct SceneFile {
   std::vector<SceneObject> objects;
   SceneCamera camera;
   SceneRender render;
+  WaterLook look;  // the water's starting look (Renderer::set_look() changes it at runtime)
 };
 
 // Reads and checks a scene file (regular file, at most kMaxSceneFileBytes). `out` is left

@@ -1,0 +1,37 @@
+// The water's look: what a technical artist tunes. Renderer::set_look() takes it per frame; a
+// scene file's optional "look" object gives the same fields under the same names. The defaults
+// are the look SiViFlow ships with.
+#pragma once
+
+#include <string>
+
+#include <glm/vec3.hpp>
+
+namespace siviflow {
+
+struct WaterLook {
+  glm::vec3 water_color{0.10f, 0.22f, 0.20f};  // linear RGB of shallow water, each in [0, 1]
+  glm::vec3 deep_color{0.015f, 0.05f, 0.07f};  // linear RGB of deep water, each in [0, 1]
+  // Per metre of view path through the water, in [0, 100]: how fast shallow turns deep, and
+  // how fast what lies behind the water disappears.
+  float absorption_per_metre = 1.4f;
+  float opacity_per_metre = 2.2f;
+  float ripple_strength = 0.55f;  // tilt of the ripples, in [0, 4]: 0 is a flat mirror
+  float ripple_scale = 1.0f;      // size of the ripples relative to the default, in [0.25, 4]
+  // Side of a Tiled Directional Flow tile (one flow direction each), in [1, 8] metres.
+  float tile_size_m = 3.0f;
+  float reflection_distortion = 0.04f;  // screen uv offset per unit of normal tilt, in [0, 0.5]
+  float fresnel_f0 = 0.02f;             // reflectance at normal incidence, in [0, 1]
+  glm::vec3 sun_direction{0.45f, 0.62f, 0.35f};  // towards the sun, finite, any non-zero length
+  glm::vec3 sun_color{1.0f, 1.0f, 1.0f};  // linear multiplier of sunlit water, each in [0, 100]
+};
+
+// Range limits of the tile size: the renderer sizes its water heights for the largest.
+inline constexpr float kMinTileSizeM = 1.0f;
+inline constexpr float kMaxTileSizeM = 8.0f;
+
+// The first field of `look` out of its range, or "" when all are in range; `problem` then says
+// what is wrong with its value, e.g. field "fresnel_f0", problem "1.5 is outside [0, 1]".
+std::string water_look_error(const WaterLook& look, std::string* problem);
+
+}  // namespace siviflow

@@ -1,0 +1,118 @@
+// The water renderer's state, shared by the files that implement Renderer: renderer.cpp
+// (creation, frame graph, frame recording) and water_controls.cpp (runtime obstacles and look).
+#pragma once
+
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+
+#include "passes/passes.h"
+#include "scene/river_simulation.h"
+#include "siviflow/renderer.h"
+#include "static_assets.h"
+#include "view_math.h"
+#include "vk/device_table.h"
+#include "vk/frame_graph.h"
+#include "vk/frame_ring.h"
+#include "vk/gpu_resources.h"
+
+namespace siviflow {
+
+struct Renderer::Impl {
+  CreateInfo info;
+  DeviceTable table;
+  GpuContext gpu;
+  FrameRing ring;
+  RiverInput river_input;         // handed to the simulation by create_static_resources
+  std::vector<float> particle_heights;  // this frame's live particles' heights
+  FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
+  std::vector<Obstacle> obstacles;  // the scene's, then the footprints of objects marked obstacle
+  // Obstacles the host added (add_obstacle), in the flow's order after the scene's.
+  struct RuntimeObstacle {
+    uint32_t id = 0;
+    WaterObstacle placed;  // as last placed: centre and rotation
+  };
+  std::vector<RuntimeObstacle> runtime_obstacles;
+  size_t scene_obstacle_count = 0;  // the flow's obstacles before the runtime ones
+  uint32_t next_obstacle_id = 1;
+  WaterLook look;                    // from the next update() on (set_look)
+  gpu::WaterLookConstants frame_look{};  // of the frame being prepared
+  RiverSimulation simulation;  // the river's flow, particles and flow textures, on the CPU
+  double last_time = 0.0;
+
+  // Geometry and textures that never change, uploaded in the first frame.
+  enum StaticBufferId : uint32_t { kRiverVertices, kRiverIndices };
+  enum StaticImageId : uint32_t { kNormalMap, kWaterHeights };
+  StaticAssets assets;
+  uint32_t river_index_count = 0;
+  FlowPass flow_pass;
+
+  // Images the frame graph declares; created after it compiles, with the usage it derived.
+  struct FrameImage {
+    ImageHandle handle;
+    Image image;
+    bool persistent = false;  // keeps its contents from frame to frame
+  };
+  std::vector<FrameImage> frame_images;
+  bool frame_images_new = true;  // persistent ones have no previous contents yet
+
+  FrameGraph graph;
+  BufferHandle frame_staging;  // the slot's staging block: this frame's flow textures
+  UploadList frame_uploads;    // flow texture and particle aux, every frame
+  ImageHandle host_color;      // imported per frame: the host's colour and depth
+  ImageHandle host_depth;
+  ImageHandle reflection_depth;
+  std::vector<ReadbackCopy> readbacks;  // one per ReadbackImage when readback is enabled
+  FrameBindings bindings;
+  gpu::FlowConstants flow_constants{};
+  gpu::FlowTileConstants tile_constants{};
+  ViewMath view;        // of the frame being prepared
+  glm::mat4 view_view{1.0f};  // its world -> view matrix
+  VkRect2D viewport{};  // in the host's images
+  ReflectionView reflection_view{};
+  // The tile table's lattice (shaders/shared.h): the points around the water at this frame's
+  // tile size, and the table's size, a power of two per axis (fixed at create).
+  glm::vec2 water_lo{0.0f};  // XZ bounds of the river surface
+  glm::vec2 water_hi{0.0f};
+  glm::ivec2 lattice_lo{0};
+  glm::ivec2 lattice_hi{0};
+  TileTableLayout tile_table;  // its corner moves with the camera when the river is larger
+
+  // With CreateInfo::enable_timing: per slot, two timestamps around each pass of the graph.
+  std::vector<VkQueryPool> query_pools;
+  std::vector<uint32_t> timed_passes;  // per slot: passes recorded with timestamps
+  uint32_t current_slot = 0;
+  float timestamp_period_ns = 1.0f;
+  uint64_t timestamp_mask = ~uint64_t{0};  // the queue's valid timestamp bits
+
+  bool unusable = false;  // a resize failed half-way
+  bool frame_begun = false;
+  bool frame_updated = false;
+
+  Status validate_info(const CreateInfo& create);
+  Status take_scene();
+  Status create_static_resources();
+  Status declare_graph();
+  ImageHandle frame_image(ImageHandle handle, bool persistent = false);
+  Status create_frame_images();
+  const Image* find_frame_image(ImageHandle handle) const;
+  void make_tile_lattice(const std::vector<glm::vec3>& surface,
+                         const std::vector<uint32_t>& indices);
+  void place_tile_lattice();
+  glm::ivec2 tile_window() const;
+  size_t runtime_obstacle_index(uint32_t id) const;  // in runtime_obstacles; size() when unknown
+  Status simulate(const View& host_view, double time_seconds);
+  float visible_water_level();
+  Status check_inputs(const FrameInputs& inputs) const;
+  Status bind_frame(const FrameInputs& inputs);
+  Status create_query_pools();
+  void declare_reflection(ImageHandle* color);
+  void retire_frame_images();
+  void destroy();
+};
+
+// An error in what the caller passed: no Vulkan result stands behind it.
+Status argument_error(const std::string& message);
+
+}  // namespace siviflow

@@ -1,0 +1,102 @@
+// What a host changes on a running renderer: obstacles placed at runtime and the water's look.
+#include <cmath>
+#include <string>
+
+#include "renderer_impl.h"
+#include "sim/text_format.h"
+
+namespace siviflow {
+namespace {
+
+// The flow's obstacle for a host's: the polygon turned about +Y (x' = x cos + z sin,
+// z' = -x sin + z cos, as glm::rotate turns +X towards -Z).
+Obstacle flow_obstacle(const WaterObstacle& placed) {
+  Obstacle obstacle;
+  obstacle.centre = placed.centre;
+  obstacle.radius = placed.radius;
+  const float c = std::cos(placed.rotation_rad);
+  const float s = std::sin(placed.rotation_rad);
+  obstacle.polygon.reserve(placed.polygon.size());
+  for (const glm::vec2& p : placed.polygon) {
+    obstacle.polygon.push_back({c * p.x + s * p.y, -s * p.x + c * p.y});
+  }
+  return obstacle;
+}
+
+// The host's obstacle checked as the flow would check it, named by `id`.
+Status check_obstacle(const char* call, const WaterObstacle& placed, uint32_t id) {
+  const std::string prefix = std::string(call) + ": ";
+  if (!std::isfinite(placed.rotation_rad)) {
+    return argument_error(prefix + text_format("obstacle %u: WaterObstacle::rotation_rad %g is not finite",
+                                               id, double(placed.rotation_rad)));
+  }
+  const Status valid = validate_obstacle(flow_obstacle(placed), id);
+  if (!valid.ok()) return argument_error(prefix + valid.message());
+  return Status::success();
+}
+
+}  // namespace
+
+size_t Renderer::Impl::runtime_obstacle_index(uint32_t id) const {
+  for (size_t i = 0; i < runtime_obstacles.size(); ++i) {
+    if (runtime_obstacles[i].id == id) return i;
+  }
+  return runtime_obstacles.size();
+}
+
+Status Renderer::add_obstacle(const WaterObstacle& obstacle, uint32_t* id) {
+  Impl& r = *impl_;
+  if (r.frame_begun) return argument_error("add_obstacle called between begin_frame and record");
+  if (id == nullptr) return argument_error("add_obstacle: id must not be null");
+  const uint32_t new_id = r.next_obstacle_id;
+  SIVIFLOW_TRY(check_obstacle("add_obstacle", obstacle, new_id));
+  SIVIFLOW_TRY(r.simulation.add_obstacle(flow_obstacle(obstacle)));
+  r.runtime_obstacles.push_back({new_id, obstacle});
+  ++r.next_obstacle_id;
+  *id = new_id;
+  return Status::success();
+}
+
+Status Renderer::move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad) {
+  Impl& r = *impl_;
+  if (r.frame_begun) return argument_error("move_obstacle called between begin_frame and record");
+  const size_t i = r.runtime_obstacle_index(id);
+  if (i == r.runtime_obstacles.size()) {
+    return argument_error(text_format("move_obstacle: no obstacle with id %u", id));
+  }
+  WaterObstacle moved = r.runtime_obstacles[i].placed;
+  moved.centre = centre;
+  moved.rotation_rad = rotation_rad;
+  SIVIFLOW_TRY(check_obstacle("move_obstacle", moved, id));
+  const size_t index = r.scene_obstacle_count + i;
+  // A circle, or a polygon that did not turn, only moves: one incremental re-solve.
+  const bool turned = !moved.polygon.empty() && rotation_rad != r.runtime_obstacles[i].placed.rotation_rad;
+  SIVIFLOW_TRY(turned ? r.simulation.replace_obstacle(index, flow_obstacle(moved))
+                      : r.simulation.move_obstacle(index, centre));
+  r.runtime_obstacles[i].placed = std::move(moved);
+  return Status::success();
+}
+
+Status Renderer::remove_obstacle(uint32_t id) {
+  Impl& r = *impl_;
+  if (r.frame_begun) return argument_error("remove_obstacle called between begin_frame and record");
+  const size_t i = r.runtime_obstacle_index(id);
+  if (i == r.runtime_obstacles.size()) {
+    return argument_error(text_format("remove_obstacle: no obstacle with id %u", id));
+  }
+  SIVIFLOW_TRY(r.simulation.remove_obstacle(r.scene_obstacle_count + i));
+  r.runtime_obstacles.erase(r.runtime_obstacles.begin() + static_cast<std::ptrdiff_t>(i));
+  return Status::success();
+}
+
+Status Renderer::set_look(const WaterLook& look) {
+  std::string problem;
+  const std::string field = water_look_error(look, &problem);
+  if (!field.empty()) return argument_error("set_look: WaterLook::" + field + " " + problem);
+  impl_->look = look;
+  return Status::success();
+}
+
+const WaterLook& Renderer::look() const { return impl_->look; }
+
+}  // namespace siviflow

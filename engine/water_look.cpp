@@ -1,0 +1,63 @@
+#include "siviflow/water_look.h"
+
+#include <cmath>
+
+#include "sim/text_format.h"
+
+namespace siviflow {
+namespace {
+
+bool in_range(float value, float lo, float hi) { return value >= lo && value <= hi; }  // NaN: no
+
+std::string range_problem(float value, float lo, float hi) {
+  return text_format("%g is outside [%g, %g]", double(value), double(lo), double(hi));
+}
+
+}  // namespace
+
+std::string water_look_error(const WaterLook& look, std::string* problem) {
+  const struct {
+    const char* name;
+    float value, lo, hi;
+  } scalars[] = {
+      {"absorption_per_metre", look.absorption_per_metre, 0.0f, 100.0f},
+      {"opacity_per_metre", look.opacity_per_metre, 0.0f, 100.0f},
+      {"ripple_strength", look.ripple_strength, 0.0f, 4.0f},
+      {"ripple_scale", look.ripple_scale, 0.25f, 4.0f},
+      {"tile_size_m", look.tile_size_m, kMinTileSizeM, kMaxTileSizeM},
+      {"reflection_distortion", look.reflection_distortion, 0.0f, 0.5f},
+      {"fresnel_f0", look.fresnel_f0, 0.0f, 1.0f},
+  };
+  for (const auto& s : scalars) {
+    if (!in_range(s.value, s.lo, s.hi)) {
+      *problem = range_problem(s.value, s.lo, s.hi);
+      return s.name;
+    }
+  }
+  const struct {
+    const char* name;
+    glm::vec3 value;
+    float hi;
+  } colors[] = {{"water_color", look.water_color, 1.0f},
+                {"deep_color", look.deep_color, 1.0f},
+                {"sun_color", look.sun_color, 100.0f}};
+  for (const auto& c : colors) {
+    for (int i = 0; i < 3; ++i) {
+      if (!in_range(c.value[i], 0.0f, c.hi)) {
+        *problem = text_format("component %d: ", i) + range_problem(c.value[i], 0.0f, c.hi);
+        return c.name;
+      }
+    }
+  }
+  const glm::vec3 sun = look.sun_direction;
+  if (!std::isfinite(sun.x) || !std::isfinite(sun.y) || !std::isfinite(sun.z) ||
+      !(sun.x * sun.x + sun.y * sun.y + sun.z * sun.z > 1e-12f)) {
+    *problem = text_format("(%g, %g, %g) is not a finite, non-zero direction", double(sun.x),
+                           double(sun.y), double(sun.z));
+    return "sun_direction";
+  }
+  problem->clear();
+  return "";
+}
+
+}  // namespace siviflow
