@@ -16,6 +16,7 @@
 #include "scene/water_normal_map.h"
 #include "siviflow/scene_file.h"
 #include "siviflow/scene_river.h"
+#include "sim/text_format.h"
 #include "sim/water_heights.h"
 #include "vk/pipeline.h"
 
@@ -139,6 +140,11 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
                    " is not D32_SFLOAT, D24_UNORM_S8_UINT or D32_SFLOAT_S8_UINT");
   }
   if (info.staging_bytes_per_slot == 0) info.staging_bytes_per_slot = kDefaultStagingBytes;
+  if ((info.readback_images & ~kAllReadbackImages) != 0) {
+    return argument_error("CreateInfo::readback_images 0x" +
+                          text_format("%x", info.readback_images) + " has bits past the " +
+                          std::to_string(kReadbackImageCount) + " ReadbackImage values");
+  }
 
   const char* missing_function = nullptr;
   const VkResult loaded = load_device_table(info.instance, info.physical_device, info.device,
@@ -239,7 +245,8 @@ Status Renderer::Impl::create_static_resources() {
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
   SIVIFLOW_TRY(assets.create(gpu));
   return flow_pass.create(gpu, info.pipeline_cache, info.color_format, info.depth_format,
-                          info.frames_in_flight, info.enable_readback, info.enable_timing);
+                          info.frames_in_flight, (info.readback_images & kAovReadbackImages) != 0,
+                          info.enable_timing);
 }
 
 // The water heights around the river, and the tile table that covers their lattice points (or
@@ -356,7 +363,7 @@ Status Renderer::Impl::declare_graph() {
   water.normal_map = assets.image_handle(kNormalMap);
   water.vertices = assets.buffer_handle(kRiverVertices);
   water.indices = assets.buffer_handle(kRiverIndices);
-  if (info.enable_readback) {
+  if ((info.readback_images & kAovReadbackImages) != 0) {
     water.mask = frame_image(graph.create_image({"water mask", FlowPass::kMaskFormat, extent, transparent}));
     water.normal = frame_image(graph.create_image({"water normal", FlowPass::kNormalFormat, extent, transparent}));
     water.reflection_sample = frame_image(
@@ -373,7 +380,7 @@ Status Renderer::Impl::declare_graph() {
     flow_pass.declare_floor(graph, &flow_constants, river_index_count, water, floor);
   }
 
-  if (info.enable_readback) {
+  if (info.readback_images != 0) {
     const ImageHandle images[kReadbackImageCount] = {water.color,
                                                      host_depth,
                                                      water.mask,
@@ -383,11 +390,14 @@ Status Renderer::Impl::declare_graph() {
                                                      water.reflection_sample,
                                                      water.tile_table};
     readbacks.clear();
+    readback_kinds.clear();
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
-      const BufferHandle buffer = graph.import_buffer(
-          {readback_image_name(static_cast<ReadbackImage>(i)), 0}, ResourceState{},
-          state_of(Access::HostRead));
+      const auto kind = static_cast<ReadbackImage>(i);
+      if ((info.readback_images & readback_bit(kind)) == 0) continue;
+      const BufferHandle buffer = graph.import_buffer({readback_image_name(kind), 0},
+                                                      ResourceState{}, state_of(Access::HostRead));
       readbacks.push_back({images[i], buffer, {}});
+      readback_kinds.push_back(kind);
     }
     add_readback_pass(graph, &readbacks);
   }
@@ -644,15 +654,15 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
     }
     return Status::success();
   };
-  if (info.enable_readback && (viewport.offset.x != 0 || viewport.offset.y != 0)) {
+  if (info.readback_images != 0 && (viewport.offset.x != 0 || viewport.offset.y != 0)) {
     return argument_error("with readback, View::viewport must start at the images' origin");
   }
   SIVIFLOW_TRY(check(inputs.color, "color", info.color_format));
   SIVIFLOW_TRY(check(inputs.depth, "depth", info.depth_format));
-  for (uint32_t i = 0; i < readbacks.size(); ++i) {
-    if (inputs.readback.buffers[i] == VK_NULL_HANDLE) {
-      return argument_error(std::string("readback is enabled but FrameInputs::readback has no ") +
-                            readback_image_name(static_cast<ReadbackImage>(i)) + " buffer");
+  for (const ReadbackImage kind : readback_kinds) {
+    if (inputs.readback.buffers[static_cast<uint32_t>(kind)] == VK_NULL_HANDLE) {
+      return argument_error(std::string("CreateInfo::readback_images asks for the ") +
+                            readback_image_name(kind) + " but FrameInputs::readback has no buffer for it");
     }
   }
   return Status::success();
@@ -682,11 +692,11 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   // The water renders over the view's part of the host's images only.
   b.set_render_area(host_color, viewport);
   b.bind_buffer(frame_staging, ring.staging_buffer());
-  for (uint32_t i = 0; i < readbacks.size(); ++i) {
-    b.bind_buffer(readbacks[i].buffer, inputs.readback.buffers[i]);
+  for (size_t i = 0; i < readbacks.size(); ++i) {
+    const ReadbackImage kind = readback_kinds[i];
+    b.bind_buffer(readbacks[i].buffer, inputs.readback.buffers[static_cast<uint32_t>(kind)]);
     // The host's images are read back over the view's viewport only.
-    const bool host_image = i == static_cast<uint32_t>(ReadbackImage::kColor) ||
-                            i == static_cast<uint32_t>(ReadbackImage::kDepth);
+    const bool host_image = kind == ReadbackImage::kColor || kind == ReadbackImage::kDepth;
     readbacks[i].region = host_image ? viewport : VkRect2D{};
   }
 

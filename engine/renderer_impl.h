@@ -63,7 +63,8 @@ struct Renderer::Impl {
   ImageHandle host_color;      // imported per frame: the host's colour and depth
   ImageHandle host_depth;
   ImageHandle reflection_depth;
-  std::vector<ReadbackCopy> readbacks;  // one per ReadbackImage when readback is enabled
+  std::vector<ReadbackCopy> readbacks;  // one per image CreateInfo::readback_images asks for
+  std::vector<ReadbackImage> readback_kinds;  // which image each of them copies
   FrameBindings bindings;
   gpu::FlowConstants flow_constants{};
   gpu::FlowTileConstants tile_constants{};

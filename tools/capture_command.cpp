@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <glm/gtc/packing.hpp>
@@ -207,6 +208,7 @@ class Capture {
   Status run();
 
  private:
+  uint32_t readback_images() const;
   void copy_out(const SlotTargets& slot);
   Status write_frame();
   void report_progress(uint32_t done_count);
@@ -248,7 +250,7 @@ Status Capture::run() {
   CreateInfo info = context_->renderer_create_info(
       {options_.size.width, options_.size.height}, kOutputFormat);
   info.frames_in_flight = kFramesInFlight;
-  info.enable_readback = true;
+  info.readback_images = readback_images();
   info.seed = options_.seed;
   info.scene = scene_.has_value() ? &*scene_ : nullptr;
   WorldCreateInfo world_info = context_->world_create_info(kOutputFormat, kDepthFormat);
@@ -274,8 +276,9 @@ Status Capture::run() {
     SIVIFLOW_TRY(
         create_host_targets(*context_, kOutputFormat, kDepthFormat, extent, readable, &slot.targets));
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
-      SIVIFLOW_TRY(context_->create_readback_buffer(
-          renderer_->readback_bytes(static_cast<ReadbackImage>(i)), &slot.readback[i]));
+      const auto kind = static_cast<ReadbackImage>(i);
+      if ((info.readback_images & readback_bit(kind)) == 0) continue;
+      SIVIFLOW_TRY(context_->create_readback_buffer(renderer_->readback_bytes(kind), &slot.readback[i]));
     }
   }
 
@@ -326,22 +329,36 @@ Status Capture::run() {
   return Status::success();
 }
 
+// The colour, and what the requested AOVs are made from.
+uint32_t Capture::readback_images() const {
+  uint32_t images = readback_bit(ReadbackImage::kColor);
+  if (options_.depth_aov) images |= readback_bit(ReadbackImage::kDepth);
+  if (options_.flow_aov || options_.particles_aov) {
+    images |= readback_bit(ReadbackImage::kWaterMask) | readback_bit(ReadbackImage::kFlowTexture);
+  }
+  if (options_.normal_aov) images |= readback_bit(ReadbackImage::kNormal);
+  if (options_.reflection_aov) images |= readback_bit(ReadbackImage::kReflection);
+  return images;
+}
+
 void Capture::copy_out(const SlotTargets& slot) {
   const size_t pixels = size_t{options_.size.width} * options_.size.height;
   finished_.frame = slot.frame;
   finished_.camera = slot.camera;
-  const auto* halves = static_cast<const uint16_t*>(slot.readback[index_of(ReadbackImage::kColor)].data);
-  finished_.color_halves.assign(halves, halves + pixels * 4);
-  const auto* depth = static_cast<const float*>(slot.readback[index_of(ReadbackImage::kDepth)].data);
-  finished_.window_depth.assign(depth, depth + pixels);
-  const auto* mask = static_cast<const float*>(slot.readback[index_of(ReadbackImage::kWaterMask)].data);
-  finished_.water_mask.assign(mask, mask + pixels);
-  const auto* flow = static_cast<const std::byte*>(slot.readback[index_of(ReadbackImage::kFlowTexture)].data);
-  finished_.flow_texture.assign(flow, flow + renderer_->readback_bytes(ReadbackImage::kFlowTexture));
-  const auto* normal = static_cast<const float*>(slot.readback[index_of(ReadbackImage::kNormal)].data);
-  finished_.normal.assign(normal, normal + pixels * 4);
-  const auto* reflection = static_cast<const float*>(slot.readback[index_of(ReadbackImage::kReflection)].data);
-  finished_.reflection.assign(reflection, reflection + pixels * 4);
+  // Each read-back image's bytes; the images not read back are left empty.
+  const auto copy = [&slot](ReadbackImage kind, size_t count, auto* out) {
+    using T = typename std::remove_reference_t<decltype(*out)>::value_type;
+    const auto* data = static_cast<const T*>(slot.readback[index_of(kind)].data);
+    if (data == nullptr) return;
+    out->assign(data, data + count);
+  };
+  copy(ReadbackImage::kColor, pixels * 4, &finished_.color_halves);
+  copy(ReadbackImage::kDepth, pixels, &finished_.window_depth);
+  copy(ReadbackImage::kWaterMask, pixels, &finished_.water_mask);
+  copy(ReadbackImage::kFlowTexture, renderer_->readback_bytes(ReadbackImage::kFlowTexture),
+       &finished_.flow_texture);
+  copy(ReadbackImage::kNormal, pixels * 4, &finished_.normal);
+  copy(ReadbackImage::kReflection, pixels * 4, &finished_.reflection);
   finished_.particles = slot.particles;
 }
 

@@ -27,7 +27,7 @@ int main() {
   if (!status.ok()) return std::fprintf(stderr, "%s\n", status.message().c_str()), 1;
   CreateInfo info = host->renderer_create_info(extent, color);
   info.depth_format = depth;
-  info.enable_readback = true;
+  info.readback_images = kAllReadbackImages;
   info.reflection = &World::draw_reflection;
   info.reflection_user = world.get();
   std::unique_ptr<Renderer> renderer;

@@ -40,7 +40,7 @@ class GpuTest : public ::testing::Test {
     CreateInfo info = context_->renderer_create_info({width, height}, VK_FORMAT_R16G16B16A16_SFLOAT);
     info.depth_format = VK_FORMAT_D32_SFLOAT;
     info.frames_in_flight = 2;
-    info.enable_readback = true;
+    info.readback_images = kAllReadbackImages;
     return info;
   }
 

@@ -52,7 +52,9 @@ class HostEmbeddingTest : public GpuTest {
     Status status = World::create(world_info, &world_);
     ASSERT_TRUE(status.ok()) << status.message();
     CreateInfo info = make_create_info(kWidth, kHeight);
-    info.enable_readback = readback;
+    info.readback_images = readback ? readback_bit(ReadbackImage::kDepth) |
+                                          readback_bit(ReadbackImage::kWaterMask)
+                                    : 0;
     info.seed = seed;
     info.reflection = &World::draw_reflection;
     info.reflection_user = world_.get();
@@ -77,10 +79,10 @@ class HostEmbeddingTest : public GpuTest {
     HostBuffer readback[kReadbackImageCount];
     ReadbackTargets targets;
     const bool reads_back = read_back_;
-    if (reads_back) {
-      for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
-        EXPECT_TRUE(context_->create_readback_buffer(
-            renderer_->readback_bytes(static_cast<ReadbackImage>(i)), &readback[i]).ok());
+    if (reads_back) {  // only the two images asked for
+      for (const ReadbackImage kind : {ReadbackImage::kDepth, ReadbackImage::kWaterMask}) {
+        const auto i = static_cast<uint32_t>(kind);
+        EXPECT_TRUE(context_->create_readback_buffer(renderer_->readback_bytes(kind), &readback[i]).ok());
         targets.buffers[i] = readback[i].buffer;
       }
     }

@@ -463,6 +463,29 @@ TEST_F(RenderTest, FrameGraphRunsWaterPassesOnly) {
   EXPECT_NE(renderer_->dump_frame_graph_graphviz().find("digraph"), std::string::npos);
 }
 
+TEST_F(RenderTest, ReadbackIsAskedForPerImage) {
+  // Colour alone: copied, with the plain water pipeline (no AOV attachments).
+  CreateInfo info = make_create_info(kWidth, kHeight);
+  info.readback_images = readback_bit(ReadbackImage::kColor);
+  ASSERT_TRUE(create_renderer(info).ok());
+  std::string dump = renderer_->dump_frame_graph();
+  EXPECT_NE(dump.find("readback colour"), std::string::npos) << dump;
+  EXPECT_EQ(dump.find("readback water mask"), std::string::npos) << dump;
+  EXPECT_EQ(dump.find("water normal"), std::string::npos) << "no AOV attachments\n" << dump;
+  // The normal: the AOV attachments come in, and only the normal is copied.
+  info.readback_images = readback_bit(ReadbackImage::kNormal);
+  ASSERT_TRUE(create_renderer(info).ok());
+  dump = renderer_->dump_frame_graph();
+  EXPECT_NE(dump.find("readback water normal"), std::string::npos) << dump;
+  EXPECT_EQ(dump.find("readback colour"), std::string::npos) << dump;
+  EXPECT_EQ(dump.find("readback reflection sample"), std::string::npos) << dump;
+  // Bits past the images are refused by value.
+  info.readback_images = 1u << 12;
+  const Status status = create_renderer(info);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("readback_images 0x1000"), std::string::npos) << status.message();
+}
+
 TEST_F(RenderTest, BadCreateInfoIsReportedNotCrashed) {
   CreateInfo info = make_create_info(0, kHeight);
   Status status = Renderer::create(info, &renderer_);

@@ -72,7 +72,9 @@ struct CreateInfo {
   // Host depth image format: D32_SFLOAT (0 means this), D24_UNORM_S8_UINT or D32_SFLOAT_S8_UINT.
   VkFormat depth_format = VK_FORMAT_UNDEFINED;
   VkExtent2D extent = {0, 0};          // the view's size in pixels (its viewport); required
-  bool enable_readback = false;        // record copies of the frame's images into host buffers
+  // The images to copy into host buffers each frame (ReadbackImage bits, readback_bit()); 0,
+  // the shipping path: no copies and no AOV attachments.
+  uint32_t readback_images = 0;
   uint64_t seed = 0;                   // seed of the river particles' random choices
   // The scene to render (its river, flow, obstacles, objects and camera keys); null: the
   // built-in default scene. Read by create() only: the renderer copies what it needs.
@@ -158,7 +160,7 @@ struct ExternalImage {
   ImageState final;
 };
 
-// What CreateInfo::enable_readback copies each frame into host-visible buffers, tightly packed
+// What CreateInfo::readback_images can copy each frame into host-visible buffers, tightly packed
 // rows, top-left origin of the view's viewport:
 enum class ReadbackImage : uint32_t {
   kColor,        // the host's colour with the water, in its format's texels
@@ -171,6 +173,13 @@ enum class ReadbackImage : uint32_t {
   kTileTable,    // RGBA32UI: the water's tile table (shaders/shared.h), tile_table_layout()
 };
 inline constexpr uint32_t kReadbackImageCount = 8;
+constexpr uint32_t readback_bit(ReadbackImage image) { return 1u << static_cast<uint32_t>(image); }
+inline constexpr uint32_t kAllReadbackImages = (1u << kReadbackImageCount) - 1;
+// The water mask, normal and reflection sample come from extra attachments of the water pass,
+// added only when one of them is read back.
+inline constexpr uint32_t kAovReadbackImages = readback_bit(ReadbackImage::kWaterMask) |
+                                               readback_bit(ReadbackImage::kNormal) |
+                                               readback_bit(ReadbackImage::kReflection);
 
 // The tile table of the water material (shaders/shared.h): its size and which lattice points
 // the last updated frame put in it (the corner moves with the camera on rivers larger than the
@@ -186,7 +195,7 @@ struct TileTableLayout {
 const char* readback_image_name(ReadbackImage image);
 
 struct ReadbackTargets {
-  VkBuffer buffers[kReadbackImageCount] = {};  // indexed by ReadbackImage
+  VkBuffer buffers[kReadbackImageCount] = {};  // indexed by ReadbackImage; those read back only
   VkBuffer& operator[](ReadbackImage image) { return buffers[static_cast<uint32_t>(image)]; }
 };
 
