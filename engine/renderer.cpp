@@ -8,6 +8,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -67,10 +68,6 @@ bool is_host_depth_format(VkFormat format) {
          format == VK_FORMAT_D32_SFLOAT_S8_UINT;
 }
 
-Status invalid(const std::string& message) {
-  return Status::error("siviflow::Renderer: " + message, VK_ERROR_INITIALIZATION_FAILED);
-}
-
 std::string extent_text(VkExtent2D extent) {
   return std::to_string(extent.width) + "x" + std::to_string(extent.height);
 }
@@ -98,7 +95,7 @@ float longest_edge_xz(const std::vector<glm::vec3>& positions,
 }  // namespace
 
 Status argument_error(const std::string& message) {
-  return Status::error("siviflow::Renderer: " + message);
+  return Status::error(std::string(kRendererErrorPrefix) + message);
 }
 
 View camera_view(const Camera& camera, VkExtent2D extent) {
@@ -119,24 +116,24 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
   info = create;
   if (info.instance == VK_NULL_HANDLE || info.physical_device == VK_NULL_HANDLE ||
       info.device == VK_NULL_HANDLE || info.get_instance_proc_addr == nullptr) {
-    return invalid("CreateInfo needs instance, physical_device, device and get_instance_proc_addr");
+    return argument_error("CreateInfo needs instance, physical_device, device and get_instance_proc_addr");
   }
   if (info.extent.width == 0 || info.extent.height == 0) {
-    return invalid("CreateInfo::extent must be at least 1x1");
+    return argument_error("CreateInfo::extent must be at least 1x1");
   }
   if (info.frames_in_flight == 0) info.frames_in_flight = kDefaultFramesInFlight;
   if (info.frames_in_flight > kMaxFramesInFlight) {
-    return invalid("CreateInfo::frames_in_flight " + std::to_string(info.frames_in_flight) +
+    return argument_error("CreateInfo::frames_in_flight " + std::to_string(info.frames_in_flight) +
                    " exceeds " + std::to_string(kMaxFramesInFlight));
   }
   if (info.color_format == VK_FORMAT_UNDEFINED) info.color_format = kDefaultColorFormat;
   if (texel_bytes(info.color_format) == 0) {
-    return invalid("CreateInfo::color_format " + std::to_string(info.color_format) +
+    return argument_error("CreateInfo::color_format " + std::to_string(info.color_format) +
                    " is not an RGBA8, RGBA16F or RGBA32F format");
   }
   if (info.depth_format == VK_FORMAT_UNDEFINED) info.depth_format = kDefaultDepthFormat;
   if (!is_host_depth_format(info.depth_format)) {
-    return invalid("CreateInfo::depth_format " + std::to_string(info.depth_format) +
+    return argument_error("CreateInfo::depth_format " + std::to_string(info.depth_format) +
                    " is not D32_SFLOAT, D24_UNORM_S8_UINT or D32_SFLOAT_S8_UINT");
   }
   if (info.staging_bytes_per_slot == 0) info.staging_bytes_per_slot = kDefaultStagingBytes;
@@ -155,7 +152,7 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
   }
   gpu = make_gpu_context(table, info.allocation_callbacks);
   if (info.enabled_features == nullptr) {
-    return invalid("CreateInfo::enabled_features must point to the feature chain the device was "
+    return argument_error("CreateInfo::enabled_features must point to the feature chain the device was "
                    "created with");
   }
   const std::vector<std::string> missing = missing_device_features(info.enabled_features);
@@ -172,14 +169,14 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
   table.vkGetPhysicalDeviceQueueFamilyProperties(info.physical_device, &family_count, families.data());
   if (info.queue_family_index >= family_count ||
       (families[info.queue_family_index].queueFlags & VK_QUEUE_GRAPHICS_BIT) == 0) {
-    return invalid("CreateInfo::queue_family_index " + std::to_string(info.queue_family_index) +
+    return argument_error("CreateInfo::queue_family_index " + std::to_string(info.queue_family_index) +
                    " is not a graphics queue family of this device");
   }
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   table.vkGetPhysicalDeviceProperties2(info.physical_device, &props);
   const uint32_t limit = props.properties.limits.maxImageDimension2D;
   if (info.extent.width > limit || info.extent.height > limit) {
-    return invalid("extent " + std::to_string(info.extent.width) + "x" +
+    return argument_error("extent " + std::to_string(info.extent.width) + "x" +
                    std::to_string(info.extent.height) + " exceeds the device limit of " +
                    std::to_string(limit));
   }
@@ -481,7 +478,10 @@ Status Renderer::Impl::create_query_pools() {
   std::vector<VkQueueFamilyProperties> families(family_count);
   table.vkGetPhysicalDeviceQueueFamilyProperties(info.physical_device, &family_count, families.data());
   const uint32_t bits = families[info.queue_family_index].timestampValidBits;
-  if (bits == 0) return invalid("enable_timing: the queue family has no timestamps");
+  if (bits == 0) {
+    return Status::error("siviflow::Renderer: enable_timing: the queue family has no timestamps",
+                         VK_ERROR_FEATURE_NOT_PRESENT);
+  }
   timestamp_mask = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
   VkQueryPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
   pool_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
@@ -496,19 +496,24 @@ Status Renderer::Impl::create_query_pools() {
 }
 
 Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) {
-  auto impl = std::make_unique<Impl>();
-  Status status = impl->validate_info(info);
-  if (status.ok()) status = impl->take_scene();
-  if (status.ok()) status = impl->create_static_resources();
-  if (status.ok()) status = impl->declare_graph();
-  if (status.ok() && info.enable_timing) status = impl->create_query_pools();
-  if (!status.ok()) {
-    if (info.log != nullptr) info.log(LogLevel::kError, status.message().c_str(), info.log_user);
-    impl->destroy();
+  return guarded(info, [&]() -> Status {
+    if (out == nullptr) return argument_error("create: out must not be null");
+    auto impl = std::make_unique<Impl>();
+    Status status;
+    try {
+      status = impl->validate_info(info);
+      if (status.ok()) status = impl->take_scene();
+      if (status.ok()) status = impl->create_static_resources();
+      if (status.ok()) status = impl->declare_graph();
+      if (status.ok() && info.enable_timing) status = impl->create_query_pools();
+      if (status.ok()) out->reset(new Renderer(std::move(impl)));
+    } catch (...) {
+      impl->destroy();  // the Vulkan objects made so far
+      throw;
+    }
+    if (!status.ok()) impl->destroy();
     return status;
-  }
-  out->reset(new Renderer(std::move(impl)));
-  return Status::success();
+  });
 }
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -516,12 +521,14 @@ Renderer::~Renderer() { impl_->destroy(); }
 
 Status Renderer::begin_frame(uint32_t slot) {
   Impl& r = *impl_;
-  if (r.unusable) return Status::error("Renderer: a resize failed; resize again before rendering");
-  SIVIFLOW_TRY(r.ring.begin_slot(slot));
-  r.current_slot = slot;
-  r.frame_begun = true;
-  r.frame_updated = false;
-  return Status::success();
+  return guarded(r.info, [&]() -> Status {
+    if (r.unusable) return argument_error("a resize failed; resize again before rendering");
+    SIVIFLOW_TRY(r.ring.begin_slot(slot));
+    r.current_slot = slot;
+    r.frame_begun = true;
+    r.frame_updated = false;
+    return Status::success();
+  });
 }
 
 Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
@@ -607,25 +614,30 @@ float Renderer::Impl::visible_water_level() {
 }
 
 Status Renderer::simulate(const View& view, double time_seconds) {
-  if (impl_->frame_begun) return Status::error("Renderer::simulate called between begin_frame and record");
-  return impl_->simulate(view, time_seconds);
+  Impl& r = *impl_;
+  return guarded(r.info, [&]() -> Status {
+    if (r.frame_begun) return argument_error("simulate called between begin_frame and record");
+    return r.simulate(view, time_seconds);
+  });
 }
 
 Status Renderer::update(const View& view, double time_seconds) {
   Impl& r = *impl_;
-  if (!r.frame_begun) return Status::error("Renderer::update called before begin_frame");
-  if (r.frame_updated) return Status::error("Renderer::update called twice for one frame");
-  // Staging first: a failure there must not leave the particles one frame ahead.
-  const FlowTextureLayout& layout = r.simulation.layout();
-  StagingAllocation staging;
-  SIVIFLOW_TRY(r.ring.allocate_staging(layout.total_bytes, kStagingAlignment, &staging));
-  SIVIFLOW_TRY(r.simulate(view, time_seconds));
-  SIVIFLOW_TRY(r.simulation.pack({static_cast<std::byte*>(staging.data), layout.total_bytes}));
-  r.frame_uploads.images[0].staging_offset = staging.offset + layout.flow_offset;
-  r.frame_uploads.images[1].staging_offset = staging.offset + layout.aux_offset;
-  if (!r.assets.uploaded() && !r.assets.staged()) SIVIFLOW_TRY(r.assets.stage(r.gpu));
-  r.frame_updated = true;
-  return Status::success();
+  return guarded(r.info, [&]() -> Status {
+    if (!r.frame_begun) return argument_error("update called before begin_frame");
+    if (r.frame_updated) return argument_error("update called twice for one frame");
+    // Staging first: a failure there must not leave the particles one frame ahead.
+    const FlowTextureLayout& layout = r.simulation.layout();
+    StagingAllocation staging;
+    SIVIFLOW_TRY(r.ring.allocate_staging(layout.total_bytes, kStagingAlignment, &staging));
+    SIVIFLOW_TRY(r.simulate(view, time_seconds));
+    SIVIFLOW_TRY(r.simulation.pack({static_cast<std::byte*>(staging.data), layout.total_bytes}));
+    r.frame_uploads.images[0].staging_offset = staging.offset + layout.flow_offset;
+    r.frame_uploads.images[1].staging_offset = staging.offset + layout.aux_offset;
+    if (!r.assets.uploaded() && !r.assets.staged()) SIVIFLOW_TRY(r.assets.stage(r.gpu));
+    r.frame_updated = true;
+    return Status::success();
+  });
 }
 
 // The host's word on an image against the configuration: an error names the image and the
@@ -711,54 +723,59 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   SIVIFLOW_TRY(vk_status(
       table.vkCreateImageView(table.device, &view_info, gpu.allocation_callbacks, &depth_view),
       "vkCreateImageView (host depth)"));
-  ring.defer_deletion([gpu_context = gpu, depth_view] {
+  const auto destroy_view = [gpu_context = gpu, depth_view] {
     gpu_context.table->vkDestroyImageView(gpu_context.table->device, depth_view,
                                           gpu_context.allocation_callbacks);
-  });
+  };
+  try {
+    ring.defer_deletion(destroy_view);
+  } catch (...) {  // not queued: nothing has used the view yet
+    destroy_view();
+    throw;
+  }
   flow_pass.set_frame(gpu, {current_slot, depth_view, view.reverse_z, viewport, frame_look});
   return Status::success();
 }
 
 Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   Impl& r = *impl_;
-  const auto logged = [&r](const Status& status) {
-    if (!status.ok() && r.info.log != nullptr) {
-      r.info.log(LogLevel::kError, status.message().c_str(), r.info.log_user);
+  return guarded(r.info, [&]() -> Status {
+    if (!r.frame_updated) return argument_error("record called before begin_frame and update");
+    SIVIFLOW_TRY(r.check_inputs(inputs));
+    if (!r.assets.uploaded()) SIVIFLOW_TRY(r.assets.record_upload(r.table, cmd));
+    SIVIFLOW_TRY(r.bind_frame(inputs));
+    FrameGraph::Timestamps timestamps;
+    if (!r.query_pools.empty()) {
+      const uint32_t passes = static_cast<uint32_t>(r.graph.pass_order().size());
+      if (passes > kMaxTimedPasses) return argument_error("too many passes to time");
+      timestamps.pool = r.query_pools[r.current_slot];
+      r.table.vkCmdResetQueryPool(cmd, timestamps.pool, 0, 2 * passes);
+      r.timed_passes[r.current_slot] = passes;
     }
-    return status;
-  };
-  if (!r.frame_updated) {
-    return logged(Status::error("siviflow::Renderer: record called before begin_frame and update"));
-  }
-  SIVIFLOW_TRY(logged(r.check_inputs(inputs)));
-  if (!r.assets.uploaded()) SIVIFLOW_TRY(logged(r.assets.record_upload(r.table, cmd)));
-  SIVIFLOW_TRY(logged(r.bind_frame(inputs)));
-  FrameGraph::Timestamps timestamps;
-  if (!r.query_pools.empty()) {
-    const uint32_t passes = static_cast<uint32_t>(r.graph.pass_order().size());
-    if (passes > kMaxTimedPasses) return logged(argument_error("too many passes to time"));
-    timestamps.pool = r.query_pools[r.current_slot];
-    r.table.vkCmdResetQueryPool(cmd, timestamps.pool, 0, 2 * passes);
-    r.timed_passes[r.current_slot] = passes;
-  }
-  SIVIFLOW_TRY(logged(
-      r.graph.execute(r.table, cmd, r.bindings, r.query_pools.empty() ? nullptr : &timestamps)));
-  if (!r.assets.uploaded()) r.assets.finish_upload(r.ring, r.gpu);
-  r.frame_images_new = false;
-  r.frame_begun = false;
-  r.frame_updated = false;
-  return Status::success();
+    SIVIFLOW_TRY(
+        r.graph.execute(r.table, cmd, r.bindings, r.query_pools.empty() ? nullptr : &timestamps));
+    if (!r.assets.uploaded()) r.assets.finish_upload(r.ring, r.gpu);
+    r.frame_images_new = false;
+    r.frame_begun = false;
+    r.frame_updated = false;
+    return Status::success();
+  });
 }
 
 Status Renderer::resize(VkExtent2D extent) {
   Impl& r = *impl_;
-  if (r.frame_begun) return Status::error("Renderer::resize called between begin_frame and record");
-  if (extent.width == 0 || extent.height == 0) return invalid("resize: extent must be at least 1x1");
+  return guarded(r.info, [&] { return r.resize(extent); });
+}
+
+Status Renderer::Impl::resize(VkExtent2D extent) {
+  Impl& r = *this;
+  if (r.frame_begun) return argument_error("resize called between begin_frame and record");
+  if (extent.width == 0 || extent.height == 0) return argument_error("resize: extent must be at least 1x1");
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   r.table.vkGetPhysicalDeviceProperties2(r.info.physical_device, &props);
   const uint32_t limit = props.properties.limits.maxImageDimension2D;
   if (extent.width > limit || extent.height > limit) {
-    return invalid("resize: extent " + extent_text(extent) + " exceeds the device limit of " +
+    return argument_error("resize: extent " + extent_text(extent) + " exceeds the device limit of " +
                    std::to_string(limit));
   }
   // The particles live in screen space: a new viewport starts them afresh at frame 0. This can
@@ -829,9 +846,14 @@ uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 
 Status Renderer::pass_times(uint32_t slot, std::vector<PassTime>* out) const {
   const Impl& r = *impl_;
+  return guarded(r.info, [&] { return r.pass_times(slot, out); });
+}
+
+Status Renderer::Impl::pass_times(uint32_t slot, std::vector<PassTime>* out) const {
+  const Impl& r = *this;
   out->clear();
-  if (r.query_pools.empty()) return Status::error("Renderer::pass_times needs CreateInfo::enable_timing");
-  if (slot >= r.query_pools.size()) return Status::error("Renderer::pass_times: slot out of range");
+  if (r.query_pools.empty()) return argument_error("pass_times needs CreateInfo::enable_timing");
+  if (slot >= r.query_pools.size()) return argument_error("pass_times: slot out of range");
   const uint32_t passes = r.timed_passes[slot];
   if (passes == 0) return Status::success();
   std::vector<uint64_t> ticks(2 * passes);

@@ -2,11 +2,15 @@
 // (creation, frame graph, frame recording) and water_controls.cpp (runtime obstacles and look).
 #pragma once
 
+#include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 
+#include "entry_guard.h"
 #include "passes/passes.h"
 #include "scene/river_simulation.h"
 #include "siviflow/renderer.h"
@@ -103,11 +107,17 @@ struct Renderer::Impl {
   void place_tile_lattice();
   glm::ivec2 tile_window() const;
   size_t runtime_obstacle_index(uint32_t id) const;  // in runtime_obstacles; size() when unknown
+  Status add_obstacle(const WaterObstacle& obstacle, uint32_t* id);
+  Status move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad);
+  Status remove_obstacle(uint32_t id);
+  Status set_look(const WaterLook& new_look);
   Status simulate(const View& host_view, double time_seconds);
   float visible_water_level();
   Status check_inputs(const FrameInputs& inputs) const;
   Status bind_frame(const FrameInputs& inputs);
   Status create_query_pools();
+  Status resize(VkExtent2D extent);
+  Status pass_times(uint32_t slot, std::vector<PassTime>* out) const;
   void declare_reflection(ImageHandle* color);
   void retire_frame_images();
   void destroy();
@@ -115,5 +125,13 @@ struct Renderer::Impl {
 
 // An error in what the caller passed: no Vulkan result stands behind it.
 Status argument_error(const std::string& message);
+
+inline constexpr std::string_view kRendererErrorPrefix = "siviflow::Renderer: ";
+
+// A public entry point's body, guarded (entry_guard.h) with the renderer's prefix and log.
+template <typename Body>
+Status guarded(const CreateInfo& info, Body&& body) noexcept {
+  return guarded(kRendererErrorPrefix, info.log, info.log_user, std::forward<Body>(body));
+}
 
 }  // namespace siviflow

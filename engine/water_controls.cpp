@@ -45,55 +45,68 @@ size_t Renderer::Impl::runtime_obstacle_index(uint32_t id) const {
 }
 
 Status Renderer::add_obstacle(const WaterObstacle& obstacle, uint32_t* id) {
-  Impl& r = *impl_;
-  if (r.frame_begun) return argument_error("add_obstacle called between begin_frame and record");
+  return guarded(impl_->info, [&] { return impl_->add_obstacle(obstacle, id); });
+}
+
+Status Renderer::move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad) {
+  return guarded(impl_->info, [&] { return impl_->move_obstacle(id, centre, rotation_rad); });
+}
+
+Status Renderer::remove_obstacle(uint32_t id) {
+  return guarded(impl_->info, [&] { return impl_->remove_obstacle(id); });
+}
+
+Status Renderer::set_look(const WaterLook& look) {
+  return guarded(impl_->info, [&] { return impl_->set_look(look); });
+}
+
+Status Renderer::Impl::add_obstacle(const WaterObstacle& obstacle, uint32_t* id) {
+  if (frame_begun) return argument_error("add_obstacle called between begin_frame and record");
   if (id == nullptr) return argument_error("add_obstacle: id must not be null");
-  const uint32_t new_id = r.next_obstacle_id;
+  const uint32_t new_id = next_obstacle_id;
   SIVIFLOW_TRY(check_obstacle("add_obstacle", obstacle, new_id));
-  SIVIFLOW_TRY(r.simulation.add_obstacle(flow_obstacle(obstacle)));
-  r.runtime_obstacles.push_back({new_id, obstacle});
-  ++r.next_obstacle_id;
+  SIVIFLOW_TRY(simulation.add_obstacle(flow_obstacle(obstacle)));
+  runtime_obstacles.push_back({new_id, obstacle});
+  ++next_obstacle_id;
   *id = new_id;
   return Status::success();
 }
 
-Status Renderer::move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad) {
-  Impl& r = *impl_;
-  if (r.frame_begun) return argument_error("move_obstacle called between begin_frame and record");
-  const size_t i = r.runtime_obstacle_index(id);
-  if (i == r.runtime_obstacles.size()) {
+Status Renderer::Impl::move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad) {
+  if (frame_begun) return argument_error("move_obstacle called between begin_frame and record");
+  const size_t i = runtime_obstacle_index(id);
+  if (i == runtime_obstacles.size()) {
     return argument_error(text_format("move_obstacle: no obstacle with id %u", id));
   }
-  WaterObstacle moved = r.runtime_obstacles[i].placed;
+  WaterObstacle moved = runtime_obstacles[i].placed;
   moved.centre = centre;
   moved.rotation_rad = rotation_rad;
   SIVIFLOW_TRY(check_obstacle("move_obstacle", moved, id));
-  const size_t index = r.scene_obstacle_count + i;
+  const size_t index = scene_obstacle_count + i;
   // A circle, or a polygon that did not turn, only moves: one incremental re-solve.
-  const bool turned = !moved.polygon.empty() && rotation_rad != r.runtime_obstacles[i].placed.rotation_rad;
-  SIVIFLOW_TRY(turned ? r.simulation.replace_obstacle(index, flow_obstacle(moved))
-                      : r.simulation.move_obstacle(index, centre));
-  r.runtime_obstacles[i].placed = std::move(moved);
+  const bool turned = !moved.polygon.empty() && rotation_rad != runtime_obstacles[i].placed.rotation_rad;
+  SIVIFLOW_TRY(turned ? simulation.replace_obstacle(index, flow_obstacle(moved))
+                      : simulation.move_obstacle(index, centre));
+  runtime_obstacles[i].placed = std::move(moved);
   return Status::success();
 }
 
-Status Renderer::remove_obstacle(uint32_t id) {
-  Impl& r = *impl_;
-  if (r.frame_begun) return argument_error("remove_obstacle called between begin_frame and record");
-  const size_t i = r.runtime_obstacle_index(id);
-  if (i == r.runtime_obstacles.size()) {
+Status Renderer::Impl::remove_obstacle(uint32_t id) {
+  if (frame_begun) return argument_error("remove_obstacle called between begin_frame and record");
+  const size_t i = runtime_obstacle_index(id);
+  if (i == runtime_obstacles.size()) {
     return argument_error(text_format("remove_obstacle: no obstacle with id %u", id));
   }
-  SIVIFLOW_TRY(r.simulation.remove_obstacle(r.scene_obstacle_count + i));
-  r.runtime_obstacles.erase(r.runtime_obstacles.begin() + static_cast<std::ptrdiff_t>(i));
+  SIVIFLOW_TRY(simulation.remove_obstacle(scene_obstacle_count + i));
+  runtime_obstacles.erase(runtime_obstacles.begin() + static_cast<std::ptrdiff_t>(i));
   return Status::success();
 }
 
-Status Renderer::set_look(const WaterLook& look) {
+Status Renderer::Impl::set_look(const WaterLook& new_look) {
   std::string problem;
-  const std::string field = water_look_error(look, &problem);
+  const std::string field = water_look_error(new_look, &problem);
   if (!field.empty()) return argument_error("set_look: WaterLook::" + field + " " + problem);
-  impl_->look = look;
+  look = new_look;
   return Status::success();
 }
 

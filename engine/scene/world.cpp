@@ -4,10 +4,12 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "entry_guard.h"
 #include "passes/passes.h"
 #include "scene/default_scene.h"
 #include "scene/detail_texture.h"
@@ -32,8 +34,10 @@ constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;  // the render
 constexpr VkFormat kDetailFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr VkFormat kBaseColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
 
+constexpr std::string_view kWorldErrorPrefix = "siviflow::World: ";
+
 Status world_error(const std::string& message) {
-  return Status::error("siviflow::World: " + message);
+  return Status::error(std::string(kWorldErrorPrefix) + message);
 }
 
 template <typename Items>
@@ -96,6 +100,9 @@ struct World::Impl {
                                      const glm::vec4& clip_plane, bool reverse) const;
   void place_obstacles(size_t which, const gpu::SceneConstants& constants);
   void destroy();
+  static Status create(const WorldCreateInfo& info, std::unique_ptr<World>* out);
+  Status record(VkCommandBuffer cmd, uint32_t slot, const View& view, double time_seconds,
+                const ExternalImage& host_color, const ExternalImage& host_depth);
 };
 
 Status World::Impl::load_scene() {
@@ -209,6 +216,11 @@ void World::Impl::destroy() {
 }
 
 Status World::create(const WorldCreateInfo& info, std::unique_ptr<World>* out) {
+  return guarded(kWorldErrorPrefix, nullptr, nullptr, [&] { return Impl::create(info, out); });
+}
+
+Status World::Impl::create(const WorldCreateInfo& info, std::unique_ptr<World>* out) {
+  if (out == nullptr) return world_error("create: out must not be null");
   auto impl = std::make_unique<Impl>();
   Impl& w = *impl;
   w.info = info;
@@ -226,12 +238,18 @@ Status World::create(const WorldCreateInfo& info, std::unique_ptr<World>* out) {
                         info.get_instance_proc_addr, info.get_device_proc_addr, info.debug_utils,
                         &w.table, &missing);
   if (loaded != VK_SUCCESS) {
-    return Status::error(std::string("siviflow::World: cannot load ") + missing, loaded);
+    return Status::error(std::string(kWorldErrorPrefix) + "cannot load " + missing, loaded);
   }
   w.gpu = make_gpu_context(w.table, info.allocation_callbacks);
-  Status status = w.load_scene();
-  if (status.ok()) status = w.create_resources();
-  if (status.ok()) status = w.declare_graph();
+  Status status;
+  try {
+    status = w.load_scene();
+    if (status.ok()) status = w.create_resources();
+    if (status.ok()) status = w.declare_graph();
+  } catch (...) {
+    w.destroy();  // the Vulkan objects made so far
+    throw;
+  }
   if (!status.ok()) {
     w.destroy();
     return status;
@@ -272,8 +290,15 @@ Camera World::scene_camera(double time_seconds) const {
 
 Status World::record(VkCommandBuffer cmd, uint32_t slot, const View& view, double time_seconds,
                      const ExternalImage& color, const ExternalImage& depth) {
-  Impl& w = *impl_;
-  if (color.format != w.info.color_format || depth.format != w.info.depth_format) {
+  return guarded(kWorldErrorPrefix, nullptr, nullptr,
+                 [&] { return impl_->record(cmd, slot, view, time_seconds, color, depth); });
+}
+
+Status World::Impl::record(VkCommandBuffer cmd, uint32_t slot, const View& view,
+                           double time_seconds, const ExternalImage& host_color,
+                           const ExternalImage& host_depth) {
+  Impl& w = *this;
+  if (host_color.format != w.info.color_format || host_depth.format != w.info.depth_format) {
     return world_error("colour or depth image format differs from WorldCreateInfo's");
   }
   ViewMath math;
@@ -298,11 +323,11 @@ Status World::record(VkCommandBuffer cmd, uint32_t slot, const View& view, doubl
     b.set_incoming(handle, {image.current.stage, image.current.access, image.current.layout});
     b.set_outgoing(handle, {image.final.stage, image.final.access, image.final.layout});
   };
-  bind_host(w.color, color);
-  bind_host(w.depth, depth);
+  bind_host(w.color, host_color);
+  bind_host(w.depth, host_depth);
   w.frame.viewport = view.viewport;
   if (w.frame.viewport.extent.width == 0 && w.frame.viewport.extent.height == 0) {
-    w.frame.viewport.extent = color.extent;
+    w.frame.viewport.extent = host_color.extent;
   }
   b.set_render_area(w.color, w.frame.viewport);  // the view's part only: cleared, then drawn
   VkClearValue far{};

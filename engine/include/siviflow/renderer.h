@@ -16,6 +16,10 @@
 // The renderer never submits, never waits idle and never owns a swapchain. It calls Vulkan only
 // through a private function table loaded from the host's vkGet*ProcAddr.
 // Destroy it only when the GPU has finished every frame it recorded.
+// Every call that can fail returns a Status: no exception leaves the library (a failed
+// allocation is VK_ERROR_OUT_OF_HOST_MEMORY), errors in the caller's arguments carry no Vulkan
+// result (Status::kGenericError), and every error message starts with "siviflow::Renderer: "
+// and also reaches CreateInfo::log.
 #pragma once
 
 #include <cstdint>
@@ -237,7 +241,8 @@ class Renderer {
   // so that a capture starting at frame N gets the same frame N as one starting at 0.
   Status simulate(const View& view, double time_seconds);
   // Records the frame into `cmd` (in the recording state, outside any render pass), after the
-  // host's own drawing of colour and depth.
+  // host's own drawing of colour and depth. On failure what it recorded is incomplete: the host
+  // resets `cmd` instead of submitting it; the next begin_frame/update/record renders normally.
   Status record(VkCommandBuffer cmd, const FrameInputs& inputs);
 
   // Runtime obstacles. Each call re-solves the flow only around the old and new footprints
