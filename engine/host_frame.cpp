@@ -32,7 +32,8 @@ Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
   ExternalImage depth = targets->depth;
   color.final = image_state(Access::ColorAttachmentWrite, color.format);
   depth.final = image_state(Access::DepthAttachmentWrite, depth.format);
-  SIVIFLOW_TRY(world.record(cmd, slot, view, time_seconds, color, depth));
+  SIVIFLOW_TRY(world.begin_frame(slot));
+  SIVIFLOW_TRY(world.record(cmd, view, time_seconds, color, depth));
   FrameInputs inputs;
   inputs.color = targets->color;
   inputs.depth = targets->depth;

@@ -34,17 +34,10 @@ constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we co
 // Layouts documented in shaders/shared.h.
 constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
 constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
-constexpr VkFormat kNormalMapFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
 constexpr uint32_t kMaxTimedPasses = 16;
 
-// The water heights sit on a fixed grid whatever the tile size: half the default tile apart,
-// reaching over half the largest tile beyond the water (on the samples a one-tile margin had).
-constexpr float kWaterHeightSpacing = 1.5f;
-constexpr float kWaterHeightMargin = 5.0f * kWaterHeightSpacing;
-static_assert(kWaterHeightMargin >= 0.5f * kMaxTileSizeM);
 constexpr float kTdfRepeatTiles = 3.5f;  // normal-map repeat in tiles at ripple scale 1 (van Hoesel 35/10)
-constexpr uint32_t kMaxWaterHeightSamples = 2048;  // per axis: 16 MiB at most, samples widen beyond
 constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
 
 uint32_t texel_bytes(VkFormat format) {
@@ -70,26 +63,6 @@ bool is_host_depth_format(VkFormat format) {
 
 std::string extent_text(VkExtent2D extent) {
   return std::to_string(extent.width) + "x" + std::to_string(extent.height);
-}
-
-// The bytes of a contiguous container, for the static upload.
-template <typename Items>
-std::vector<uint8_t> bytes_of(const Items& items) {
-  const auto* first = reinterpret_cast<const uint8_t*>(items.data());
-  return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
-}
-
-// The longest triangle edge of a mesh, seen from above.
-float longest_edge_xz(const std::vector<glm::vec3>& positions,
-                      const std::vector<uint32_t>& indices) {
-  float longest = 0.0f;
-  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
-    for (int e = 0; e < 3; ++e) {
-      const glm::vec3 d = positions[indices[t + e]] - positions[indices[t + (e + 1) % 3]];
-      longest = std::max(longest, glm::length(glm::vec2(d.x, d.z)));
-    }
-  }
-  return longest;
 }
 
 }  // namespace
@@ -198,7 +171,8 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
   return Status::success();
 }
 
-Status Renderer::Impl::take_scene() {
+// The starting look: the host's, else the scene's, else the defaults.
+Status Renderer::Impl::take_look() {
   look = info.look != nullptr ? *info.look : info.scene != nullptr ? info.scene->look : WaterLook{};
   std::string problem;
   const std::string field = water_look_error(look, &problem);
@@ -206,87 +180,70 @@ Status Renderer::Impl::take_scene() {
     return argument_error((info.look != nullptr ? "CreateInfo::look." : "the scene's look.") +
                           field + " " + problem);
   }
-  std::optional<ProceduralRiver> procedural;
-  SIVIFLOW_TRY(scene_river_input(info.scene, &river_input, &procedural));
-  if (info.scene == nullptr) {
-    obstacles = default_scene_obstacles(*procedural);
-    return Status::success();
-  }
-  const SceneFile& scene = *info.scene;
-  flow_params = scene.flow;
-  obstacles = scene.obstacles;
-  std::vector<Obstacle> object_obstacles;
-  SIVIFLOW_TRY(scene_object_obstacles(scene, river_input.mesh.positions, &object_obstacles));
-  obstacles.insert(obstacles.end(), object_obstacles.begin(), object_obstacles.end());
   return Status::success();
 }
 
-Status Renderer::Impl::create_static_resources() {
-  SIVIFLOW_TRY(simulation.create(std::move(river_input), flow_params, std::move(obstacles),
-                                 info.seed, {info.extent.width, info.extent.height}));
-  scene_obstacle_count = simulation.obstacle_count();
-  const RiverMesh& surface = simulation.mesh();
-  river_index_count = static_cast<uint32_t>(surface.indices.size());
-  assets.add_buffer({"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
-                     bytes_of(surface.positions)});
-  assets.add_buffer({"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
-                     bytes_of(surface.indices)});
-  WaterNormalMap normal_map = make_water_normal_map();
-  assets.add_image({"water normal map", kNormalMapFormat, {normal_map.size, normal_map.size},
-                    std::move(normal_map.texels), std::move(normal_map.mip_offsets)});
-  make_tile_lattice(surface.positions, surface.indices);
+// The river of the scene (or the default one) with its obstacles, solved, with its static data;
+// or the one of the renderer this one shares it with.
+Status Renderer::Impl::create_river() {
+  if (info.share_river_with != nullptr) {
+    const Impl& other = *info.share_river_with->impl_;
+    if (other.info.device != info.device) {
+      return argument_error("CreateInfo::share_river_with renders on another device");
+    }
+    river = other.river;
+    return Status::success();
+  }
+  RiverInput input;
+  std::optional<ProceduralRiver> procedural;
+  SIVIFLOW_TRY(scene_river_input(info.scene, &input, &procedural));
+  FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
+  std::vector<Obstacle> obstacles;
+  if (info.scene == nullptr) {
+    obstacles = default_scene_obstacles(*procedural);
+  } else {
+    flow = info.scene->flow;
+    obstacles = info.scene->obstacles;
+    std::vector<Obstacle> object_obstacles;
+    SIVIFLOW_TRY(scene_object_obstacles(*info.scene, input.mesh.positions, &object_obstacles));
+    obstacles.insert(obstacles.end(), object_obstacles.begin(), object_obstacles.end());
+  }
+  return SharedRiver::create(table, info.allocation_callbacks, std::move(input), flow,
+                             std::move(obstacles), &river);
+}
 
+// This view's particles and flow textures, tile table size, staging ring and water passes.
+Status Renderer::Impl::create_view_resources() {
+  SIVIFLOW_TRY(simulation.create(river->flow, info.seed, {info.extent.width, info.extent.height}));
+  size_tile_table();
   // Every frame's flow textures must fit a slot's staging block.
   info.staging_bytes_per_slot = std::max(info.staging_bytes_per_slot,
                                          VkDeviceSize{simulation.layout().total_bytes} + kStagingAlignment);
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
-  SIVIFLOW_TRY(assets.create(gpu));
   return flow_pass.create(gpu, info.pipeline_cache, info.color_format, info.depth_format,
                           info.frames_in_flight, (info.readback_images & kAovReadbackImages) != 0,
                           info.enable_timing);
 }
 
-// The water heights around the river, and the tile table that covers their lattice points (or
-// as many as SIVIFLOW_TILE_TABLE_MAX allows, then a window around the camera).
-void Renderer::Impl::make_tile_lattice(const std::vector<glm::vec3>& surface,
-                                       const std::vector<uint32_t>& indices) {
-  // A tile reaches half a tile beyond the water it covers; the margin keeps its centre inside.
-  const WaterHeights heights =
-      water_heights(surface, kWaterHeightSpacing, kWaterHeightMargin, kMaxWaterHeightSamples);
-  water_lo = glm::vec2(std::numeric_limits<float>::max());
-  water_hi = glm::vec2(std::numeric_limits<float>::lowest());
-  for (const glm::vec3& p : surface) {
-    water_lo = glm::min(water_lo, glm::vec2(p.x, p.z));
-    water_hi = glm::max(water_hi, glm::vec2(p.x, p.z));
-  }
-  place_tile_lattice();  // at the starting look's tile size, which sizes the table
+// The tile table covers the lattice points around the water at the starting tile size (or as
+// many as SIVIFLOW_TILE_TABLE_MAX allows, then a window around the camera).
+void Renderer::Impl::size_tile_table() {
+  place_tile_lattice();
   const auto table_side = [](int points) {
     return std::min(std::bit_ceil(static_cast<uint32_t>(points)), SIVIFLOW_TILE_TABLE_MAX);
   };
   tile_table.width = table_side(lattice_hi.x - lattice_lo.x + 1);
   tile_table.height = table_side(lattice_hi.y - lattice_lo.y + 1);
-  tile_constants.heights = glm::vec4(heights.origin, heights.spacing, look.tile_size_m);
-  // A tile centre is within a tile of water it covers, and water within its longest triangle
-  // edge of a vertex: samples farther than both (at the largest tile) are no tile's. Steps go
-  // along the axes, so a distance d takes up to d sqrt(2) / spacing of them, plus one for the
-  // vertex's own sample.
-  const float reach = (kMaxTileSizeM + longest_edge_xz(surface, indices)) * std::sqrt(2.0f);
-  const auto reach_steps = static_cast<uint32_t>(std::ceil(reach / heights.spacing)) + 1;
-  std::vector<float> texels(heights.heights.size());
-  for (size_t i = 0; i < texels.size(); ++i) {
-    texels[i] = heights.steps[i] <= reach_steps ? heights.heights[i]
-                                                : static_cast<float>(SIVIFLOW_FAR_FROM_WATER);
-  }
-  assets.add_image({"water heights", FlowPass::kWaterHeightsFormat, {heights.columns, heights.rows},
-                    bytes_of(texels), {0}, Access::SampledCompute});
+  tile_constants.heights =
+      glm::vec4(river->heights_origin, river->heights_spacing, look.tile_size_m);
 }
 
 // The lattice points around the water at the look's tile size: those within a tile of it.
 void Renderer::Impl::place_tile_lattice() {
   const float tile = look.tile_size_m;
   const float half_tile = 0.5f * tile;
-  lattice_lo = glm::ivec2(glm::floor((water_lo - tile) / half_tile));
-  lattice_hi = glm::ivec2(glm::ceil((water_hi + tile) / half_tile));
+  lattice_lo = glm::ivec2(glm::floor((river->water_lo - tile) / half_tile));
+  lattice_hi = glm::ivec2(glm::ceil((river->water_hi + tile) / half_tile));
   tile_table.tile_size_m = tile;
 }
 
@@ -320,7 +277,7 @@ Status Renderer::Impl::declare_graph() {
       std::max(1u, static_cast<uint32_t>(std::lround(extent.width * kDefaultReflectionScale))),
       std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
   frame_images.clear();
-  assets.import_into(graph);
+  river_assets = river->assets.import_into(graph);
   VkClearValue transparent{};
 
   // upload: this frame's flow texture and particle aux data, through the slot's staging block.
@@ -357,24 +314,24 @@ Status Renderer::Impl::declare_graph() {
   water.flow = frame_uploads.images[0].destination;
   water.aux = frame_uploads.images[1].destination;
   water.reflection = reflection;
-  water.normal_map = assets.image_handle(kNormalMap);
-  water.vertices = assets.buffer_handle(kRiverVertices);
-  water.indices = assets.buffer_handle(kRiverIndices);
+  water.normal_map = river_assets.images[SharedRiver::kNormalMap];
+  water.vertices = river_assets.buffers[SharedRiver::kRiverVertices];
+  water.indices = river_assets.buffers[SharedRiver::kRiverIndices];
   if ((info.readback_images & kAovReadbackImages) != 0) {
     water.mask = frame_image(graph.create_image({"water mask", FlowPass::kMaskFormat, extent, transparent}));
     water.normal = frame_image(graph.create_image({"water normal", FlowPass::kNormalFormat, extent, transparent}));
     water.reflection_sample = frame_image(
         graph.create_image({"reflection sample", FlowPass::kReflectionFormat, extent, transparent}));
   }
-  water.water_heights = assets.image_handle(kWaterHeights);
+  water.water_heights = river_assets.images[SharedRiver::kWaterHeights];
   water.tile_table = frame_image(graph.create_image(
       {"tile table", FlowPass::kTileTableFormat, {tile_table.width, tile_table.height}, {}}));
   flow_pass.declare_tiles(graph, &tile_constants, &water);
-  flow_pass.declare(graph, &flow_constants, river_index_count, &water);
+  flow_pass.declare(graph, &flow_constants, river->index_count, &water);
   if (info.enable_timing) {
     const ImageHandle floor =
         frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
-    flow_pass.declare_floor(graph, &flow_constants, river_index_count, water, floor);
+    flow_pass.declare_floor(graph, &flow_constants, river->index_count, water, floor);
   }
 
   if (info.readback_images != 0) {
@@ -405,9 +362,9 @@ Status Renderer::Impl::declare_graph() {
   textures.flow = find_frame_image(flow_texture)->view;
   textures.aux = find_frame_image(particle_aux)->view;
   textures.reflection = find_frame_image(reflection)->view;
-  textures.normal_map = assets.image(kNormalMap).view;
+  textures.normal_map = river->assets.image(SharedRiver::kNormalMap).view;
   textures.tile_table = find_frame_image(water.tile_table)->view;
-  textures.water_heights = assets.image(kWaterHeights).view;
+  textures.water_heights = river->assets.image(SharedRiver::kWaterHeights).view;
   return flow_pass.bind_textures(gpu, textures, [this](VkDescriptorPool pool) {
     ring.defer_deletion_until_all_slots([gpu_context = gpu, pool] {
       gpu_context.table->vkDestroyDescriptorPool(gpu_context.table->device, pool,
@@ -464,9 +421,9 @@ void Renderer::Impl::destroy() {
   if (gpu.table == nullptr) return;  // failed before any Vulkan object existed
   flow_pass.destroy(gpu);
   for (FrameImage& f : frame_images) destroy_image(gpu, &f.image);
-  assets.destroy(gpu);
   for (VkQueryPool pool : query_pools) table.vkDestroyQueryPool(table.device, pool, gpu.allocation_callbacks);
   ring.destroy();
+  river.reset();  // the last view of the river frees its static data
 }
 
 Status Renderer::Impl::create_query_pools() {
@@ -502,8 +459,9 @@ Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) 
     Status status;
     try {
       status = impl->validate_info(info);
-      if (status.ok()) status = impl->take_scene();
-      if (status.ok()) status = impl->create_static_resources();
+      if (status.ok()) status = impl->take_look();
+      if (status.ok()) status = impl->create_river();
+      if (status.ok()) status = impl->create_view_resources();
       if (status.ok()) status = impl->declare_graph();
       if (status.ok() && info.enable_timing) status = impl->create_query_pools();
       if (status.ok()) out->reset(new Renderer(std::move(impl)));
@@ -550,7 +508,7 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   }
   const float dt = simulation.next_frame() == 0 ? 0.0f : static_cast<float>(time_seconds - last_time);
   if (dt < 0.0f) return argument_error("time went backwards");
-  SIVIFLOW_TRY(simulation.set_time(time_seconds));
+  SIVIFLOW_TRY(river->flow.set_time(time_seconds));
   SIVIFLOW_TRY(simulation.simulate(math.view_proj, dt));
   view = math;
   view_view = host_view.view;
@@ -607,7 +565,7 @@ float Renderer::Impl::visible_water_level() {
   for (const Particle& p : simulation.particle_field().particles()) {
     if (p.live()) heights.push_back(p.world.y);
   }
-  if (heights.empty()) return simulation.mesh().positions.front().y;  // no water on screen
+  if (heights.empty()) return river->flow.mesh().positions.front().y;  // no water on screen
   const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
   std::nth_element(heights.begin(), middle, heights.end());
   return *middle;
@@ -634,7 +592,8 @@ Status Renderer::update(const View& view, double time_seconds) {
     SIVIFLOW_TRY(r.simulation.pack({static_cast<std::byte*>(staging.data), layout.total_bytes}));
     r.frame_uploads.images[0].staging_offset = staging.offset + layout.flow_offset;
     r.frame_uploads.images[1].staging_offset = staging.offset + layout.aux_offset;
-    if (!r.assets.uploaded() && !r.assets.staged()) SIVIFLOW_TRY(r.assets.stage(r.gpu));
+    StaticAssets& assets = r.river->assets;  // staged by the first view of the river to update
+    if (!assets.uploaded() && !assets.staged()) SIVIFLOW_TRY(assets.stage(r.river->gpu));
     r.frame_updated = true;
     return Status::success();
   });
@@ -666,8 +625,11 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
     }
     return Status::success();
   };
-  if (info.readback_images != 0 && (viewport.offset.x != 0 || viewport.offset.y != 0)) {
-    return argument_error("with readback, View::viewport must start at the images' origin");
+  // The AOV attachments are the view's size: they cannot sit at an offset in the host's images.
+  if ((info.readback_images & kAovReadbackImages) != 0 &&
+      (viewport.offset.x != 0 || viewport.offset.y != 0)) {
+    return argument_error("with the water mask, normal or reflection read back, View::viewport "
+                          "must start at the images' origin");
   }
   SIVIFLOW_TRY(check(inputs.color, "color", info.color_format));
   SIVIFLOW_TRY(check(inputs.depth, "depth", info.depth_format));
@@ -685,7 +647,7 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
 Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   FrameBindings& b = bindings;
   b.reset();
-  assets.bind(b);
+  river->assets.bind(b, river_assets);
   for (const FrameImage& f : frame_images) {
     b.bind_image(f.handle, f.image.image, f.image.view);
     // Persistent images start without contents (only the upload writes them, whole).
@@ -742,7 +704,11 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   return guarded(r.info, [&]() -> Status {
     if (!r.frame_updated) return argument_error("record called before begin_frame and update");
     SIVIFLOW_TRY(r.check_inputs(inputs));
-    if (!r.assets.uploaded()) SIVIFLOW_TRY(r.assets.record_upload(r.table, cmd));
+    StaticAssets& assets = r.river->assets;  // uploaded by the first view of the river to record
+    if (!assets.uploaded()) {
+      if (!assets.staged()) SIVIFLOW_TRY(assets.stage(r.river->gpu));
+      SIVIFLOW_TRY(assets.record_upload(r.table, cmd));
+    }
     SIVIFLOW_TRY(r.bind_frame(inputs));
     FrameGraph::Timestamps timestamps;
     if (!r.query_pools.empty()) {
@@ -754,7 +720,7 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
     }
     SIVIFLOW_TRY(
         r.graph.execute(r.table, cmd, r.bindings, r.query_pools.empty() ? nullptr : &timestamps));
-    if (!r.assets.uploaded()) r.assets.finish_upload(r.ring, r.gpu);
+    if (!assets.uploaded()) assets.finish_upload(r.ring, r.river->gpu);
     r.frame_images_new = false;
     r.frame_begun = false;
     r.frame_updated = false;
@@ -843,6 +809,7 @@ const ParticleField& Renderer::particle_field() const { return impl_->simulation
 const TileTableLayout& Renderer::tile_table_layout() const { return impl_->tile_table; }
 const FlowTextureLayout& Renderer::flow_texture_layout() const { return impl_->simulation.layout(); }
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
+uint64_t Renderer::flow_solves() const { return impl_->river->flow.full_solves(); }
 
 Status Renderer::pass_times(uint32_t slot, std::vector<PassTime>* out) const {
   const Impl& r = *impl_;

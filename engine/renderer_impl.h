@@ -14,6 +14,7 @@
 #include "passes/passes.h"
 #include "scene/river_simulation.h"
 #include "siviflow/renderer.h"
+#include "shared_river.h"
 #include "static_assets.h"
 #include "view_math.h"
 #include "vk/device_table.h"
@@ -28,28 +29,13 @@ struct Renderer::Impl {
   DeviceTable table;
   GpuContext gpu;
   FrameRing ring;
-  RiverInput river_input;         // handed to the simulation by create_static_resources
   std::vector<float> particle_heights;  // this frame's live particles' heights
-  FlowParams flow_params{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
-  std::vector<Obstacle> obstacles;  // the scene's, then the footprints of objects marked obstacle
-  // Obstacles the host added (add_obstacle), in the flow's order after the scene's.
-  struct RuntimeObstacle {
-    uint32_t id = 0;
-    WaterObstacle placed;  // as last placed: centre and rotation
-  };
-  std::vector<RuntimeObstacle> runtime_obstacles;
-  size_t scene_obstacle_count = 0;  // the flow's obstacles before the runtime ones
-  uint32_t next_obstacle_id = 1;
   WaterLook look;                    // from the next update() on (set_look)
   gpu::WaterLookConstants frame_look{};  // of the frame being prepared
-  RiverSimulation simulation;  // the river's flow, particles and flow textures, on the CPU
+  // The river, its flow and its static GPU data, shared with the other views of it.
+  std::shared_ptr<SharedRiver> river;
+  RiverView simulation;  // this view's particles and flow textures, on the CPU
   double last_time = 0.0;
-
-  // Geometry and textures that never change, uploaded in the first frame.
-  enum StaticBufferId : uint32_t { kRiverVertices, kRiverIndices };
-  enum StaticImageId : uint32_t { kNormalMap, kWaterHeights };
-  StaticAssets assets;
-  uint32_t river_index_count = 0;
   FlowPass flow_pass;
 
   // Images the frame graph declares; created after it compiles, with the usage it derived.
@@ -62,6 +48,7 @@ struct Renderer::Impl {
   bool frame_images_new = true;  // persistent ones have no previous contents yet
 
   FrameGraph graph;
+  StaticAssets::GraphHandles river_assets;  // the shared river's static data in `graph`
   BufferHandle frame_staging;  // the slot's staging block: this frame's flow textures
   UploadList frame_uploads;    // flow texture and particle aux, every frame
   ImageHandle host_color;      // imported per frame: the host's colour and depth
@@ -78,8 +65,6 @@ struct Renderer::Impl {
   ReflectionView reflection_view{};
   // The tile table's lattice (shaders/shared.h): the points around the water at this frame's
   // tile size, and the table's size, a power of two per axis (fixed at create).
-  glm::vec2 water_lo{0.0f};  // XZ bounds of the river surface
-  glm::vec2 water_hi{0.0f};
   glm::ivec2 lattice_lo{0};
   glm::ivec2 lattice_hi{0};
   TileTableLayout tile_table;  // its corner moves with the camera when the river is larger
@@ -96,14 +81,14 @@ struct Renderer::Impl {
   bool frame_updated = false;
 
   Status validate_info(const CreateInfo& create);
-  Status take_scene();
-  Status create_static_resources();
+  Status take_look();
+  Status create_river();
+  Status create_view_resources();
   Status declare_graph();
   ImageHandle frame_image(ImageHandle handle, bool persistent = false);
   Status create_frame_images();
   const Image* find_frame_image(ImageHandle handle) const;
-  void make_tile_lattice(const std::vector<glm::vec3>& surface,
-                         const std::vector<uint32_t>& indices);
+  void size_tile_table();
   void place_tile_lattice();
   glm::ivec2 tile_window() const;
   size_t runtime_obstacle_index(uint32_t id) const;  // in runtime_obstacles; size() when unknown

@@ -6,12 +6,12 @@
 namespace siviflow {
 
 uint32_t StaticAssets::add_buffer(BufferSpec spec) {
-  buffers_.push_back({std::move(spec), {}, {}});
+  buffers_.push_back({std::move(spec), {}});
   return static_cast<uint32_t>(buffers_.size() - 1);
 }
 
 uint32_t StaticAssets::add_image(ImageSpec spec) {
-  images_.push_back({std::move(spec), {}, {}});
+  images_.push_back({std::move(spec), {}});
   return static_cast<uint32_t>(images_.size() - 1);
 }
 
@@ -104,20 +104,26 @@ void StaticAssets::finish_upload(FrameRing& ring, const GpuContext& gpu) {
   uploaded_ = true;
 }
 
-void StaticAssets::import_into(FrameGraph& graph) {
-  for (StaticBuffer& b : buffers_) {
-    b.in_graph = graph.import_buffer({b.spec.name, b.buffer.size}, state_of(b.spec.read_as),
-                                     state_of(b.spec.read_as));
+StaticAssets::GraphHandles StaticAssets::import_into(FrameGraph& graph) const {
+  GraphHandles handles;
+  for (const StaticBuffer& b : buffers_) {
+    handles.buffers.push_back(graph.import_buffer(
+        {b.spec.name, b.buffer.size}, state_of(b.spec.read_as), state_of(b.spec.read_as)));
   }
-  for (StaticImage& i : images_) {
-    i.in_graph = graph.import_image({i.spec.name, i.spec.format, i.spec.extent, {}},
-                                    state_of(i.spec.read_as), state_of(i.spec.read_as));
+  for (const StaticImage& i : images_) {
+    handles.images.push_back(graph.import_image({i.spec.name, i.spec.format, i.spec.extent, {}},
+                                                state_of(i.spec.read_as), state_of(i.spec.read_as)));
   }
+  return handles;
 }
 
-void StaticAssets::bind(FrameBindings& bindings) const {
-  for (const StaticBuffer& b : buffers_) bindings.bind_buffer(b.in_graph, b.buffer.buffer);
-  for (const StaticImage& i : images_) bindings.bind_image(i.in_graph, i.image.image, i.image.view);
+void StaticAssets::bind(FrameBindings& bindings, const GraphHandles& handles) const {
+  for (size_t n = 0; n < buffers_.size(); ++n) {
+    bindings.bind_buffer(handles.buffers[n], buffers_[n].buffer.buffer);
+  }
+  for (size_t n = 0; n < images_.size(); ++n) {
+    bindings.bind_image(handles.images[n], images_[n].image.image, images_[n].image.view);
+  }
 }
 
 }  // namespace siviflow

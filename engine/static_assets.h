@@ -18,6 +18,13 @@
 
 namespace siviflow {
 
+// The bytes of a contiguous container, for a static upload.
+template <typename Items>
+std::vector<uint8_t> bytes_of(const Items& items) {
+  const auto* first = reinterpret_cast<const uint8_t*>(items.data());
+  return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
+}
+
 class StaticAssets {
  public:
   struct BufferSpec {
@@ -52,11 +59,15 @@ class StaticAssets {
   // the ring's current slot comes round again.
   void finish_upload(FrameRing& ring, const GpuContext& gpu);
 
-  // Imports every asset into `graph` in the state it is read in, both ways.
-  void import_into(FrameGraph& graph);
-  void bind(FrameBindings& bindings) const;
-  BufferHandle buffer_handle(uint32_t index) const { return buffers_[index].in_graph; }
-  ImageHandle image_handle(uint32_t index) const { return images_[index].in_graph; }
+  // The assets as one frame graph knows them, by their indices.
+  struct GraphHandles {
+    std::vector<BufferHandle> buffers;
+    std::vector<ImageHandle> images;
+  };
+  // Imports every asset into `graph` in the state it is read in, both ways. Several graphs may
+  // import the same assets (the views of one river).
+  GraphHandles import_into(FrameGraph& graph) const;
+  void bind(FrameBindings& bindings, const GraphHandles& handles) const;
   const Buffer& buffer(uint32_t index) const { return buffers_[index].buffer; }
   const Image& image(uint32_t index) const { return images_[index].image; }
   size_t image_count() const { return images_.size(); }
@@ -65,12 +76,10 @@ class StaticAssets {
   struct StaticBuffer {
     BufferSpec spec;
     Buffer buffer;
-    BufferHandle in_graph;
   };
   struct StaticImage {
     ImageSpec spec;
     Image image;
-    ImageHandle in_graph;
   };
   std::vector<StaticBuffer> buffers_;
   std::vector<StaticImage> images_;

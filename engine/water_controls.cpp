@@ -38,10 +38,11 @@ Status check_obstacle(const char* call, const WaterObstacle& placed, uint32_t id
 }  // namespace
 
 size_t Renderer::Impl::runtime_obstacle_index(uint32_t id) const {
-  for (size_t i = 0; i < runtime_obstacles.size(); ++i) {
-    if (runtime_obstacles[i].id == id) return i;
+  const auto& placed = river->runtime_obstacles;
+  for (size_t i = 0; i < placed.size(); ++i) {
+    if (placed[i].id == id) return i;
   }
-  return runtime_obstacles.size();
+  return placed.size();
 }
 
 Status Renderer::add_obstacle(const WaterObstacle& obstacle, uint32_t* id) {
@@ -63,42 +64,44 @@ Status Renderer::set_look(const WaterLook& look) {
 Status Renderer::Impl::add_obstacle(const WaterObstacle& obstacle, uint32_t* id) {
   if (frame_begun) return argument_error("add_obstacle called between begin_frame and record");
   if (id == nullptr) return argument_error("add_obstacle: id must not be null");
-  const uint32_t new_id = next_obstacle_id;
+  const uint32_t new_id = river->next_obstacle_id;
   SIVIFLOW_TRY(check_obstacle("add_obstacle", obstacle, new_id));
-  SIVIFLOW_TRY(simulation.add_obstacle(flow_obstacle(obstacle)));
-  runtime_obstacles.push_back({new_id, obstacle});
-  ++next_obstacle_id;
+  SIVIFLOW_TRY(river->flow.add_obstacle(flow_obstacle(obstacle)));
+  river->runtime_obstacles.push_back({new_id, obstacle});
+  ++river->next_obstacle_id;
   *id = new_id;
   return Status::success();
 }
 
 Status Renderer::Impl::move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad) {
   if (frame_begun) return argument_error("move_obstacle called between begin_frame and record");
+  auto& placed = river->runtime_obstacles;
   const size_t i = runtime_obstacle_index(id);
-  if (i == runtime_obstacles.size()) {
+  if (i == placed.size()) {
     return argument_error(text_format("move_obstacle: no obstacle with id %u", id));
   }
-  WaterObstacle moved = runtime_obstacles[i].placed;
+  WaterObstacle moved = placed[i].placed;
   moved.centre = centre;
   moved.rotation_rad = rotation_rad;
   SIVIFLOW_TRY(check_obstacle("move_obstacle", moved, id));
-  const size_t index = scene_obstacle_count + i;
+  const size_t index = river->scene_obstacle_count + i;
   // A circle, or a polygon that did not turn, only moves: one incremental re-solve.
-  const bool turned = !moved.polygon.empty() && rotation_rad != runtime_obstacles[i].placed.rotation_rad;
-  SIVIFLOW_TRY(turned ? simulation.replace_obstacle(index, flow_obstacle(moved))
-                      : simulation.move_obstacle(index, centre));
-  runtime_obstacles[i].placed = std::move(moved);
+  const bool turned = !moved.polygon.empty() && rotation_rad != placed[i].placed.rotation_rad;
+  SIVIFLOW_TRY(turned ? river->flow.replace_obstacle(index, flow_obstacle(moved))
+                      : river->flow.move_obstacle(index, centre));
+  placed[i].placed = std::move(moved);
   return Status::success();
 }
 
 Status Renderer::Impl::remove_obstacle(uint32_t id) {
   if (frame_begun) return argument_error("remove_obstacle called between begin_frame and record");
+  auto& placed = river->runtime_obstacles;
   const size_t i = runtime_obstacle_index(id);
-  if (i == runtime_obstacles.size()) {
+  if (i == placed.size()) {
     return argument_error(text_format("remove_obstacle: no obstacle with id %u", id));
   }
-  SIVIFLOW_TRY(simulation.remove_obstacle(scene_obstacle_count + i));
-  runtime_obstacles.erase(runtime_obstacles.begin() + static_cast<std::ptrdiff_t>(i));
+  SIVIFLOW_TRY(river->flow.remove_obstacle(river->scene_obstacle_count + i));
+  placed.erase(placed.begin() + static_cast<std::ptrdiff_t>(i));
   return Status::success();
 }
 

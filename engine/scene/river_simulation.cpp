@@ -69,72 +69,80 @@ Status scene_river_input(const SceneFile* scene, RiverInput* out,
   return in_scene(procedural_river_input(**procedural, out));
 }
 
-Status RiverSimulation::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
-                               uint64_t seed, glm::uvec2 viewport) {
-  viewport_ = viewport;
+Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles) {
   mesh_ = std::move(river.mesh);
   slope_ = std::move(river.slope);
   SIVIFLOW_TRY(StreamFunction::create(std::move(river.surface), flow, &flow_));
   for (const Obstacle& obstacle : obstacles) has_keys_ = has_keys_ || !obstacle.keys.empty();
   SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
+  full_solves_ = 1;
   const size_t count = mesh_.positions.size();
   velocity_.resize(count);
   speed_.resize(count);
   refresh_velocity();
-  RiverFlowField field;
-  field.positions = mesh_.positions;
-  field.indices = mesh_.indices;
-  field.flow = velocity_;
-  field.speed = speed_;
-  field.depth = mesh_.depth;
-  field.slope = slope_;
-  ParticleParams params;
-  params.seed = seed;
-  params.viewport = viewport;
-  SIVIFLOW_TRY(ParticleField::create(field, params, &particles_));
-  return FlowTextures::create(particles_, kDefaultFlowTexelPx, &flow_textures_);
+  field_.positions = mesh_.positions;
+  field_.indices = mesh_.indices;
+  field_.flow = velocity_;
+  field_.speed = speed_;
+  field_.depth = mesh_.depth;
+  field_.slope = slope_;
+  auto bvh = std::make_shared<RiverBvh>();
+  SIVIFLOW_TRY(RiverBvh::build(field_.positions, field_.indices, bvh.get()));
+  bvh_ = std::move(bvh);
+  return Status::success();
 }
 
-void RiverSimulation::refresh_velocity() {
+void RiverFlow::refresh_velocity() {
   for (size_t v = 0; v < velocity_.size(); ++v) {
     velocity_[v] = flow_.velocity(v);
     speed_[v] = glm::length(velocity_[v]);
   }
 }
 
-Status RiverSimulation::set_time(double time_seconds) {
+Status RiverFlow::set_time(double time_seconds) {
   if (!has_keys_) return Status::success();
   SIVIFLOW_TRY(flow_.set_time(time_seconds));
+  if (flow_.last_update().nodes_resolved == 0) return Status::success();  // nothing moved
   // A few thousand vertices: re-reading them all costs less than tracking which changed.
   refresh_velocity();
   return Status::success();
 }
 
-Status RiverSimulation::add_obstacle(Obstacle obstacle) {
+Status RiverFlow::add_obstacle(Obstacle obstacle) {
   SIVIFLOW_TRY(flow_.add_obstacle(std::move(obstacle)));
   refresh_velocity();
   return Status::success();
 }
 
-Status RiverSimulation::replace_obstacle(size_t index, Obstacle obstacle) {
+Status RiverFlow::replace_obstacle(size_t index, Obstacle obstacle) {
   SIVIFLOW_TRY(flow_.replace_obstacle(index, std::move(obstacle)));
   refresh_velocity();
   return Status::success();
 }
 
-Status RiverSimulation::move_obstacle(size_t index, const glm::vec3& centre) {
+Status RiverFlow::move_obstacle(size_t index, const glm::vec3& centre) {
   SIVIFLOW_TRY(flow_.move_obstacle(index, centre));
   refresh_velocity();
   return Status::success();
 }
 
-Status RiverSimulation::remove_obstacle(size_t index) {
+Status RiverFlow::remove_obstacle(size_t index) {
   SIVIFLOW_TRY(flow_.remove_obstacle(index));
   refresh_velocity();
   return Status::success();
 }
 
-Status RiverSimulation::resize(glm::uvec2 viewport) {
+Status RiverView::create(const RiverFlow& river, uint64_t seed, glm::uvec2 viewport) {
+  ParticleParams params;
+  params.seed = seed;
+  params.viewport = viewport;
+  SIVIFLOW_TRY(ParticleField::create(river.field(), river.bvh(), params, &particles_));
+  SIVIFLOW_TRY(FlowTextures::create(particles_, kDefaultFlowTexelPx, &flow_textures_));
+  viewport_ = viewport;
+  return Status::success();
+}
+
+Status RiverView::resize(glm::uvec2 viewport) {
   ParticleParams params = particles_.params();
   params.viewport = viewport;
   ParticleField particles;
@@ -147,11 +155,11 @@ Status RiverSimulation::resize(glm::uvec2 viewport) {
   return Status::success();
 }
 
-Status RiverSimulation::simulate(const glm::mat4& view_proj, float dt_seconds) {
+Status RiverView::simulate(const glm::mat4& view_proj, float dt_seconds) {
   return particles_.update(ScreenCamera{view_proj, viewport_}, particles_.next_frame(), dt_seconds);
 }
 
-Status RiverSimulation::pack(std::span<std::byte> staging) {
+Status RiverView::pack(std::span<std::byte> staging) {
   return flow_textures_.pack(particles_, staging);
 }
 

@@ -1,9 +1,11 @@
-// The simulation half of a frame for the scene's river, on the CPU: the river surface
-// and its stream-function flow (solved once), and the screen-space particles and flow textures
-// (kept every frame). No Vulkan: the renderer copies pack()'s bytes into its staging block.
+// The simulation half of a frame for the scene's river, on the CPU: the river surface and its
+// stream-function flow (solved once, shared by every view of the river), and per view the
+// screen-space particles and flow textures (kept every frame). No Vulkan: the renderer copies
+// pack()'s bytes into its staging block.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "sim/procedural_river.h"
+#include "sim/river_bvh.h"
 #include "sim/river_surface.h"
 #include "sim/obstacle.h"
 #include "sim/status.h"
@@ -45,28 +48,55 @@ Status gltf_river_input(TriangleMesh gltf, RiverInput* out);
 Status scene_river_input(const SceneFile* scene, RiverInput* out,
                          std::optional<ProceduralRiver>* procedural);
 
-class RiverSimulation {
+// The river every view of it shares: its mesh, its flow (solved once, then re-solved only
+// around obstacles that move, come or go) and the ray-cast structure of its surface. Its
+// per-vertex arrays change in place, so the views' particles see every new flow.
+class RiverFlow {
  public:
-  // Solves the flow of `river` with the obstacles and sizes the particles and flow textures for
-  // `viewport`. Must not be moved after create(): the particles keep spans into this object's
-  // per-vertex arrays.
-  Status create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
-                uint64_t seed, glm::uvec2 viewport);
+  // Solves the flow of `river` with the obstacles. Must not be moved after create(): the views
+  // keep spans into its per-vertex arrays.
+  Status create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles);
 
   // Places the keyframed obstacles at `time_seconds` and re-solves the flow near those that
-  // moved, so the next simulate() hands the particles the new course.
+  // moved (nothing when they are already there).
   Status set_time(double time_seconds);
   glm::vec3 obstacle_centre(size_t index) const { return flow_.obstacle_centre(index); }
   size_t obstacle_count() const { return flow_.obstacles().size(); }
 
   // Obstacles placed at runtime, by their index in the flow's list (add appends): each re-solves
-  // the flow only around the old and new footprint, as the next simulate() then carries.
+  // the flow only around the old and new footprint.
   Status add_obstacle(Obstacle obstacle);
   Status replace_obstacle(size_t index, Obstacle obstacle);
   Status move_obstacle(size_t index, const glm::vec3& centre);
   Status remove_obstacle(size_t index);
 
-  // A new viewport: new particles (from frame 0) and flow textures, on the same river, flow and
+  const RiverMesh& mesh() const { return mesh_; }
+  // The surface, its flow and what the particles read per vertex (spans into this object).
+  const RiverFlowField& field() const { return field_; }
+  std::shared_ptr<const RiverBvh> bvh() const { return bvh_; }
+  uint64_t full_solves() const { return full_solves_; }  // 1: the one at create
+
+ private:
+  void refresh_velocity();
+
+  RiverMesh mesh_;
+  StreamFunction flow_;
+  std::vector<glm::vec3> velocity_;  // per vertex, m/s
+  std::vector<float> speed_;
+  std::vector<float> slope_;         // riverbed slope under the vertex (rise over run)
+  bool has_keys_ = false;            // some obstacle moves: re-solve as time goes
+  RiverFlowField field_;
+  std::shared_ptr<const RiverBvh> bvh_;
+  uint64_t full_solves_ = 0;
+};
+
+// One view of a river: its screen-space particles and the flow textures packed from them.
+class RiverView {
+ public:
+  // Sizes the particles and flow textures for `viewport`. `river` outlives this view.
+  Status create(const RiverFlow& river, uint64_t seed, glm::uvec2 viewport);
+
+  // A new viewport: new particles (from frame 0) and flow textures, on the same river and
   // ray-cast structure. On failure nothing changes.
   Status resize(glm::uvec2 viewport);
 
@@ -78,17 +108,8 @@ class RiverSimulation {
   uint64_t next_frame() const { return particles_.next_frame(); }
   const FlowTextureLayout& layout() const { return flow_textures_.layout(); }
   const ParticleField& particle_field() const { return particles_; }
-  const RiverMesh& mesh() const { return mesh_; }
 
  private:
-  RiverMesh mesh_;
-  StreamFunction flow_;
-  std::vector<glm::vec3> velocity_;  // per vertex, m/s
-  std::vector<float> speed_;
-  std::vector<float> slope_;         // riverbed slope under the vertex (rise over run)
-  bool has_keys_ = false;            // some obstacle moves: re-solve as time goes
-
-  void refresh_velocity();
   ParticleField particles_;
   FlowTextures flow_textures_;
   glm::uvec2 viewport_{0u};

@@ -40,12 +40,6 @@ Status world_error(const std::string& message) {
   return Status::error(std::string(kWorldErrorPrefix) + message);
 }
 
-template <typename Items>
-std::vector<uint8_t> bytes_of(const Items& items) {
-  const auto* first = reinterpret_cast<const uint8_t*>(items.data());
-  return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
-}
-
 // The constants that draw a model placed at `offset` with the scene shaders, which work in the
 // model's coordinates: clip and fog see the same distances as for the translated model.
 gpu::SceneConstants translated(const gpu::SceneConstants& constants, glm::vec3 offset) {
@@ -74,6 +68,7 @@ struct World::Impl {
   enum StaticBufferId : uint32_t { kVertices, kIndices };
   enum StaticImageId : uint32_t { kDetail, kFirstBaseColor };
   StaticAssets assets;
+  StaticAssets::GraphHandles asset_handles;  // in `graph`
   ScenePass main_pass;        // host colour and depth formats
   ScenePass reflection_pass;  // the renderer's reflection target, when its depth format differs
   bool own_reflection_pass = false;
@@ -101,7 +96,7 @@ struct World::Impl {
   void place_obstacles(size_t which, const gpu::SceneConstants& constants);
   void destroy();
   static Status create(const WorldCreateInfo& info, std::unique_ptr<World>* out);
-  Status record(VkCommandBuffer cmd, uint32_t slot, const View& view, double time_seconds,
+  Status record(VkCommandBuffer cmd, const View& view, double time_seconds,
                 const ExternalImage& host_color, const ExternalImage& host_depth);
 };
 
@@ -169,7 +164,7 @@ Status World::Impl::create_resources() {
 }
 
 Status World::Impl::declare_graph() {
-  assets.import_into(graph);
+  asset_handles = assets.import_into(graph);
   // The host's images: their states and clear depth come per frame.
   color = graph.import_image({"host colour", info.color_format, {1, 1}, {}}, ResourceState{},
                              state_of(Access::SampledFragment));
@@ -178,11 +173,11 @@ Status World::Impl::declare_graph() {
   ScenePass::Handles handles;
   handles.color = color;
   handles.depth = depth;
-  handles.vertices = assets.buffer_handle(kVertices);
-  handles.indices = assets.buffer_handle(kIndices);
-  handles.detail = assets.image_handle(kDetail);
+  handles.vertices = asset_handles.buffers[kVertices];
+  handles.indices = asset_handles.buffers[kIndices];
+  handles.detail = asset_handles.images[kDetail];
   for (uint32_t n = kFirstBaseColor; n < assets.image_count(); ++n) {
-    handles.base_colors.push_back(assets.image_handle(n));
+    handles.base_colors.push_back(asset_handles.images[n]);
   }
   main_pass.declare(graph, "world", &main_draws, &frame, &handles);
   return graph.compile();
@@ -288,13 +283,17 @@ Camera World::scene_camera(double time_seconds) const {
   return camera;
 }
 
-Status World::record(VkCommandBuffer cmd, uint32_t slot, const View& view, double time_seconds,
-                     const ExternalImage& color, const ExternalImage& depth) {
-  return guarded(kWorldErrorPrefix, nullptr, nullptr,
-                 [&] { return impl_->record(cmd, slot, view, time_seconds, color, depth); });
+Status World::begin_frame(uint32_t slot) {
+  return guarded(kWorldErrorPrefix, nullptr, nullptr, [&] { return impl_->ring.begin_slot(slot); });
 }
 
-Status World::Impl::record(VkCommandBuffer cmd, uint32_t slot, const View& view,
+Status World::record(VkCommandBuffer cmd, const View& view, double time_seconds,
+                     const ExternalImage& color, const ExternalImage& depth) {
+  return guarded(kWorldErrorPrefix, nullptr, nullptr,
+                 [&] { return impl_->record(cmd, view, time_seconds, color, depth); });
+}
+
+Status World::Impl::record(VkCommandBuffer cmd, const View& view,
                            double time_seconds, const ExternalImage& host_color,
                            const ExternalImage& host_depth) {
   Impl& w = *this;
@@ -303,7 +302,6 @@ Status World::Impl::record(VkCommandBuffer cmd, uint32_t slot, const View& view,
   }
   ViewMath math;
   SIVIFLOW_TRY(derive_view_math(view.view, view.projection, &math));
-  SIVIFLOW_TRY(w.ring.begin_slot(slot));
   if (!w.assets.uploaded()) {
     if (!w.assets.staged()) SIVIFLOW_TRY(w.assets.stage(w.gpu));
     SIVIFLOW_TRY(w.assets.record_upload(w.table, cmd));
@@ -317,7 +315,7 @@ Status World::Impl::record(VkCommandBuffer cmd, uint32_t slot, const View& view,
 
   FrameBindings& b = w.bindings;
   b.reset();
-  w.assets.bind(b);
+  w.assets.bind(b, w.asset_handles);
   const auto bind_host = [&b](ImageHandle handle, const ExternalImage& image) {
     b.bind_image(handle, image.image, image.view);
     b.set_incoming(handle, {image.current.stage, image.current.access, image.current.layout});

@@ -110,7 +110,8 @@ class HostEmbeddingTest : public GpuTest {
                         {VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
                          VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL}};
-    status = world_->record(cmd, 0, view, time, color, depth);
+    EXPECT_TRUE(world_->begin_frame(0).ok());
+    status = world_->record(cmd, view, time, color, depth);
     EXPECT_TRUE(status.ok()) << status.message();
     copy(cmd, before);
     FrameInputs inputs;

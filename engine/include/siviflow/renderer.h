@@ -42,6 +42,7 @@
 namespace siviflow {
 
 enum class LogLevel { kInfo, kWarning, kError };
+class Renderer;
 
 // What a host's own reflection drawing needs: the scene mirrored about the water plane, seen from
 // the real camera, and the plane to clip below (keep dot(plane.xyz, p) + plane.w >= 0).
@@ -86,6 +87,11 @@ struct CreateInfo {
   // The water's starting look; null: the scene's "look" (or WaterLook's defaults). Read by
   // create() only; set_look() changes it.
   const WaterLook* look = nullptr;
+  // Another view of the same river: a renderer on the same device whose river this one shares
+  // (its surface, flow, obstacles and static GPU data: no second flow solve), with particles,
+  // flow textures, tile table and reflection of its own; `scene` is then not read. Obstacles
+  // added through either renderer re-route both. Null: a river of its own.
+  const Renderer* share_river_with = nullptr;
   bool enable_timing = false;          // GPU timestamps around every pass (see pass_times()),
                                        // and the flow pass's floor pass, for benchmarks
   VkDeviceSize staging_bytes_per_slot = 0;  // per-slot staging block; 0 means 8 MiB
@@ -274,6 +280,9 @@ class Renderer {
   const TileTableLayout& tile_table_layout() const;
   // The index of the next frame update() or simulate() will advance to.
   uint64_t next_frame() const;
+  // Full solves of this renderer's river flow so far (one at its creation; the renderers that
+  // share the river share the count). Runtime obstacles re-solve incrementally, not fully.
+  uint64_t flow_solves() const;
 
   // Byte size of the readback buffer of that image at the configured extent.
   VkDeviceSize readback_bytes(ReadbackImage image) const;

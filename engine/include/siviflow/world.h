@@ -4,9 +4,11 @@
 // draws itself mirrored into the renderer's reflection through the reflection callback.
 //
 // Per frame, on the host's command buffer, with the host having waited for the slot:
-//   world->record(cmd, slot, view, time, color, depth);    // colour and depth of the world
-//   renderer->record(cmd, inputs);                          // the water over them
-// with CreateInfo::reflection = World::draw_reflection and reflection_user = the world.
+//   world->begin_frame(slot);
+//   world->record(cmd, view, time, color, depth);  // colour and depth of the world (per view)
+//   renderer->record(cmd, inputs);                 // the water over them
+// with CreateInfo::reflection = World::draw_reflection and reflection_user = the world. Several
+// views in one frame (split screen) record the world once per view, each over its viewport.
 #pragma once
 
 #include <cstdint>
@@ -48,10 +50,12 @@ class World {
   // glTF river without keys is seen from above its upstream end).
   Camera scene_camera(double time_seconds) const;
 
+  // The host has waited until the GPU finished the commands last recorded for this slot.
+  Status begin_frame(uint32_t slot);
   // Records the world seen through `view` at `time_seconds` (obstacles where their keys put
-  // them) into `color` and `depth`, cleared first, and leaves them in their final states. The
-  // depth convention (standard or reverse-Z) is the projection's.
-  Status record(VkCommandBuffer cmd, uint32_t slot, const View& view, double time_seconds,
+  // them) into `color` and `depth`, cleared first over the view's viewport, and leaves them in
+  // their final states. The depth convention (standard or reverse-Z) is the projection's.
+  Status record(VkCommandBuffer cmd, const View& view, double time_seconds,
                 const ExternalImage& color, const ExternalImage& depth);
 
   // A siviflow::ReflectionCallback (user: this World): draws the world as of the last record(),

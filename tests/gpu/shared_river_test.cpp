@@ -1,0 +1,216 @@
+// One river, many views: renderers that share a river (CreateInfo::share_river_with) render
+// each view exactly as a renderer of its own would, in two images or side by side in one image
+// (split screen by viewports), with one flow solve between them; an obstacle added through one
+// re-routes the other's flow.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include <glm/gtc/packing.hpp>
+#include <gtest/gtest.h>
+
+#include "gpu_test.h"
+#include "siviflow/host_frame.h"
+
+namespace siviflow::testing {
+namespace {
+
+constexpr uint32_t kWidth = 320;
+constexpr uint32_t kHeight = 180;
+constexpr uint32_t kFrames = 3;
+
+// One view: its renderer, its camera time offset, where it lies in which host images.
+struct Pane {
+  Renderer* renderer = nullptr;
+  double camera_delay = 0.0;  // seconds ahead on the scene's camera path
+  HostTargets* targets = nullptr;
+  VkRect2D viewport{};
+  HostBuffer colour;  // read back: the view's pixels
+  HostBuffer flow;    // read back: its flow texture
+};
+
+class SharedRiverTest : public GpuTest {
+ protected:
+  std::unique_ptr<Renderer> make(VkExtent2D extent, const Renderer* share = nullptr) {
+    if (world_ == nullptr) {
+      WorldCreateInfo world_info =
+          context_->world_create_info(VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT);
+      EXPECT_TRUE(World::create(world_info, &world_).ok());
+    }
+    CreateInfo info = make_create_info(extent.width, extent.height);
+    info.readback_images = readback_bit(ReadbackImage::kColor) | readback_bit(ReadbackImage::kFlowTexture);
+    info.reflection = &World::draw_reflection;
+    info.reflection_user = world_.get();
+    info.share_river_with = share;
+    std::unique_ptr<Renderer> renderer;
+    const Status status = Renderer::create(info, &renderer);
+    EXPECT_TRUE(status.ok()) << status.message();
+    return renderer;
+  }
+
+  HostTargets* targets(VkExtent2D extent) {
+    targets_.push_back(std::make_unique<HostTargets>());
+    EXPECT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
+                                    extent,
+                                    {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                    targets_.back().get()).ok());
+    return targets_.back().get();
+  }
+
+  void add_readback(Pane* pane) {
+    ASSERT_TRUE(context_->create_readback_buffer(
+        pane->renderer->readback_bytes(ReadbackImage::kColor), &pane->colour).ok());
+    ASSERT_TRUE(context_->create_readback_buffer(
+        pane->renderer->readback_bytes(ReadbackImage::kFlowTexture), &pane->flow).ok());
+  }
+
+  // Frames 0 .. kFrames-1 of every pane, all in one command buffer per frame: the world then the
+  // water of each view in turn.
+  void render(std::vector<Pane*> panes) {
+    for (Pane* pane : panes) add_readback(pane);
+    for (uint32_t frame = 0; frame < kFrames; ++frame) {
+      const double time = frame / 30.0;
+      VkCommandBuffer cmd = VK_NULL_HANDLE;
+      ASSERT_TRUE(context_->begin_slot(0, &cmd).ok());
+      ASSERT_TRUE(world_->begin_frame(0).ok());
+      for (Pane* pane : panes) {
+        const View view = pane_view(*pane, time);
+        ASSERT_TRUE(pane->renderer->begin_frame(0).ok());
+        Status status = pane->renderer->update(view, time);
+        ASSERT_TRUE(status.ok()) << status.message();
+        ExternalImage color = pane->targets->color;
+        ExternalImage depth = pane->targets->depth;
+        color.final = {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                       VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+        depth.final = {VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                       VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                       VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL};
+        status = world_->record(cmd, view, time, color, depth);
+        ASSERT_TRUE(status.ok()) << status.message();
+        FrameInputs inputs;
+        inputs.color = pane->targets->color;
+        inputs.depth = pane->targets->depth;
+        inputs.color.current = color.final;
+        inputs.depth.current = depth.final;
+        inputs.readback[ReadbackImage::kColor] = pane->colour.buffer;
+        inputs.readback[ReadbackImage::kFlowTexture] = pane->flow.buffer;
+        status = pane->renderer->record(cmd, inputs);
+        ASSERT_TRUE(status.ok()) << status.message();
+        pane->targets->color.current = pane->targets->color.final;
+        pane->targets->depth.current = pane->targets->depth.final;
+      }
+      ASSERT_TRUE(context_->end_slot_and_submit(0).ok());
+      ASSERT_TRUE(context_->wait_slot(0).ok());
+    }
+  }
+
+  View pane_view(const Pane& pane, double time) const {
+    View view = camera_view(world_->scene_camera(time + pane.camera_delay), pane.viewport.extent);
+    view.viewport = pane.viewport;
+    return view;
+  }
+
+  std::vector<std::unique_ptr<HostTargets>> targets_;
+};
+
+// Pixels of two panes' read-back colours that differ, and by how much at most (per channel).
+size_t differing_pixels(const Pane& a, const Pane& b, float* largest = nullptr) {
+  const size_t values = size_t{a.viewport.extent.width} * a.viewport.extent.height * 4;
+  const auto* pa = static_cast<const uint16_t*>(a.colour.data);
+  const auto* pb = static_cast<const uint16_t*>(b.colour.data);
+  size_t count = 0;
+  float worst = 0.0f;
+  for (size_t i = 0; i < values; i += 4) {
+    bool differs = false;
+    for (size_t c = i; c < i + 4; ++c) {
+      const float d = std::abs(glm::unpackHalf1x16(pa[c]) - glm::unpackHalf1x16(pb[c]));
+      worst = std::max(worst, d);
+      differs = differs || d > 0.0f;
+    }
+    count += differs ? 1 : 0;
+  }
+  if (largest != nullptr) *largest = worst;
+  return count;
+}
+
+TEST_F(SharedRiverTest, TwoViewsInTwoImagesEqualEachAloneWithOneSolve) {
+  const VkExtent2D extent{kWidth, kHeight};
+  auto main = make(extent);
+  auto probe = make(extent, main.get());
+  EXPECT_EQ(main->flow_solves(), 1u);
+  EXPECT_EQ(probe->flow_solves(), 1u) << "the probe view shares the solve";
+  Pane a{main.get(), 0.0, targets(extent), {{0, 0}, extent}};
+  Pane b{probe.get(), 4.0, targets(extent), {{0, 0}, extent}};
+  render({&a, &b});
+
+  auto main_alone = make(extent);
+  auto probe_alone = make(extent);
+  Pane a_alone{main_alone.get(), 0.0, targets(extent), {{0, 0}, extent}};
+  Pane b_alone{probe_alone.get(), 4.0, targets(extent), {{0, 0}, extent}};
+  render({&a_alone});
+  render({&b_alone});
+  EXPECT_GT(differing_pixels(a, b), 1000u) << "two different views";
+  EXPECT_EQ(differing_pixels(a, a_alone), 0u);
+  EXPECT_EQ(differing_pixels(b, b_alone), 0u);
+}
+
+TEST_F(SharedRiverTest, SplitScreenViewsEqualEachAlone) {
+  const VkExtent2D half{kWidth / 2, kHeight};
+  HostTargets* screen = targets({kWidth, kHeight});
+  auto left = make(half);
+  auto right = make(half, left.get());
+  Pane l{left.get(), 0.0, screen, {{0, 0}, half}};
+  Pane r{right.get(), 4.0, screen, {{static_cast<int32_t>(kWidth / 2), 0}, half}};
+  render({&l, &r});
+
+  auto left_alone = make(half);
+  auto right_alone = make(half);
+  Pane l_alone{left_alone.get(), 0.0, targets(half), {{0, 0}, half}};
+  Pane r_alone{right_alone.get(), 4.0, targets(half), {{0, 0}, half}};
+  render({&l_alone, &r_alone});
+  EXPECT_EQ(differing_pixels(l, l_alone), 0u);
+  // Placed at an offset, the host's world rasterizes a hair differently (its full-screen sky
+  // triangle a half-float step here and there, a few edge pixels more): within the goldens'
+  // tolerance, the same view.
+  float largest = 0.0f;
+  const size_t differing = differing_pixels(r, r_alone, &largest);
+  EXPECT_LT(differing, size_t{kWidth / 2} * kHeight / 20) << "the right half is the right view";
+  EXPECT_LE(largest, 0.02f);
+}
+
+TEST_F(SharedRiverTest, ObstacleAddedThroughOneViewReroutesTheOther) {
+  const VkExtent2D extent{kWidth, kHeight};
+  auto main = make(extent);
+  auto probe = make(extent, main.get());
+  Pane before{probe.get(), 0.0, targets(extent), {{0, 0}, extent}};
+  render({&before});
+  std::vector<uint8_t> flow_before(static_cast<const uint8_t*>(before.flow.data),
+                                   static_cast<const uint8_t*>(before.flow.data) +
+                                       probe->readback_bytes(ReadbackImage::kFlowTexture));
+  // A boat where the probe looks, added through the main view's renderer.
+  WaterObstacle boat;
+  const Camera camera = world_->scene_camera((kFrames - 1) / 30.0);
+  boat.centre = {camera.target.x, 0.0f, camera.target.z};
+  boat.radius = 2.5f;
+  uint32_t id = 0;
+  ASSERT_TRUE(main->add_obstacle(boat, &id).ok());
+  EXPECT_EQ(probe->flow_solves(), 1u) << "incremental, not a new solve";
+  auto probe_again = make(extent, main.get());  // same particles as `before` from frame 0
+  Pane after{probe_again.get(), 0.0, targets(extent), {{0, 0}, extent}};
+  render({&after});
+  const auto* flow_after = static_cast<const uint8_t*>(after.flow.data);
+  size_t changed = 0;
+  for (size_t i = 0; i < flow_before.size(); ++i) changed += flow_before[i] != flow_after[i] ? 1 : 0;
+  EXPECT_GT(changed, 1000u) << "the shared flow goes round the boat";
+  // Removed through the probe's renderer: the river is as before for every view.
+  ASSERT_TRUE(probe->remove_obstacle(id).ok());
+  EXPECT_FALSE(main->remove_obstacle(id).ok()) << "one set of obstacles";
+}
+
+}  // namespace
+}  // namespace siviflow::testing
