@@ -157,9 +157,13 @@ class FrameAfterFailuresTest : public AllocationFailureTest {
     const Status status =
         record_world_and_water(cmd, 0, *world_, *renderer_, view, time, buffers_, &targets_);
     disarm();
-    *failed = g_failures > 0;
-    if (*failed) return status;
-    SIVIFLOW_TRY(status);
+    // A failure that hit the host's own code (its validation message callback, called from
+    // inside the layer) may be absorbed there: then the frame is whole and is submitted.
+    *failed = !status.ok();
+    if (*failed) {
+      EXPECT_GT(g_failures, 0) << "a failure without an injected one: " << status.message();
+      return status;
+    }
     SIVIFLOW_TRY(context_->end_slot_and_submit(0));
     return context_->wait_slot(0);
   }
@@ -208,31 +212,32 @@ TEST_F(FrameAfterFailuresTest, FailedUpdateReportsAndTheNextFrameRenders) {
 
 TEST_F(FrameAfterFailuresTest, FailedRecordLeavesNoTraceInTheNextFrame) {
   start();
-  long attempts = 0, failures = 0;
+  std::vector<bool> submitted;  // per attempt: whether its frame was recorded whole
+  long failures = 0;
   for (const long n : failure_points(100'000)) {
-    ++attempts;
     bool failed = false;
     const Status status = frame(n, &failed);
-    if (!failed) {
-      ASSERT_TRUE(status.ok()) << status.message();
-      break;
+    submitted.push_back(!failed);
+    if (failed) {
+      ++failures;
+      continue;
     }
-    ++failures;
-    EXPECT_FALSE(status.ok()) << "record failing allocation " << n;
+    ASSERT_TRUE(status.ok()) << status.message();
+    if (g_failures == 0) break;  // past the last allocation: the frame is done
   }
   EXPECT_GT(failures, 3) << "recording allocates";
   const std::vector<float> after_failures = colour();
-  // The same calls without injection: every attempt but the last is a frame never submitted.
+  // The same calls without injection: the failed attempts as frames updated but never submitted.
   start();
-  for (long i = 0; i < attempts; ++i) {
-    bool failed = false;
-    if (i + 1 < attempts) {
-      const double time = 1.0 / 30.0;
-      ASSERT_TRUE(renderer_->begin_frame(0).ok());
-      ASSERT_TRUE(renderer_->update(camera_view(world_->scene_camera(time), {kWidth, kHeight}), time).ok());
+  for (const bool whole : submitted) {
+    if (whole) {
+      bool failed = false;
+      ASSERT_TRUE(frame(-1, &failed).ok());
       continue;
     }
-    ASSERT_TRUE(frame(-1, &failed).ok());
+    const double time = 1.0 / 30.0;
+    ASSERT_TRUE(renderer_->begin_frame(0).ok());
+    ASSERT_TRUE(renderer_->update(camera_view(world_->scene_camera(time), {kWidth, kHeight}), time).ok());
   }
   const std::vector<float> reference = colour();
   size_t differing = 0;
