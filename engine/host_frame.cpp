@@ -25,25 +25,46 @@ Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFo
 }
 
 Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
-                              Renderer& renderer, const View& view, double time_seconds,
-                              const ReadbackTargets& readback, HostTargets* targets) {
-  // The world leaves its images as attachments; the water takes them from there.
+                              std::span<Renderer* const> renderers, const View& view,
+                              double time_seconds, const ReadbackTargets& readback,
+                              HostTargets* targets) {
+  // The world leaves its images as attachments; the water takes them from there, and each
+  // river but the last hands them on as attachments to the next.
+  const ImageState color_attachment = image_state(Access::ColorAttachmentWrite, targets->color.format);
+  ImageState color_now = color_attachment;
+  ImageState depth_now = image_state(Access::DepthAttachmentWrite, targets->depth.format);
   ExternalImage color = targets->color;
   ExternalImage depth = targets->depth;
-  color.final = image_state(Access::ColorAttachmentWrite, color.format);
-  depth.final = image_state(Access::DepthAttachmentWrite, depth.format);
+  color.final = color_now;
+  depth.final = depth_now;
   SIVIFLOW_TRY(world.begin_frame(slot));
   SIVIFLOW_TRY(world.record(cmd, view, time_seconds, color, depth));
-  FrameInputs inputs;
-  inputs.color = targets->color;
-  inputs.depth = targets->depth;
-  inputs.color.current = color.final;
-  inputs.depth.current = depth.final;
-  inputs.readback = readback;
-  SIVIFLOW_TRY(renderer.record(cmd, inputs));
-  targets->color.current = targets->color.final;
-  targets->depth.current = targets->depth.final;
+  for (size_t i = 0; i < renderers.size(); ++i) {
+    const bool last = i + 1 == renderers.size();
+    FrameInputs inputs;
+    inputs.color = targets->color;
+    inputs.depth = targets->depth;
+    inputs.color.current = color_now;
+    inputs.depth.current = depth_now;
+    if (!last) {
+      inputs.color.final = color_attachment;
+      inputs.depth.final = image_state(Access::DepthAttachmentRead, targets->depth.format);
+    }
+    if (last) inputs.readback = readback;
+    SIVIFLOW_TRY(renderers[i]->record(cmd, inputs));
+    color_now = inputs.color.final;
+    depth_now = inputs.depth.final;
+  }
+  targets->color.current = color_now;
+  targets->depth.current = depth_now;
   return Status::success();
+}
+
+Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
+                              Renderer& renderer, const View& view, double time_seconds,
+                              const ReadbackTargets& readback, HostTargets* targets) {
+  Renderer* const one[] = {&renderer};
+  return record_world_and_water(cmd, slot, world, one, view, time_seconds, readback, targets);
 }
 
 }  // namespace siviflow

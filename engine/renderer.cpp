@@ -196,13 +196,13 @@ Status Renderer::Impl::create_river() {
   }
   RiverInput input;
   std::optional<ProceduralRiver> procedural;
-  SIVIFLOW_TRY(scene_river_input(info.scene, &input, &procedural));
+  SIVIFLOW_TRY(scene_river_input(info.scene, info.river_index, &input, &procedural));
   FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
   std::vector<Obstacle> obstacles;
   if (info.scene == nullptr) {
     obstacles = default_scene_obstacles(*procedural);
   } else {
-    flow = info.scene->flow;
+    flow = info.scene->rivers[info.river_index].flow;
     obstacles = info.scene->obstacles;
     std::vector<Obstacle> object_obstacles;
     SIVIFLOW_TRY(scene_object_obstacles(*info.scene, input.mesh.positions, &object_obstacles));

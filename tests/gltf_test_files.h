@@ -36,13 +36,13 @@ std::vector<size_t> write_bin(const std::filesystem::path& gltf, const Arrays&..
 }
 
 // A straight channel along +Z, `across` vertices per section, width w, as glTF with a .bin;
-// with a `drop` it descends that many metres per metre downstream.
+// with a `drop` it descends that many metres per metre downstream; its centreline at x = `x`.
 inline void write_channel_gltf(const std::filesystem::path& gltf, int sections, int across,
-                               float width, float spacing, float drop = 0.0f) {
+                               float width, float spacing, float drop = 0.0f, float x = 0.0f) {
   std::vector<float> positions;
   for (int k = 0; k < sections; ++k) {
     for (int j = 0; j < across; ++j) {
-      positions.push_back(width * 0.5f - width * static_cast<float>(j) / (across - 1));  // left = +X
+      positions.push_back(x + width * 0.5f - width * static_cast<float>(j) / (across - 1));  // left = +X
       positions.push_back(-drop * spacing * static_cast<float>(k));
       positions.push_back(spacing * static_cast<float>(k));
     }
@@ -63,8 +63,8 @@ inline void write_channel_gltf(const std::filesystem::path& gltf, int sections, 
        << R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" << at[1]
        << R"(},{"buffer":0,"byteOffset":)" << at[1] << R"(,"byteLength":)" << at[2] - at[1] << "}],"
        << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << positions.size() / 3
-       << R"(,"type":"VEC3","min":[)" << -half << "," << -drop * spacing * static_cast<float>(sections - 1)
-       << ",0],\"max\":[" << half << ",0," << spacing * static_cast<float>(sections - 1) << "]},"
+       << R"(,"type":"VEC3","min":[)" << x - half << "," << -drop * spacing * static_cast<float>(sections - 1)
+       << ",0],\"max\":[" << x + half << ",0," << spacing * static_cast<float>(sections - 1) << "]},"
        << R"({"bufferView":1,"componentType":5125,"count":)" << indices.size() << R"(,"type":"SCALAR"}]})";
   write_text(gltf, json.str());
 }

@@ -217,7 +217,9 @@ class Capture {
   std::optional<SceneFile> scene_;
   std::unique_ptr<HeadlessContext> context_;
   std::unique_ptr<World> world_;
-  std::unique_ptr<Renderer> renderer_;
+  std::vector<std::unique_ptr<Renderer>> rivers_;  // one water renderer per river of the scene
+  std::vector<Renderer*> river_renderers_;
+  Renderer* renderer_ = nullptr;  // the last river's: it reads the frame back
   Status write_particles_csv(const std::string& path) const;
 
   FinishedFrame finished_;
@@ -230,6 +232,12 @@ class Capture {
 };
 
 Status Capture::run() {
+  const size_t river_count = scene_.has_value() ? scene_->rivers.size() : 1;
+  if (river_count > 1 && (options_.flow_aov || options_.particles_aov || options_.normal_aov ||
+                          options_.reflection_aov)) {
+    return Status::error("--aov flow, particles, normal and reflection are of one river; the scene has " +
+                         std::to_string(river_count) + " (depth works with any number)");
+  }
   HeadlessContextOptions context_options;
   context_options.enable_validation = options_.validation;
   context_options.require_validation = options_.validation;
@@ -250,7 +258,6 @@ Status Capture::run() {
   CreateInfo info = context_->renderer_create_info(
       {options_.size.width, options_.size.height}, kOutputFormat);
   info.frames_in_flight = kFramesInFlight;
-  info.readback_images = readback_images();
   info.seed = options_.seed;
   info.scene = scene_.has_value() ? &*scene_ : nullptr;
   WorldCreateInfo world_info = context_->world_create_info(kOutputFormat, kDepthFormat);
@@ -260,13 +267,21 @@ Status Capture::run() {
   info.depth_format = kDepthFormat;
   info.reflection = &World::draw_reflection;
   info.reflection_user = world_.get();
-  SIVIFLOW_TRY(Renderer::create(info, &renderer_));
+  for (size_t i = 0; i < river_count; ++i) {
+    info.river_index = static_cast<uint32_t>(i);
+    info.readback_images = i + 1 == river_count ? readback_images() : 0;
+    rivers_.emplace_back();
+    SIVIFLOW_TRY(Renderer::create(info, &rivers_.back()));
+    river_renderers_.push_back(rivers_.back().get());
+  }
+  renderer_ = river_renderers_.back();
   const VkExtent2D extent{options_.size.width, options_.size.height};
   // The particles carry state from frame to frame: a shard starting at frame A first advances
   // the simulation through frames 0..A-1, without rendering, so that its frames equal a full run's.
   for (uint32_t frame = 0; frame < options_.first_frame; ++frame) {
     const double time = static_cast<double>(frame) / options_.fps;
-    SIVIFLOW_TRY(renderer_->simulate(camera_view(world_->scene_camera(time), extent), time));
+    const View view = camera_view(world_->scene_camera(time), extent);
+    for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->simulate(view, time));
   }
 
   std::vector<SlotTargets> slots(kFramesInFlight);
@@ -293,15 +308,15 @@ Status Capture::run() {
     const bool have_finished = slot.pending;
     if (have_finished) copy_out(slot);
     const double time = static_cast<double>(frame) / options_.fps;
-    SIVIFLOW_TRY(renderer_->begin_frame(index));
+    for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->begin_frame(index));
     slot.camera = world_->scene_camera(time);
     const View view = camera_view(slot.camera, extent);
-    SIVIFLOW_TRY(renderer_->update(view, time));
+    for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->update(view, time));
     const std::span<const Particle> particles = renderer_->particle_field().particles();
     slot.particles.assign(particles.begin(), particles.end());
     ReadbackTargets readback;
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) readback.buffers[i] = slot.readback[i].buffer;
-    SIVIFLOW_TRY(record_world_and_water(cmd, index, *world_, *renderer_, view, time, readback,
+    SIVIFLOW_TRY(record_world_and_water(cmd, index, *world_, river_renderers_, view, time, readback,
                                         &slot.targets));
     SIVIFLOW_TRY(context_->end_slot_and_submit(index));
     slot.pending = true;

@@ -1,4 +1,5 @@
-// `siviflow flow SCENE.json --out FILE.csv [--time T]`: the solved flow field of a scene's river.
+// `siviflow flow SCENE.json --out FILE.csv [--time T] [--river N]`: the solved flow field of one
+// of a scene's rivers.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,10 +17,11 @@ constexpr const char* kCommand = "flow";
 
 void print_help() {
   std::printf(
-      "usage: siviflow flow SCENE.json --out FILE.csv [--time T]\n"
-      "  Solves the stream-function flow of the scene's river, with its obstacles placed at\n"
-      "  time T (seconds, default 0), and writes one CSV row per river vertex in the file's\n"
-      "  accessor order: vertex,x,y,z,section,bank,width,d_left,d_right,psi,vx,vy,vz,wet\n");
+      "usage: siviflow flow SCENE.json --out FILE.csv [--time T] [--river N]\n"
+      "  Solves the stream-function flow of the scene's river N (default 0, the first), with\n"
+      "  its obstacles placed at time T (seconds, default 0), and writes one CSV row per river\n"
+      "  vertex in the file's accessor order:\n"
+      "  vertex,x,y,z,section,bank,width,d_left,d_right,psi,vx,vy,vz,wet\n");
 }
 
 Status parse_time(std::string_view text, double* out) {
@@ -40,6 +42,7 @@ int run_flow(int argc, char** argv) {
   std::string scene_path;
   std::string out_path;
   double time = 0.0;
+  uint32_t river_index = 0;
   std::string_view value;
   while (!args.done()) {
     const std::string_view arg = args.next();
@@ -53,6 +56,9 @@ int run_flow(int argc, char** argv) {
     } else if (arg == "--time") {
       status = args.value(arg, &value);
       if (status.ok()) status = parse_time(value, &time);
+    } else if (arg == "--river") {
+      status = args.value(arg, &value);
+      if (status.ok()) status = cli::parse_uint(arg, value, &river_index);
     } else if (!arg.empty() && arg[0] == '-') {
       status = Status::error("unknown option '" + std::string(arg) + "' (see --help)");
     } else if (scene_path.empty()) {
@@ -71,7 +77,7 @@ int run_flow(int argc, char** argv) {
   status = load_scene_file(scene_path, &scene);
   if (!status.ok()) return cli::fail(kCommand, status.message());
   SceneRiverFlow river;
-  status = build_scene_river_flow(scene, time, &river);
+  status = build_scene_river_flow(scene, river_index, time, &river);
   if (!status.ok()) return cli::fail(kCommand, status.message());
   const std::string csv = flow_field_csv(river);
   status = write_file_atomically(out_path, csv.data(), csv.size());

@@ -1,6 +1,7 @@
 #include "scene/river_simulation.h"
 
 #include <cmath>
+#include <string>
 
 #include <glm/geometric.hpp>
 
@@ -49,8 +50,14 @@ Status gltf_river_input(TriangleMesh gltf, RiverInput* out) {
   return Status::success();
 }
 
-Status scene_river_input(const SceneFile* scene, RiverInput* out,
+Status scene_river_input(const SceneFile* scene, size_t river_index, RiverInput* out,
                          std::optional<ProceduralRiver>* procedural) {
+  const size_t rivers = scene == nullptr ? 1 : scene->rivers.size();
+  if (river_index >= rivers) {
+    return Status::error((scene == nullptr ? std::string("the default scene") : scene->path) +
+                         ": no river " + std::to_string(river_index) + " (it has " +
+                         std::to_string(rivers) + ")");
+  }
   if (scene == nullptr) {
     procedural->emplace(default_river_params());
     return procedural_river_input(**procedural, out);
@@ -58,14 +65,15 @@ Status scene_river_input(const SceneFile* scene, RiverInput* out,
   const auto in_scene = [scene](const Status& status) {
     return status.ok() ? status : Status::error(scene->path + ": " + status.message(), status.code());
   };
-  if (scene->river.source == SceneRiver::Source::kGltf) {
+  const SceneRiver& river = scene->rivers[river_index];
+  if (river.source == SceneRiver::Source::kGltf) {
     TriangleMesh gltf;
-    SIVIFLOW_TRY(in_scene(load_river_mesh(scene->river.gltf, scene->river.mesh, &gltf)));
+    SIVIFLOW_TRY(in_scene(load_river_mesh(river.gltf, river.mesh, &gltf)));
     procedural->reset();
     return in_scene(gltf_river_input(std::move(gltf), out));
   }
-  SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(scene->river.procedural)));
-  procedural->emplace(scene->river.procedural);
+  SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(river.procedural)));
+  procedural->emplace(river.procedural);
   return in_scene(procedural_river_input(**procedural, out));
 }
 

@@ -43,9 +43,9 @@ struct RiverInput {
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
 // A glTF river with the depth profile above, and the slope of that riverbed across.
 Status gltf_river_input(TriangleMesh gltf, RiverInput* out);
-// The river of a scene file (null: the default scene's), and the procedural river it was made
-// from, if it was. Errors name the scene file.
-Status scene_river_input(const SceneFile* scene, RiverInput* out,
+// River `river_index` of a scene file (null: the default scene's one river), and the procedural
+// river it was made from, if it was. Errors name the scene file, or the index it lacks.
+Status scene_river_input(const SceneFile* scene, size_t river_index, RiverInput* out,
                          std::optional<ProceduralRiver>* procedural);
 
 // The river every view of it shares: its mesh, its flow (solved once, then re-solved only

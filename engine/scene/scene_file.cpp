@@ -237,45 +237,57 @@ Status parse_procedural(const Reader& r, const Json& v, const std::string& path,
   return Status::success();
 }
 
-Status parse_river(const Reader& r, const Json& v, const std::string& folder, SceneRiver* out) {
-  const std::string path = "river";
+Status parse_flow(const Reader& r, const Json& v, const std::string& path, FlowParams* out) {
   SIVIFLOW_TRY(r.object(v, path));
-  SIVIFLOW_TRY(r.keys(v, path, {"gltf", "mesh", "procedural"}));
+  SIVIFLOW_TRY(r.keys(v, path, {"discharge", "p", "search_radius"}));
+  if (const Json* x = find(v, "discharge"))
+    SIVIFLOW_TRY(r.positive(*x, join(path, "discharge"), &out->discharge));
+  if (const Json* x = find(v, "p")) {
+    SIVIFLOW_TRY(r.positive(*x, join(path, "p"), &out->p));
+    if (out->p > 16.0f)
+      return r.fail(join(path, "p"), text_format("%g must be at most 16", double(out->p)));
+  }
+  if (const Json* x = find(v, "search_radius")) {
+    SIVIFLOW_TRY(r.positive(*x, join(path, "search_radius"), &out->search_radius));
+  }
+  return Status::success();
+}
+
+// One river at `path`: "river" (its flow from the top-level "flow") or an element of "rivers"
+// (which may carry a "flow" of its own, else the top-level one's).
+Status parse_river(const Reader& r, const Json& v, const std::string& path,
+                   const std::string& folder, bool own_flow, const FlowParams& flow,
+                   SceneRiver* out) {
+  SIVIFLOW_TRY(r.object(v, path));
+  if (own_flow) {
+    SIVIFLOW_TRY(r.keys(v, path, {"gltf", "mesh", "procedural", "flow"}));
+  } else {
+    SIVIFLOW_TRY(r.keys(v, path, {"gltf", "mesh", "procedural"}));
+  }
   const Json* gltf = find(v, "gltf");
   const Json* mesh = find(v, "mesh");
   const Json* procedural = find(v, "procedural");
   if (gltf && procedural) return r.fail(path, "give either 'gltf' or 'procedural', not both");
   if (!gltf && !procedural) return r.fail(path, "needs 'gltf' (a river mesh file) or 'procedural'");
   SceneRiver river;
+  river.flow = flow;
   if (gltf) {
     river.source = SceneRiver::Source::kGltf;
-    SIVIFLOW_TRY(r.string(*gltf, "river.gltf", &river.gltf));
+    SIVIFLOW_TRY(r.string(*gltf, join(path, "gltf"), &river.gltf));
     river.gltf = r.resolve(folder, river.gltf);
-    if (mesh) SIVIFLOW_TRY(r.string(*mesh, "river.mesh", &river.mesh));
+    if (mesh) SIVIFLOW_TRY(r.string(*mesh, join(path, "mesh"), &river.mesh));
   } else {
-    if (mesh) return r.fail("river.mesh", "only goes with 'gltf'");
+    if (mesh) return r.fail(join(path, "mesh"), "only goes with 'gltf'");
     river.source = SceneRiver::Source::kProcedural;
-    SIVIFLOW_TRY(parse_procedural(r, *procedural, "river.procedural", &river.procedural));
+    SIVIFLOW_TRY(parse_procedural(r, *procedural, join(path, "procedural"), &river.procedural));
+  }
+  if (const Json* x = own_flow ? find(v, "flow") : nullptr) {
+    SIVIFLOW_TRY(parse_flow(r, *x, join(path, "flow"), &river.flow));
   }
   *out = std::move(river);
   return Status::success();
 }
 
-Status parse_flow(const Reader& r, const Json& v, FlowParams* out) {
-  SIVIFLOW_TRY(r.object(v, "flow"));
-  SIVIFLOW_TRY(r.keys(v, "flow", {"discharge", "p", "search_radius"}));
-  if (const Json* x = find(v, "discharge"))
-    SIVIFLOW_TRY(r.positive(*x, "flow.discharge", &out->discharge));
-  if (const Json* x = find(v, "p")) {
-    SIVIFLOW_TRY(r.positive(*x, "flow.p", &out->p));
-    if (out->p > 16.0f)
-      return r.fail("flow.p", text_format("%g must be at most 16", double(out->p)));
-  }
-  if (const Json* x = find(v, "search_radius")) {
-    SIVIFLOW_TRY(r.positive(*x, "flow.search_radius", &out->search_radius));
-  }
-  return Status::success();
-}
 
 // The water's look: every field of WaterLook under its own name, each optional, then the ranges
 // the renderer accepts (so a file the parser takes is one the renderer takes).
@@ -555,18 +567,32 @@ Status parse_root(const Reader& r, const Json& root, const std::string& file,
   }
   SIVIFLOW_TRY(
       r.keys(root, "",
-             {"$schema", "version", "river", "flow", "obstacles", "objects", "camera", "render",
-              "look"}));
+             {"$schema", "version", "river", "rivers", "flow", "obstacles", "objects", "camera",
+              "render", "look"}));
   if (const Json* schema = find(root, "$schema"); schema && !schema->is_string()) {
     return r.fail("$schema", "must be a string");
   }
   const Json* river = find(root, "river");
-  if (!river) return Status::error(file + ": missing required key 'river'");
+  const Json* rivers = find(root, "rivers");
+  if (river && rivers) return r.fail("rivers", "give either 'river' or 'rivers', not both");
+  if (!river && !rivers) return Status::error(file + ": missing required key 'river' (or 'rivers')");
   SceneFile scene;
   scene.path = file;
   scene.folder = folder;
-  SIVIFLOW_TRY(parse_river(r, *river, folder, &scene.river));
-  if (const Json* x = find(root, "flow")) SIVIFLOW_TRY(parse_flow(r, *x, &scene.flow));
+  FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
+  if (const Json* x = find(root, "flow")) SIVIFLOW_TRY(parse_flow(r, *x, "flow", &flow));
+  if (river) {
+    scene.rivers.resize(1);
+    SIVIFLOW_TRY(parse_river(r, *river, "river", folder, false, flow, &scene.rivers[0]));
+  } else {
+    SIVIFLOW_TRY(r.array(*rivers, "rivers", kMaxSceneRivers));
+    if (rivers->empty()) return r.fail("rivers", "needs at least one river");
+    scene.rivers.resize(rivers->size());
+    for (size_t i = 0; i < rivers->size(); ++i) {
+      SIVIFLOW_TRY(parse_river(r, (*rivers)[i], element("rivers", i), folder, true, flow,
+                               &scene.rivers[i]));
+    }
+  }
   if (const Json* x = find(root, "obstacles"))
     SIVIFLOW_TRY(parse_obstacles(r, *x, &scene.obstacles));
   if (const Json* x = find(root, "objects"))

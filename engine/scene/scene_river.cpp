@@ -188,18 +188,24 @@ Status scene_object_obstacles(const SceneFile& scene, std::span<const glm::vec3>
   return Status::success();
 }
 
-Status build_scene_river_flow(const SceneFile& scene, double time_seconds, SceneRiverFlow* out) {
+Status build_scene_river_flow(const SceneFile& scene, size_t river_index, double time_seconds,
+                              SceneRiverFlow* out) {
+  if (river_index >= scene.rivers.size()) {
+    return Status::error(scene.path + ": no river " + std::to_string(river_index) + " (the scene has " +
+                         std::to_string(scene.rivers.size()) + ")");
+  }
+  const SceneRiver& river = scene.rivers[river_index];
   std::vector<uint32_t> indices;
-  if (scene.river.source == SceneRiver::Source::kGltf) {
+  if (river.source == SceneRiver::Source::kGltf) {
     TriangleMesh mesh;
-    SIVIFLOW_TRY(load_river_mesh(scene.river.gltf, scene.river.mesh, &mesh));
+    SIVIFLOW_TRY(load_river_mesh(river.gltf, river.mesh, &mesh));
     out->positions = std::move(mesh.positions);
     indices = std::move(mesh.indices);
   } else {
-    Status status = ProceduralRiver::validate(scene.river.procedural);
+    Status status = ProceduralRiver::validate(river.procedural);
     if (!status.ok()) return in_scene(scene, status);
     RiverMesh mesh;
-    status = ProceduralRiver(scene.river.procedural).generate_mesh(&mesh);
+    status = ProceduralRiver(river.procedural).generate_mesh(&mesh);
     if (!status.ok()) return in_scene(scene, status);
     out->positions = std::move(mesh.positions);
     indices = std::move(mesh.indices);
@@ -207,7 +213,7 @@ Status build_scene_river_flow(const SceneFile& scene, double time_seconds, Scene
   RiverSurface surface;
   Status status = RiverSurface::build(out->positions, indices, RiverSurfaceOptions{}, &surface);
   if (!status.ok()) return in_scene(scene, status);
-  status = StreamFunction::create(std::move(surface), scene.flow, &out->flow);
+  status = StreamFunction::create(std::move(surface), river.flow, &out->flow);
   if (!status.ok()) return in_scene(scene, status);
   std::vector<Obstacle> obstacles = scene.obstacles;
   std::vector<Obstacle> from_objects;

@@ -61,6 +61,7 @@ struct World::Impl {
   ProceduralRiver river{default_river_params()};  // the default scene's, or the scene file's
   bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
   RiverMesh river_mesh;          // for a glTF river's bed and overview camera
+  std::vector<SceneGeometry> other_rivers;  // the scene's rivers after the first, until uploaded
   std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is at the frame's time
   SceneCamera camera_path;          // keys empty: the scene's default camera
   SceneLook look = default_scene_look();
@@ -103,10 +104,19 @@ struct World::Impl {
 Status World::Impl::load_scene() {
   RiverInput input;
   std::optional<ProceduralRiver> procedural;
-  SIVIFLOW_TRY(scene_river_input(info.scene, &input, &procedural));
+  SIVIFLOW_TRY(scene_river_input(info.scene, 0, &input, &procedural));
   river_from_file = !procedural.has_value();
   if (procedural) river = *procedural;
   river_mesh = std::move(input.mesh);
+  // The scene's other rivers: their valleys (procedural) or beds (glTF), without boulders.
+  const size_t rivers = info.scene != nullptr ? info.scene->rivers.size() : 1;
+  for (size_t i = 1; i < rivers; ++i) {
+    RiverInput other;
+    std::optional<ProceduralRiver> other_procedural;
+    SIVIFLOW_TRY(scene_river_input(info.scene, i, &other, &other_procedural));
+    other_rivers.push_back(other_procedural ? build_scene_geometry(*other_procedural, {})
+                                            : build_riverbed_geometry(other.mesh, {}));
+  }
   obstacles = info.scene != nullptr ? info.scene->obstacles : default_scene_obstacles(river);
   if (info.scene != nullptr) camera_path = info.scene->camera;
   return Status::success();
@@ -126,6 +136,18 @@ Status World::Impl::create_resources() {
     main_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i]});
     reflection_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i + 1]});
   }
+  // The other rivers' valleys or beds, static like the first's.
+  for (const SceneGeometry& other : other_rivers) {
+    const auto first_vertex = static_cast<uint32_t>(geometry.vertices.size());
+    const auto first_index = static_cast<uint32_t>(geometry.indices.size());
+    geometry.vertices.insert(geometry.vertices.end(), other.vertices.begin(), other.vertices.end());
+    for (uint32_t i = 0; i < other.static_index_count; ++i) {
+      geometry.indices.push_back(first_vertex + other.indices[i]);
+    }
+    main_draws.push_back({first_index, other.static_index_count, &main_constants});
+    reflection_draws.push_back({first_index, other.static_index_count, &reflection_constants});
+  }
+  other_rivers.clear();
   // The objects after the valley, in world space: drawn with the view's own constants.
   const auto first_object_vertex = static_cast<uint32_t>(geometry.vertices.size());
   const auto first_object_index = static_cast<uint32_t>(geometry.indices.size());

@@ -153,7 +153,7 @@ class HostEmbeddingTest : public GpuTest {
 SceneFile default_scene_file(std::vector<SceneObject> objects = {}) {
   SceneFile scene;
   scene.path = "host.json";
-  scene.river.procedural = default_river_params();
+  scene.rivers[0].procedural = default_river_params();
   scene.obstacles = default_scene_obstacles(ProceduralRiver(default_river_params()));
   scene.objects = std::move(objects);
   return scene;
@@ -235,7 +235,7 @@ TEST_F(HostEmbeddingTest, DeeperHostBedDarkensTheWater) {
   const float depths[2] = {0.4f, 4.0f};
   for (int i = 0; i < 2; ++i) {
     SceneFile scene = default_scene_file();
-    scene.river.procedural.depth = depths[i];
+    scene.rivers[0].procedural.depth = depths[i];
     create(&scene, true);
     shots[i] = shoot(view, 1.0);
     ASSERT_FALSE(shots[i].mask.empty());

@@ -21,7 +21,7 @@ namespace {
 SceneFile default_scene_file(const std::vector<Obstacle>& extra = {}) {
   SceneFile scene;
   scene.path = "default-as-file.json";
-  scene.river.procedural = default_river_params();
+  scene.rivers[0].procedural = default_river_params();
   scene.obstacles = default_scene_obstacles(ProceduralRiver(default_river_params()));
   scene.obstacles.insert(scene.obstacles.end(), extra.begin(), extra.end());
   scene.camera.fov_y_deg = default_camera(ProceduralRiver(default_river_params()), 0.0).fov_y_deg;

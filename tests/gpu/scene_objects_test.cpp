@@ -165,5 +165,38 @@ TEST_F(SceneObjectsTest, GltfRiverFlowsDownstreamAroundAnObjectObstacle) {
   EXPECT_LT(aside, water / 5);
 }
 
+// A scene of two rivers captured: both drawn over the world (their beds), with the depth AOV;
+// the AOVs that belong to one river are refused by name before any GPU work.
+TEST_F(SceneObjectsTest, CaptureOfTwoRivers) {
+  write_channel_gltf(dir_ / "west.gltf", 41, 9, 8.0f, 1.0f, 0.0f, -9.0f);
+  write_channel_gltf(dir_ / "east.gltf", 41, 9, 8.0f, 1.0f, 0.0f, 9.0f);
+  const fs::path scene = dir_ / "two.json";
+  write_text(scene, R"({"version":1,"rivers":[{"gltf":"west.gltf"},)"
+                    R"({"gltf":"east.gltf","flow":{"discharge":30}}],)"
+                    R"("camera":{"keys":[{"t":0,"position":[0,30,-12],"target":[0,0,30]}]}})");
+  RunResult r = run_siviflow("capture " + scene.string() + " --frames 1 --size 320x180 --aov depth "
+                             "--validation --out " + (dir_ / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ExrImage image;
+  ASSERT_TRUE(read_exr((dir_ / "out" / "frame_00000.exr").string(), &image).ok());
+  // Water is bluer than the grey-lit beds it lies on: count the bluish pixels in front of a bed
+  // (finite depth, not the sky) on each side of the picture's middle.
+  const std::vector<float>& red = *image.find("R");
+  const std::vector<float>& blue = *image.find("B");
+  const std::vector<float>* depth = image.find("depth.Z");
+  ASSERT_NE(depth, nullptr);
+  size_t left = 0, right = 0;
+  for (size_t i = 0; i < red.size(); ++i) {
+    if (!std::isfinite((*depth)[i]) || blue[i] <= red[i] * 1.2f) continue;
+    (i % kWidth < kWidth / 2 ? left : right) += 1;
+  }
+  EXPECT_GT(left, 500u) << "the east river (+X is on the left looking down +Z)";
+  EXPECT_GT(right, 500u) << "the west river";
+  r = run_siviflow("capture " + scene.string() + " --frames 1 --size 64x36 --aov flow --out " +
+                   (dir_ / "out").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("the scene has 2"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace siviflow::testing

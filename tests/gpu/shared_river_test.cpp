@@ -1,22 +1,30 @@
 // One river, many views: renderers that share a river (CreateInfo::share_river_with) render
 // each view exactly as a renderer of its own would, in two images or side by side in one image
 // (split screen by viewports), with one flow solve between them; an obstacle added through one
-// re-routes the other's flow.
+// re-routes the other's flow. And several rivers: a scene's rivers, one renderer each, drawn
+// over one world, each with its own flow.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
+#include <string>
 #include <memory>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <glm/gtc/packing.hpp>
 #include <gtest/gtest.h>
 
+#include "gltf_test_files.h"
 #include "gpu_test.h"
+#include "run_command.h"
 #include "siviflow/host_frame.h"
 
 namespace siviflow::testing {
 namespace {
+
+namespace fs = std::filesystem;
 
 constexpr uint32_t kWidth = 320;
 constexpr uint32_t kHeight = 180;
@@ -28,20 +36,27 @@ struct Pane {
   double camera_delay = 0.0;  // seconds ahead on the scene's camera path
   HostTargets* targets = nullptr;
   VkRect2D viewport{};
+  bool draws_world = true;  // false: another river over the world a pane before drew
   HostBuffer colour;  // read back: the view's pixels
   HostBuffer flow;    // read back: its flow texture
+  HostBuffer mask;    // read back when the renderer was made with the water mask
 };
 
 class SharedRiverTest : public GpuTest {
  protected:
-  std::unique_ptr<Renderer> make(VkExtent2D extent, const Renderer* share = nullptr) {
+  std::unique_ptr<Renderer> make(VkExtent2D extent, const Renderer* share = nullptr,
+                                 const SceneFile* scene = nullptr, uint32_t river = 0) {
     if (world_ == nullptr) {
       WorldCreateInfo world_info =
           context_->world_create_info(VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT);
+      world_info.scene = scene;
       EXPECT_TRUE(World::create(world_info, &world_).ok());
     }
     CreateInfo info = make_create_info(extent.width, extent.height);
     info.readback_images = readback_bit(ReadbackImage::kColor) | readback_bit(ReadbackImage::kFlowTexture);
+    if (scene != nullptr) info.readback_images |= readback_bit(ReadbackImage::kWaterMask);
+    info.scene = scene;
+    info.river_index = river;
     info.reflection = &World::draw_reflection;
     info.reflection_user = world_.get();
     info.share_river_with = share;
@@ -67,6 +82,8 @@ class SharedRiverTest : public GpuTest {
         pane->renderer->readback_bytes(ReadbackImage::kColor), &pane->colour).ok());
     ASSERT_TRUE(context_->create_readback_buffer(
         pane->renderer->readback_bytes(ReadbackImage::kFlowTexture), &pane->flow).ok());
+    ASSERT_TRUE(context_->create_readback_buffer(
+        pane->renderer->readback_bytes(ReadbackImage::kWaterMask), &pane->mask).ok());
   }
 
   // Frames 0 .. kFrames-1 of every pane, all in one command buffer per frame: the world then the
@@ -85,13 +102,19 @@ class SharedRiverTest : public GpuTest {
         ASSERT_TRUE(status.ok()) << status.message();
         ExternalImage color = pane->targets->color;
         ExternalImage depth = pane->targets->depth;
-        color.final = {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                       VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
-        depth.final = {VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                       VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                       VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL};
-        status = world_->record(cmd, view, time, color, depth);
-        ASSERT_TRUE(status.ok()) << status.message();
+        if (pane->draws_world) {
+          color.final = {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+          depth.final = {VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL};
+          status = world_->record(cmd, view, time, color, depth);
+          ASSERT_TRUE(status.ok()) << status.message();
+        } else {
+          color.final = color.current;
+          depth.final = depth.current;
+        }
         FrameInputs inputs;
         inputs.color = pane->targets->color;
         inputs.depth = pane->targets->depth;
@@ -99,6 +122,7 @@ class SharedRiverTest : public GpuTest {
         inputs.depth.current = depth.final;
         inputs.readback[ReadbackImage::kColor] = pane->colour.buffer;
         inputs.readback[ReadbackImage::kFlowTexture] = pane->flow.buffer;
+        inputs.readback[ReadbackImage::kWaterMask] = pane->mask.buffer;
         status = pane->renderer->record(cmd, inputs);
         ASSERT_TRUE(status.ok()) << status.message();
         pane->targets->color.current = pane->targets->color.final;
@@ -113,6 +137,19 @@ class SharedRiverTest : public GpuTest {
     View view = camera_view(world_->scene_camera(time + pane.camera_delay), pane.viewport.extent);
     view.viewport = pane.viewport;
     return view;
+  }
+
+  // A renderer of river `river` of `scene` that should fail to be made.
+  Status make_status(VkExtent2D extent, const SceneFile* scene, uint32_t river) {
+    CreateInfo info = make_create_info(extent.width, extent.height);
+    info.scene = scene;
+    info.river_index = river;
+    std::unique_ptr<Renderer> renderer;
+    const Status status = Renderer::create(info, &renderer);
+    if (!status.ok()) {
+      EXPECT_NE(status.message().find("no river 2 (it has 2)"), std::string::npos) << status.message();
+    }
+    return status;
   }
 
   std::vector<std::unique_ptr<HostTargets>> targets_;
@@ -210,6 +247,68 @@ TEST_F(SharedRiverTest, ObstacleAddedThroughOneViewReroutesTheOther) {
   // Removed through the probe's renderer: the river is as before for every view.
   ASSERT_TRUE(probe->remove_obstacle(id).ok());
   EXPECT_FALSE(main->remove_obstacle(id).ok()) << "one set of obstacles";
+}
+
+// Mean speed of a renderer's live particles (their flow as simulated).
+double mean_particle_speed(const Renderer& renderer, size_t* count) {
+  double sum = 0.0;
+  *count = 0;
+  for (const Particle& p : renderer.particle_field().particles()) {
+    if (!p.live()) continue;
+    sum += glm::length(p.flow);
+    ++*count;
+  }
+  return *count == 0 ? 0.0 : sum / static_cast<double>(*count);
+}
+
+TEST_F(SharedRiverTest, TwoRiversOfASceneRenderEachWithItsOwnFlow) {
+  // Two straight channels 8 m wide side by side, the right one carrying four times the water.
+  const fs::path dir = fresh_test_dir("two_rivers");
+  write_channel_gltf(dir / "slow.gltf", 61, 9, 8.0f, 1.0f, 0.0f, -9.0f);
+  write_channel_gltf(dir / "fast.gltf", 61, 9, 8.0f, 1.0f, 0.0f, 9.0f);
+  SceneFile scene;
+  scene.path = (dir / "two_rivers.json").string();
+  scene.rivers.resize(2);
+  for (int i = 0; i < 2; ++i) {
+    scene.rivers[i].source = SceneRiver::Source::kGltf;
+    scene.rivers[i].gltf = (dir / (i == 0 ? "slow.gltf" : "fast.gltf")).string();
+    scene.rivers[i].flow.discharge = i == 0 ? 4.0f : 16.0f;
+  }
+  scene.camera.keys = {{0.0, {0.0f, 30.0f, -12.0f}, {0.0f, 0.0f, 30.0f}}};
+  const VkExtent2D extent{kWidth, kHeight};
+  auto slow = make(extent, nullptr, &scene, 0);
+  auto fast = make(extent, nullptr, &scene, 1);
+  EXPECT_FALSE(make_status(extent, &scene, 2).ok());
+  HostTargets* screen = targets(extent);
+  Pane a{slow.get(), 0.0, screen, {{0, 0}, extent}};
+  Pane b{fast.get(), 0.0, screen, {{0, 0}, extent}, false};
+  render({&a, &b});
+
+  // Both rivers drawn: each one's water where it is. Looking down +Z, +X is on the left of the
+  // picture: the fast river (x = 9) on the left, the slow one on the right.
+  double centre[2] = {};
+  size_t water[2] = {};
+  for (int i = 0; i < 2; ++i) {
+    const auto* mask = static_cast<const float*>((i == 0 ? a : b).mask.data);
+    for (size_t p = 0; p < size_t{kWidth} * kHeight; ++p) {
+      if (mask[p] != 1.0f) continue;
+      centre[i] += static_cast<double>(p % kWidth);
+      ++water[i];
+    }
+    ASSERT_GT(water[i], 1000u) << "river " << i << " is drawn";
+    centre[i] /= static_cast<double>(water[i]);
+  }
+  EXPECT_GT(centre[0], kWidth / 2.0);
+  EXPECT_LT(centre[1], kWidth / 2.0);
+  // Each with its own flow: the same channel, four times the discharge, four times the speed.
+  size_t count[2] = {};
+  const double slow_speed = mean_particle_speed(*slow, &count[0]);
+  const double fast_speed = mean_particle_speed(*fast, &count[1]);
+  ASSERT_GT(count[0], 50u);
+  ASSERT_GT(count[1], 50u);
+  EXPECT_NEAR(fast_speed / slow_speed, 4.0, 0.4);
+  EXPECT_EQ(slow->flow_solves(), 1u);
+  EXPECT_EQ(fast->flow_solves(), 1u);
 }
 
 }  // namespace

@@ -89,12 +89,12 @@ TEST(SceneFile, FullFileParsesEveryField) {
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(scene.path, kFile);
   EXPECT_EQ(scene.folder, kFolder);
-  EXPECT_EQ(scene.river.source, SceneRiver::Source::kGltf);
-  EXPECT_EQ(scene.river.gltf, "/data/scenes/rivers/river.glb");
-  EXPECT_EQ(scene.river.mesh, "River");
-  EXPECT_EQ(scene.flow.discharge, 12.5f);
-  EXPECT_EQ(scene.flow.p, 1.25f);
-  EXPECT_EQ(scene.flow.search_radius, 30.0f);
+  EXPECT_EQ(scene.rivers[0].source, SceneRiver::Source::kGltf);
+  EXPECT_EQ(scene.rivers[0].gltf, "/data/scenes/rivers/river.glb");
+  EXPECT_EQ(scene.rivers[0].mesh, "River");
+  EXPECT_EQ(scene.rivers[0].flow.discharge, 12.5f);
+  EXPECT_EQ(scene.rivers[0].flow.p, 1.25f);
+  EXPECT_EQ(scene.rivers[0].flow.search_radius, 30.0f);
 
   ASSERT_EQ(scene.obstacles.size(), 2u);
   EXPECT_EQ(scene.obstacles[0].centre, glm::vec3(1, 0, 2));
@@ -203,14 +203,14 @@ TEST(SceneFile, DefaultsWhenOptionalPartsAreAbsent) {
   const Status status = parse(R"({"version": 1, "river": {"procedural": {}}})", &scene);
   ASSERT_TRUE(status.ok()) << status.message();
   const ProceduralRiverParams defaults;
-  EXPECT_EQ(scene.river.source, SceneRiver::Source::kProcedural);
-  EXPECT_EQ(scene.river.procedural.length, defaults.length);
-  EXPECT_EQ(scene.river.procedural.width, defaults.width);
-  EXPECT_EQ(scene.river.procedural.seed, defaults.seed);
-  EXPECT_EQ(scene.river.procedural.vertices_across, defaults.vertices_across);
-  EXPECT_EQ(scene.flow.discharge, kDefaultSceneDischarge);
-  EXPECT_EQ(scene.flow.p, kDefaultShepardPower);
-  EXPECT_EQ(scene.flow.search_radius, 0.0f) << "0: 3 x the widest section";
+  EXPECT_EQ(scene.rivers[0].source, SceneRiver::Source::kProcedural);
+  EXPECT_EQ(scene.rivers[0].procedural.length, defaults.length);
+  EXPECT_EQ(scene.rivers[0].procedural.width, defaults.width);
+  EXPECT_EQ(scene.rivers[0].procedural.seed, defaults.seed);
+  EXPECT_EQ(scene.rivers[0].procedural.vertices_across, defaults.vertices_across);
+  EXPECT_EQ(scene.rivers[0].flow.discharge, kDefaultSceneDischarge);
+  EXPECT_EQ(scene.rivers[0].flow.p, kDefaultShepardPower);
+  EXPECT_EQ(scene.rivers[0].flow.search_radius, 0.0f) << "0: 3 x the widest section";
   EXPECT_TRUE(scene.obstacles.empty());
   EXPECT_TRUE(scene.objects.empty());
   EXPECT_EQ(scene.camera.fov_y_deg, 50.0f);
@@ -229,7 +229,7 @@ TEST(SceneFile, DefaultsWhenOptionalPartsAreAbsent) {
                           {"objects", Json::array()}}),
                     &empty_sections)
                   .ok());
-  EXPECT_EQ(empty_sections.flow.discharge, kDefaultSceneDischarge);
+  EXPECT_EQ(empty_sections.rivers[0].flow.discharge, kDefaultSceneDischarge);
   EXPECT_EQ(empty_sections.render.width, 1280u);
 }
 
@@ -251,7 +251,7 @@ TEST(SceneFile, ProceduralParametersAreParsed) {
                                         {"vertices_across", 9}}}}}}),
                               &scene);
   ASSERT_TRUE(status.ok()) << status.message();
-  const ProceduralRiverParams& p = scene.river.procedural;
+  const ProceduralRiverParams& p = scene.rivers[0].procedural;
   EXPECT_EQ(p.length, 300.0f);
   EXPECT_EQ(p.meander_amplitude, 0.0f);
   EXPECT_EQ(p.meander_wavelength, 90.5f);
@@ -384,7 +384,7 @@ TEST(SceneFile, RiverIsRequiredAndHasOneSource) {
   const Status status =
       parse(with({{"river", {{"procedural", nullptr}, {"gltf", "r.glb"}}}}), &scene);
   ASSERT_TRUE(status.ok()) << status.message();
-  EXPECT_EQ(scene.river.mesh, "") << "mesh is optional: the first mesh";
+  EXPECT_EQ(scene.rivers[0].mesh, "") << "mesh is optional: the first mesh";
 }
 
 TEST(SceneFile, MalformedJsonIsAnErrorNamingTheFile) {
@@ -407,7 +407,7 @@ TEST(SceneFile, LoadsFromDiskAndResolvesPathsAgainstTheFilesFolder) {
   const Status status = load_scene_file((dir / "scenes" / "valley.json").string(), &scene);
   ASSERT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(fs::path(scene.folder), dir / "scenes");
-  EXPECT_EQ(fs::path(scene.river.gltf), dir / "models" / "river.glb");
+  EXPECT_EQ(fs::path(scene.rivers[0].gltf), dir / "models" / "river.glb");
   EXPECT_EQ(fs::path(scene.objects[0].gltf), dir / "scenes" / "props" / "duck.glb");
   EXPECT_EQ(fs::path(scene.objects[1].gltf), dir / "scenes" / "rock.glb");
 }
@@ -464,7 +464,7 @@ TEST(SceneFileSchema, ProceduralPropertiesAndDefaultsMatchTheParser) {
   const Status status = parse(with({{"river", {{"procedural", procedural}}}}), &from_defaults);
   ASSERT_TRUE(status.ok()) << status.message();
   const ProceduralRiverParams d;
-  const ProceduralRiverParams& p = from_defaults.river.procedural;
+  const ProceduralRiverParams& p = from_defaults.rivers[0].procedural;
   EXPECT_EQ(p.length, d.length);
   EXPECT_EQ(p.meander_amplitude, d.meander_amplitude);
   EXPECT_EQ(p.meander_wavelength, d.meander_wavelength);
@@ -477,6 +477,44 @@ TEST(SceneFileSchema, ProceduralPropertiesAndDefaultsMatchTheParser) {
   EXPECT_EQ(p.seed, d.seed);
   EXPECT_EQ(p.section_spacing, d.section_spacing);
   EXPECT_EQ(p.vertices_across, d.vertices_across);
+}
+
+TEST(SceneFile, SeveralRiversEachWithTheirOwnFlow) {
+  SceneFile scene;
+  const Status status = parse(
+      with({{"river", nullptr},
+            {"flow", {{"discharge", 7.0}}},
+            {"rivers", {{{"gltf", "a.glb"}, {"flow", {{"discharge", 3.0}, {"p", 2.0}}}},
+                        {{"procedural", {{"width", 9.0}}}}}}}),
+      &scene);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(scene.rivers.size(), 2u);
+  EXPECT_EQ(scene.rivers[0].source, SceneRiver::Source::kGltf);
+  EXPECT_EQ(scene.rivers[0].flow.discharge, 3.0f);
+  EXPECT_EQ(scene.rivers[0].flow.p, 2.0f);
+  EXPECT_EQ(scene.rivers[1].procedural.width, 9.0f);
+  EXPECT_EQ(scene.rivers[1].flow.discharge, 7.0f) << "the top-level flow is the default";
+  // "river" still means one river, with the top-level flow.
+  ASSERT_TRUE(parse(with({{"flow", {{"discharge", 5.0}}}}), &scene).ok());
+  ASSERT_EQ(scene.rivers.size(), 1u);
+  EXPECT_EQ(scene.rivers[0].flow.discharge, 5.0f);
+}
+
+TEST(SceneFile, BadRiverListsAreNamed) {
+  expect_error(with({{"rivers", {{{"procedural", Json::object()}}}}}),
+               {"rivers: give either 'river' or 'rivers', not both"});
+  expect_error(with({{"river", nullptr}, {"rivers", Json::array()}}), {"rivers: needs at least one"});
+  expect_error(with({{"river", nullptr}}), {"missing required key 'river' (or 'rivers')"});
+  expect_error(with({{"river", nullptr}, {"rivers", {{{"procedural", Json::object()}}, {{"gltf", 3}}}}}),
+               {"rivers[1].gltf"});
+  expect_error(with({{"river", nullptr},
+                     {"rivers", {{{"procedural", Json::object()}, {"flow", {{"p", 40}}}}}}}),
+               {"rivers[0].flow.p", "at most 16"});
+  expect_error(with({{"river", {{"procedural", Json::object()}, {"flow", Json::object()}}}}),
+               {"river.flow: unknown key"});
+  Json many = Json::array();
+  for (size_t i = 0; i <= kMaxSceneRivers; ++i) many.push_back({{"procedural", Json::object()}});
+  expect_error(with({{"river", nullptr}, {"rivers", many}}), {"rivers", "more than the limit"});
 }
 
 TEST(SceneFileSchema, LookKeysDefaultsAndRangesMatchWaterLook) {
@@ -531,11 +569,13 @@ TEST(SceneFile, LookKeysReachTheLookAndBadOnesAreNamed) {
 TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {
   const Json schema = load_schema();
   const Json& top = schema["properties"];
-  EXPECT_EQ(schema["required"], Json({"version", "river"}));
+  EXPECT_EQ(schema["required"], Json({"version"}));
+  EXPECT_EQ(schema["oneOf"], Json::parse(R"([{"required":["river"]},{"required":["rivers"]}])"));
+  EXPECT_EQ(top["rivers"]["maxItems"].get<size_t>(), kMaxSceneRivers);
   const SceneFile defaults;
   EXPECT_EQ(top["flow"]["properties"]["discharge"]["default"].get<double>(),
-            defaults.flow.discharge);
-  EXPECT_EQ(top["flow"]["properties"]["p"]["default"].get<double>(), defaults.flow.p);
+            defaults.rivers[0].flow.discharge);
+  EXPECT_EQ(top["flow"]["properties"]["p"]["default"].get<double>(), defaults.rivers[0].flow.p);
   EXPECT_EQ(top["camera"]["properties"]["fov_y_deg"]["default"].get<double>(),
             defaults.camera.fov_y_deg);
   EXPECT_EQ(top["render"]["properties"]["size"]["default"],
@@ -553,11 +593,11 @@ TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {
       EXPECT_TRUE(s.ok()) << section << "." << item.key() << ": " << s.message();
     }
   }
-  for (const char* key : {"version", "river", "flow", "obstacles", "objects", "camera", "render",
-                          "look", "$schema"}) {
+  for (const char* key : {"version", "river", "rivers", "flow", "obstacles", "objects", "camera",
+                          "render", "look", "$schema"}) {
     EXPECT_TRUE(top.contains(key)) << key;
   }
-  EXPECT_EQ(top.size(), 9u) << "a top-level key the parser does not know";
+  EXPECT_EQ(top.size(), 10u) << "a top-level key the parser does not know";
   // Obstacles: a circle or a polygon, exactly one (oneOf), and every listed key parses.
   const Json& obstacle = top["obstacles"]["items"];
   std::set<std::string> obstacle_keys;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
 #include <vulkan/vulkan.h>
 
@@ -25,8 +26,14 @@ struct HostTargets {
 Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFormat depth_format,
                            VkExtent2D extent, ImageState color_final, HostTargets* out);
 
-// Records into `cmd`: the world seen through `view` at `time_seconds`, then the water
-// (renderer.update() for this frame already called). Updates the targets' current states.
+// Records into `cmd`: the world seen through `view` at `time_seconds`, then the water of each
+// renderer in turn (a scene's rivers; update() for this frame already called on each), the
+// last one copying `readback`. Updates the targets' current states.
+Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
+                              std::span<Renderer* const> renderers, const View& view,
+                              double time_seconds, const ReadbackTargets& readback,
+                              HostTargets* targets);
+// The same with one river.
 Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
                               Renderer& renderer, const View& view, double time_seconds,
                               const ReadbackTargets& readback, HostTargets* targets);

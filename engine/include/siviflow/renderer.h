@@ -84,6 +84,7 @@ struct CreateInfo {
   // The scene to render (its river, flow, obstacles, objects and camera keys); null: the
   // built-in default scene. Read by create() only: the renderer copies what it needs.
   const SceneFile* scene = nullptr;
+  uint32_t river_index = 0;  // which of the scene's rivers this renderer draws (0: the first)
   // The water's starting look; null: the scene's "look" (or WaterLook's defaults). Read by
   // create() only; set_look() changes it.
   const WaterLook* look = nullptr;

@@ -6,7 +6,9 @@
 //     "version": 1,                                       required, must be 1
 //     "river": { "gltf": "river.glb", "mesh": "River" }   required: a glTF river (mesh optional:
 //            | { "procedural": { ...params..., "seed": 7 } }        first mesh), or the generator
-//     "flow":      { "discharge": 20.0, "p": 1.5, "search_radius": 30.0 },
+//     | "rivers": [ { ...as "river"..., "flow": {...} }, ... ]     or several, each with its flow
+//     "flow":      { "discharge": 20.0, "p": 1.5, "search_radius": 30.0 },   "river"'s flow, and
+//                                                  the default of "rivers" without their own
 //     "obstacles": [ { "center": [x,y,z], "radius": 1.5,            a circle, or a footprint:
 //                      | "polygon": [[x,z], [x,z], [x,z], ...],      offsets around center
 //                      "keys": [ { "t": 0.0, "center": [..] } ] } ],
@@ -68,6 +70,7 @@ inline constexpr int kMaxSceneJsonDepth = 64;  // the format nests 5 levels; dee
 inline constexpr uint32_t kMaxRenderDimension = 16384;  // maxImageDimension2D of common devices
 inline constexpr double kMaxRenderFps = 1000.0;
 inline constexpr size_t kMaxSceneObjects = 4096;
+inline constexpr size_t kMaxSceneRivers = 64;
 inline constexpr size_t kMaxCameraKeys = size_t{1} << 20;
 inline constexpr float kDefaultSceneDischarge = 20.0f;  // m^2/s: ~1.7 m/s in the default 12 m river
 inline constexpr float kDefaultCameraFovYDeg = 50.0f;
@@ -82,6 +85,7 @@ struct SceneRiver {
   std::string gltf;                  // kGltf: the file, resolved against the scene's folder
   std::string mesh;                  // kGltf: mesh name; empty: the first mesh
   ProceduralRiverParams procedural;  // kProcedural: the generator's parameters
+  FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};  // its own flow
 };
 
 struct SceneObject {
@@ -113,9 +117,8 @@ struct SceneRender {
 struct SceneFile {
   std::string path;    // the file as given
   std::string folder;  // absolute folder that relative paths were resolved against
-  SceneRiver river;
-  FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
-  std::vector<Obstacle> obstacles;  // circles (radius > 0) or polygons, keys optional
+  std::vector<SceneRiver> rivers{1};  // at least one; each with its own flow
+  std::vector<Obstacle> obstacles;  // in every river they touch  // circles (radius > 0) or polygons, keys optional
   std::vector<SceneObject> objects;
   SceneCamera camera;
   SceneRender render;

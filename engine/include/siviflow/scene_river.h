@@ -25,10 +25,12 @@ struct SceneRiverFlow {
 // one segment test per corner, and a few hundred outline any mesh's waterline closely enough.
 inline constexpr size_t kMaxObjectFootprintPoints = 256;
 
-// Loads the river mesh of `scene`, builds its surface and solves the flow with the scene's
-// obstacles at `time_seconds`: first `scene.obstacles`, then one per object marked `obstacle`
-// (scene_object_obstacles). Errors name the scene file (and the glTF file where it is the cause).
-Status build_scene_river_flow(const SceneFile& scene, double time_seconds, SceneRiverFlow* out);
+// Loads the mesh of river `river_index` of `scene`, builds its surface and solves its flow with
+// the scene's obstacles at `time_seconds`: first `scene.obstacles`, then one per object marked
+// `obstacle` (scene_object_obstacles). Errors name the scene file (and the glTF file where it is
+// the cause), or the river index the scene does not have.
+Status build_scene_river_flow(const SceneFile& scene, size_t river_index, double time_seconds,
+                              SceneRiverFlow* out);
 
 // One static polygon obstacle per object marked `obstacle`, in the order of `scene.objects`.
 // The object (load_gltf_object) is placed by its translation, rotation and scale; the water
