@@ -24,10 +24,9 @@ Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFo
   return Status::success();
 }
 
-Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
-                              std::span<Renderer* const> renderers, const View& view,
-                              double time_seconds, const ReadbackTargets& readback,
-                              HostTargets* targets) {
+Status record_view(VkCommandBuffer cmd, World& world, std::span<Renderer* const> renderers,
+                   const View& view, double time_seconds, const ReadbackTargets& readback,
+                   HostTargets* targets) {
   // The world leaves its images as attachments; the water takes them from there, and each
   // river but the last hands them on as attachments to the next.
   const ImageState color_attachment = image_state(Access::ColorAttachmentWrite, targets->color.format);
@@ -37,7 +36,6 @@ Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
   ExternalImage depth = targets->depth;
   color.final = color_now;
   depth.final = depth_now;
-  SIVIFLOW_TRY(world.begin_frame(slot));
   SIVIFLOW_TRY(world.record(cmd, view, time_seconds, color, depth));
   for (size_t i = 0; i < renderers.size(); ++i) {
     const bool last = i + 1 == renderers.size();
@@ -58,6 +56,14 @@ Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
   targets->color.current = color_now;
   targets->depth.current = depth_now;
   return Status::success();
+}
+
+Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
+                              std::span<Renderer* const> renderers, const View& view,
+                              double time_seconds, const ReadbackTargets& readback,
+                              HostTargets* targets) {
+  SIVIFLOW_TRY(world.begin_frame(slot));
+  return record_view(cmd, world, renderers, view, time_seconds, readback, targets);
 }
 
 Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,

@@ -37,7 +37,10 @@ struct BenchOptions {
   uint32_t frames = 60;
   uint32_t warmup = 10;
   bool json = false;
+  bool second_view = false;  // also a second view of the same river (a probe 4 s ahead)
 };
+
+constexpr double kSecondViewAhead = 4.0;  // seconds ahead on the camera path
 
 struct Stats {
   double median = 0.0;
@@ -56,13 +59,18 @@ Stats stats_of(std::vector<double> values) {
 void print_help() {
   std::printf(
       "usage: siviflow bench [SCENE.json] [--size WxH] [--frames N] [--warmup W] [--json]\n"
+      "                      [--second-view]\n"
       "  Renders the scene file (at its render size unless --size says otherwise) or the\n"
       "  default scene (1280x720): W warm-up frames (default 10), then N measured frames\n"
       "  (default 60), one at a time. Reports per pass the median, min and max GPU time\n"
       "  (timestamps), the whole frame, the flow pass's floor (a pass over the water's pixels\n"
       "  making the same texture reads and writes with next to no arithmetic), and the CPU\n"
       "  stages' medians. \"flow\" is the water's tile table and material together (also shown\n"
-      "  apart as \"flow tiles\" and \"flow material\"). --json prints one JSON object.\n");
+      "  apart as \"flow tiles\" and \"flow material\"). --json prints one JSON object.\n"
+      "  --second-view also renders a second view of the same river (CreateInfo::\n"
+      "  share_river_with; the camera 4 s further on) into images of its own, and reports its\n"
+      "  creation, CPU update and water span beside the first view's. The first river of a\n"
+      "  scene file is benchmarked.\n");
 }
 
 Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
@@ -85,6 +93,8 @@ Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
       SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->warmup));
     } else if (arg == "--json") {
       options->json = true;
+    } else if (arg == "--second-view") {
+      options->second_view = true;
     } else if (!arg.empty() && arg[0] != '-' && options->scene_path.empty()) {
       options->scene_path = std::string(arg);
     } else {
@@ -96,6 +106,15 @@ Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
 
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The water's span in a frame: its passes from the first start to the last end, floor left out.
+double water_span(const std::vector<PassTime>& times) {
+  double water = 0.0;
+  for (const PassTime& pass : times) {
+    if (pass.name != kFloorPass) water = std::max(water, pass.begin_ms + pass.milliseconds);
+  }
+  return water;
 }
 
 }  // namespace
@@ -136,20 +155,37 @@ int run_bench(int argc, char** argv) {
   info.reflection = &World::draw_reflection;
   info.reflection_user = world.get();
   std::unique_ptr<Renderer> renderer;
+  auto create_start = std::chrono::steady_clock::now();
   status = Renderer::create(info, &renderer);
+  const double create_ms = ms_since(create_start);
   if (!status.ok()) return cli::fail(kCommand, status.message());
+  const ImageState shown{VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   HostTargets targets;
-  status = create_host_targets(*context, kOutputFormat, kDepthFormat, extent,
-                               {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                               &targets);
+  status = create_host_targets(*context, kOutputFormat, kDepthFormat, extent, shown, &targets);
   if (!status.ok()) return cli::fail(kCommand, status.message());
+  // The second view: the same river (no second solve), its own particles, passes and images.
+  std::unique_ptr<Renderer> second;
+  HostTargets second_targets;
+  double second_create_ms = 0.0;
+  if (options.second_view) {
+    info.share_river_with = renderer.get();
+    create_start = std::chrono::steady_clock::now();
+    status = Renderer::create(info, &second);
+    second_create_ms = ms_since(create_start);
+    if (status.ok()) {
+      status = create_host_targets(*context, kOutputFormat, kDepthFormat, extent, shown,
+                                   &second_targets);
+    }
+    if (!status.ok()) return cli::fail(kCommand, status.message());
+  }
 
   std::map<std::string, std::vector<double>> pass_ms;
   std::vector<double> frame_ms;
   std::vector<double> update_ms;
   std::vector<double> record_ms;
+  std::vector<double> second_update_ms;
+  std::vector<double> second_water_ms;
   std::vector<PassTime> times;
   for (uint32_t frame = 0; frame < options.warmup + options.frames; ++frame) {
     const double time = frame / fps;
@@ -160,30 +196,47 @@ int run_bench(int argc, char** argv) {
     const auto update_start = std::chrono::steady_clock::now();
     if (status.ok()) status = renderer->update(view, time);
     const double update = ms_since(update_start);
+    const View second_view = camera_view(world->scene_camera(time + kSecondViewAhead), extent);
+    double second_update = 0.0;
+    if (second != nullptr) {
+      if (status.ok()) status = second->begin_frame(0);
+      const auto second_start = std::chrono::steady_clock::now();
+      if (status.ok()) status = second->update(second_view, time);
+      second_update = ms_since(second_start);
+    }
     const auto record_start = std::chrono::steady_clock::now();
+    if (status.ok()) status = world->begin_frame(0);
+    Renderer* const first_river[] = {renderer.get()};
     if (status.ok()) {
-      status = record_world_and_water(cmd, 0, *world, *renderer, view, time, ReadbackTargets{},
-                                      &targets);
+      status = record_view(cmd, *world, first_river, view, time, ReadbackTargets{}, &targets);
     }
     const double record = ms_since(record_start);
+    Renderer* const second_river[] = {second.get()};
+    if (status.ok() && second != nullptr) {
+      status = record_view(cmd, *world, second_river, second_view, time, ReadbackTargets{},
+                           &second_targets);
+    }
     const auto submit_start = std::chrono::steady_clock::now();
     if (status.ok()) status = context->end_slot_and_submit(0);
     if (status.ok()) status = context->wait_slot(0);
     const double gpu_wall = ms_since(submit_start);
+    double second_water = 0.0;
+    if (status.ok() && second != nullptr) status = second->pass_times(0, &times);
+    if (status.ok()) second_water = water_span(times);
     if (status.ok()) status = renderer->pass_times(0, &times);
     if (!status.ok()) return cli::fail(kCommand, status.message());
     if (frame < options.warmup) continue;
     update_ms.push_back(update);
     record_ms.push_back(record);
-    double water = 0.0;  // the renderer's passes, first start to last end, floor left out
+    second_update_ms.push_back(second_update);
+    second_water_ms.push_back(second_water);
     double flow = 0.0;
     for (const PassTime& pass : times) {
       if (pass.name == "flow" || pass.name == kTilePass) flow += pass.milliseconds;
       pass_ms[pass.name == "flow" ? kMaterialPass : pass.name].push_back(pass.milliseconds);
-      if (pass.name != kFloorPass) water = std::max(water, pass.begin_ms + pass.milliseconds);
     }
     pass_ms["flow"].push_back(flow);
-    pass_ms["water"].push_back(water);
+    pass_ms["water"].push_back(water_span(times));
     frame_ms.push_back(gpu_wall);
   }
 
@@ -204,6 +257,12 @@ int run_bench(int argc, char** argv) {
       out["passes"][name] = {{"median_ms", s.median}, {"min_ms", s.min}, {"max_ms", s.max}};
     }
     out["cpu"] = {{"update_ms", update.median}, {"record_ms", record.median}};
+    out["create_ms"] = create_ms;
+    if (second != nullptr) {
+      out["second_view"] = {{"create_ms", second_create_ms},
+                            {"update_ms", stats_of(second_update_ms).median},
+                            {"water_ms", stats_of(second_water_ms).median}};
+    }
     std::printf("%s\n", out.dump(2).c_str());
     return cli::kExitOk;
   }
@@ -220,6 +279,14 @@ int run_bench(int argc, char** argv) {
   std::printf("flow / floor: %.2f\n", floor.median > 0.0 ? flow.median / floor.median : 0.0);
   std::printf("cpu update (particles + packing) %.3f ms, record %.3f ms (medians)\n", update.median,
               record.median);
+  std::printf("create %.1f ms (the flow solve and static data included)\n", create_ms);
+  if (second != nullptr) {
+    std::printf("second view: create %.1f ms, cpu update %.3f ms, water %.3f ms (medians; the "
+                "first view: %.1f, %.3f, %.3f)\n",
+                second_create_ms, stats_of(second_update_ms).median,
+                stats_of(second_water_ms).median, create_ms, update.median,
+                stats_of(pass_ms["water"]).median);
+  }
   return cli::kExitOk;
 }
 

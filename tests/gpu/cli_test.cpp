@@ -268,6 +268,16 @@ TEST_F(CliTest, BenchReportsEveryPassAsJson) {
   }
   EXPECT_FALSE(report.at("passes").contains("flow floor")) << "the floor is reported apart";
   EXPECT_GE(report.at("cpu").at("update_ms").get<double>(), 0.0);
+  EXPECT_GT(report.at("create_ms").get<double>(), 0.0);
+  EXPECT_FALSE(report.contains("second_view"));
+  // A second view of the river: its own creation, update and water span.
+  const RunResult two = run_siviflow("bench --size 96x54 --frames 2 --warmup 1 --json --second-view");
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  const nlohmann::json second = nlohmann::json::parse(two.output, nullptr, false);
+  ASSERT_FALSE(second.is_discarded()) << two.output;
+  for (const char* key : {"create_ms", "update_ms", "water_ms"}) {
+    EXPECT_GT(second.at("second_view").at(key).get<double>(), 0.0) << key;
+  }
   expect_error(run_siviflow("bench --frames 0"), "--frames");
   // A scene file, at its own render size.
   const fs::path scene = dir_.parent_path() / "bench_scene.json";

@@ -28,7 +28,12 @@ Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFo
 
 // Records into `cmd`: the world seen through `view` at `time_seconds`, then the water of each
 // renderer in turn (a scene's rivers; update() for this frame already called on each), the
-// last one copying `readback`. Updates the targets' current states.
+// last one copying `readback`. Updates the targets' current states. The world's frame must have
+// begun (World::begin_frame, once per frame however many views it records).
+Status record_view(VkCommandBuffer cmd, World& world, std::span<Renderer* const> renderers,
+                   const View& view, double time_seconds, const ReadbackTargets& readback,
+                   HostTargets* targets);
+// A frame of one view: the world's frame begun in `slot`, then record_view().
 Status record_world_and_water(VkCommandBuffer cmd, uint32_t slot, World& world,
                               std::span<Renderer* const> renderers, const View& view,
                               double time_seconds, const ReadbackTargets& readback,
