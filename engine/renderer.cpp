@@ -13,12 +13,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "renderer_impl.h"
-#include "scene/default_scene.h"
-#include "scene/water_normal_map.h"
-#include "siviflow/scene_file.h"
-#include "siviflow/scene_river.h"
+#include "renderer_inspect.h"
+#include "default_river.h"
 #include "sim/text_format.h"
-#include "sim/water_heights.h"
 #include "vk/pipeline.h"
 
 namespace siviflow {
@@ -173,13 +170,10 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
 
 // The starting look: the host's, else the scene's, else the defaults.
 Status Renderer::Impl::take_look() {
-  look = info.look != nullptr ? *info.look : info.scene != nullptr ? info.scene->look : WaterLook{};
+  look = info.look != nullptr ? *info.look : WaterLook{};
   std::string problem;
   const std::string field = water_look_error(look, &problem);
-  if (!field.empty()) {
-    return argument_error((info.look != nullptr ? "CreateInfo::look." : "the scene's look.") +
-                          field + " " + problem);
-  }
+  if (!field.empty()) return argument_error("CreateInfo::look." + field + " " + problem);
   return Status::success();
 }
 
@@ -195,20 +189,23 @@ Status Renderer::Impl::create_river() {
     return Status::success();
   }
   RiverInput input;
-  std::optional<ProceduralRiver> procedural;
-  SIVIFLOW_TRY(scene_river_input(info.scene, info.river_index, &input, &procedural));
-  FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};
+  RiverFlowParams flow;
   std::vector<Obstacle> obstacles;
-  if (info.scene == nullptr) {
-    obstacles = default_scene_obstacles(*procedural);
+  if (info.river == nullptr) {  // the built-in default river and its boulders
+    const ProceduralRiver procedural(default_river_params());
+    SIVIFLOW_TRY(procedural_river_input(procedural, &input));
+    obstacles = default_scene_obstacles(procedural);
   } else {
-    flow = info.scene->rivers[info.river_index].flow;
-    obstacles = info.scene->obstacles;
-    std::vector<Obstacle> object_obstacles;
-    SIVIFLOW_TRY(scene_object_obstacles(*info.scene, input.mesh.positions, &object_obstacles));
-    obstacles.insert(obstacles.end(), object_obstacles.begin(), object_obstacles.end());
+    SIVIFLOW_TRY(river_input_from(*info.river, &input));
+    flow = info.river->flow;
+    for (size_t i = 0; i < info.river->obstacles.size(); ++i) {
+      const Status valid = check_obstacle(info.river->obstacles[i], i);
+      if (!valid.ok()) return argument_error("CreateInfo::river->obstacles: " + valid.message());
+      obstacles.push_back(flow_obstacle(info.river->obstacles[i]));
+    }
   }
-  return SharedRiver::create(table, info.allocation_callbacks, std::move(input), flow,
+  const FlowParams params{flow.discharge, flow.shepard_power, flow.search_radius};
+  return SharedRiver::create(table, info.allocation_callbacks, std::move(input), params,
                              std::move(obstacles), &river);
 }
 
@@ -805,9 +802,13 @@ const char* readback_image_name(ReadbackImage image) {
   return "readback";
 }
 
-const ParticleField& Renderer::particle_field() const { return impl_->simulation.particle_field(); }
 const TileTableLayout& Renderer::tile_table_layout() const { return impl_->tile_table; }
-const FlowTextureLayout& Renderer::flow_texture_layout() const { return impl_->simulation.layout(); }
+const ParticleField& RendererInspector::particle_field(const Renderer& renderer) {
+  return renderer.impl_->simulation.particle_field();
+}
+const FlowTextureLayout& RendererInspector::flow_texture_layout(const Renderer& renderer) {
+  return renderer.impl_->simulation.layout();
+}
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 uint64_t Renderer::flow_solves() const { return impl_->river->flow.full_solves(); }
 

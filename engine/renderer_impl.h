@@ -12,7 +12,6 @@
 
 #include "entry_guard.h"
 #include "passes/passes.h"
-#include "scene/river_simulation.h"
 #include "siviflow/renderer.h"
 #include "shared_river.h"
 #include "static_assets.h"

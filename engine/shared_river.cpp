@@ -8,7 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "passes/passes.h"
-#include "scene/water_normal_map.h"
+#include "water_normal_map.h"
 #include "sim/water_heights.h"
 
 namespace siviflow {

@@ -11,7 +11,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
-#include "scene/river_simulation.h"
+#include "river_simulation.h"
 #include "siviflow/renderer.h"
 #include "static_assets.h"
 #include "vk/device_table.h"

@@ -8,30 +8,10 @@
 namespace siviflow {
 namespace {
 
-// The flow's obstacle for a host's: the polygon turned about +Y (x' = x cos + z sin,
-// z' = -x sin + z cos, as glm::rotate turns +X towards -Z).
-Obstacle flow_obstacle(const WaterObstacle& placed) {
-  Obstacle obstacle;
-  obstacle.centre = placed.centre;
-  obstacle.radius = placed.radius;
-  const float c = std::cos(placed.rotation_rad);
-  const float s = std::sin(placed.rotation_rad);
-  obstacle.polygon.reserve(placed.polygon.size());
-  for (const glm::vec2& p : placed.polygon) {
-    obstacle.polygon.push_back({c * p.x + s * p.y, -s * p.x + c * p.y});
-  }
-  return obstacle;
-}
-
 // The host's obstacle checked as the flow would check it, named by `id`.
 Status check_obstacle(const char* call, const WaterObstacle& placed, uint32_t id) {
-  const std::string prefix = std::string(call) + ": ";
-  if (!std::isfinite(placed.rotation_rad)) {
-    return argument_error(prefix + text_format("obstacle %u: WaterObstacle::rotation_rad %g is not finite",
-                                               id, double(placed.rotation_rad)));
-  }
-  const Status valid = validate_obstacle(flow_obstacle(placed), id);
-  if (!valid.ok()) return argument_error(prefix + valid.message());
+  const Status valid = check_obstacle(placed, id);
+  if (!valid.ok()) return argument_error(std::string(call) + ": " + valid.message());
   return Status::success();
 }
 

@@ -17,6 +17,7 @@
 #include "siviflow/host_frame.h"
 #include "siviflow/renderer.h"
 #include "siviflow/scene_file.h"
+#include "siviflow/scene_river.h"
 
 namespace siviflow {
 namespace {
@@ -144,11 +145,17 @@ int run_bench(int argc, char** argv) {
   CreateInfo info = context->renderer_create_info(extent, kOutputFormat);
   info.frames_in_flight = 1;
   info.enable_timing = true;
-  info.scene = scene.has_value() ? &*scene : nullptr;
+  const SceneFile* scene_file = scene.has_value() ? &*scene : nullptr;
+  SceneRiverData river;  // the scene's first river
+  status = scene_river_data(scene_file, 0, &river);
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  const WaterRiver water = river.river();
+  info.river = &water;
+  info.look = scene_file != nullptr ? &scene_file->look : nullptr;
   info.depth_format = kDepthFormat;
   WorldCreateInfo world_info = context->world_create_info(kOutputFormat, kDepthFormat);
   world_info.frames_in_flight = 1;
-  world_info.scene = info.scene;
+  world_info.scene = scene_file;
   std::unique_ptr<World> world;
   status = World::create(world_info, &world);
   if (!status.ok()) return cli::fail(kCommand, status.message());

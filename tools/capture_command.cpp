@@ -20,10 +20,12 @@
 #include "shaders/shared.h"
 #include "siviflow/atomic_file.h"
 #include "siviflow/headless_context.h"
+#include "renderer_inspect.h"
 #include "siviflow/host_frame.h"
 #include "siviflow/image_files.h"
 #include "siviflow/renderer.h"
 #include "siviflow/scene_file.h"
+#include "siviflow/scene_river.h"
 
 namespace siviflow {
 namespace {
@@ -259,16 +261,20 @@ Status Capture::run() {
       {options_.size.width, options_.size.height}, kOutputFormat);
   info.frames_in_flight = kFramesInFlight;
   info.seed = options_.seed;
-  info.scene = scene_.has_value() ? &*scene_ : nullptr;
+  const SceneFile* scene = scene_.has_value() ? &*scene_ : nullptr;
+  info.look = scene != nullptr ? &scene->look : nullptr;
   WorldCreateInfo world_info = context_->world_create_info(kOutputFormat, kDepthFormat);
   world_info.frames_in_flight = kFramesInFlight;
-  world_info.scene = info.scene;
+  world_info.scene = scene;
   SIVIFLOW_TRY(World::create(world_info, &world_));
   info.depth_format = kDepthFormat;
   info.reflection = &World::draw_reflection;
   info.reflection_user = world_.get();
   for (size_t i = 0; i < river_count; ++i) {
-    info.river_index = static_cast<uint32_t>(i);
+    SceneRiverData river;
+    SIVIFLOW_TRY(scene_river_data(scene, i, &river));
+    const WaterRiver water = river.river();
+    info.river = &water;
     info.readback_images = i + 1 == river_count ? readback_images() : 0;
     rivers_.emplace_back();
     SIVIFLOW_TRY(Renderer::create(info, &rivers_.back()));
@@ -312,7 +318,7 @@ Status Capture::run() {
     slot.camera = world_->scene_camera(time);
     const View view = camera_view(slot.camera, extent);
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->update(view, time));
-    const std::span<const Particle> particles = renderer_->particle_field().particles();
+    const std::span<const Particle> particles = particle_field(*renderer_).particles();
     slot.particles.assign(particles.begin(), particles.end());
     ReadbackTargets readback;
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) readback.buffers[i] = slot.readback[i].buffer;
@@ -396,7 +402,7 @@ Status Capture::write_frame() {
     }
     frame.channels.push_back({"depth.Z", depth_.data()});
   }
-  const FlowTextureLayout& layout = renderer_->flow_texture_layout();
+  const FlowTextureLayout& layout = flow_texture_layout(*renderer_);
   const auto texel_at = [&](size_t pixel) {
     const uint32_t x = static_cast<uint32_t>(pixel % width) / layout.texel_px;
     const uint32_t y = static_cast<uint32_t>(pixel / width) / layout.texel_px;

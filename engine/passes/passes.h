@@ -8,7 +8,6 @@
 
 #include <vulkan/vulkan.h>
 
-#include "scene/default_scene.h"
 #include "shared.h"
 #include "sim/status.h"
 #include "vk/frame_graph.h"
@@ -47,63 +46,6 @@ struct UploadList {
 // written versions; the levels of one image must be listed one after another) from the
 // imported staging buffer. `list` is read again when the pass records.
 void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list);
-
-// ---- scene: sky, terrain, riverbed and objects (the built-in world, siviflow/world.h) ----
-
-// One indexed draw of the scene pipeline with its own push constants.
-struct SceneDraw {
-  uint32_t first_index = 0;
-  uint32_t index_count = 0;
-  const gpu::SceneConstants* constants = nullptr;  // read when the pass records
-  // 0: terrain material (vertex colours and the ground detail); k > 0: object material with
-  // base-colour texture k - 1 of ScenePass::set_textures.
-  uint32_t material = 0;
-};
-
-class ScenePass {
- public:
-  Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
-                VkFormat depth_format);
-  void destroy(const GpuContext& gpu);
-  // Points the pass's descriptors at the ground-detail texture and the objects' base-colour
-  // textures (once, after they are created).
-  Status set_textures(const GpuContext& gpu, VkImageView detail,
-                      const std::vector<VkImageView>& base_colors);
-
-  struct Handles {
-    ImageHandle color;
-    ImageHandle depth;
-    BufferHandle vertices;
-    BufferHandle indices;
-    ImageHandle detail;
-    std::vector<ImageHandle> base_colors;  // in the order of set_textures
-  };
-  // The view a declared pass draws: its depth convention (the clear value is the caller's) and
-  // its viewport.
-  struct Frame {
-    bool reverse_z = false;
-    VkRect2D viewport{};
-  };
-  // Declares a pass clearing colour and depth, then drawing the scene's `draws` and the sky;
-  // the new versions of colour and depth go back into `handles`. `draws` and `frame` are read
-  // when the pass records.
-  void declare(FrameGraph& graph, const char* pass_name, const std::vector<SceneDraw>* draws,
-               const Frame* frame, Handles* handles);
-  // Records `draws` then the sky into the rendering begun by the caller (viewport set).
-  void draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices, VkBuffer indices,
-            const std::vector<SceneDraw>& draws, bool reverse_z) const;
-
- private:
-  VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkDescriptorPool pool_ = VK_NULL_HANDLE;
-  std::vector<VkDescriptorSet> sets_;  // per material: the detail texture, then base colours
-  VkSampler detail_sampler_ = VK_NULL_HANDLE;
-  VkSampler base_color_sampler_ = VK_NULL_HANDLE;
-  VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
-  VkPipeline scene_pipeline_ = VK_NULL_HANDLE;
-  VkPipeline object_pipeline_ = VK_NULL_HANDLE;
-};
 
 // ---- flow: the water material of Algorithm 3, drawn over the scene ----
 

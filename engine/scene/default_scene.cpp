@@ -12,8 +12,6 @@ namespace {
 constexpr int kTerrainColumns = 120;   // quads across the valley (1.5 m)
 constexpr int kTerrainRows = 160;      // quads along the valley (1.5 m)
 constexpr float kTerrainHalfWidth = 90.0f;
-constexpr float kInRiverRadius = 1.3f;  // the boulder in mid-river
-constexpr float kMovingRadius = 1.1f;   // the boulder that rolls into the river
 constexpr glm::vec3 kGranite(0.46f, 0.44f, 0.42f);
 constexpr glm::vec3 kSandstone(0.55f, 0.45f, 0.35f);
 
@@ -121,11 +119,6 @@ void add_tree(glm::vec3 foot, float height, SceneGeometry* geometry) {
   add_ring_pair(crown_radius, trunk_height, 0.0f, height, crown_colour);
 }
 
-glm::vec3 on_ground(const ProceduralRiver& river, float lateral_offset, float z) {
-  const float x = river.centreline_x(z) + lateral_offset;
-  return {x, river.terrain_height(x, z), z};
-}
-
 // The obstacles: a boulder as wide as each footprint, slightly squat, modelled at the origin.
 void add_obstacle_boulders(const std::vector<Obstacle>& obstacles, SceneGeometry* geometry) {
   geometry->static_index_count = static_cast<uint32_t>(geometry->indices.size());
@@ -142,23 +135,6 @@ void add_obstacle_boulders(const std::vector<Obstacle>& obstacles, SceneGeometry
 }  // namespace
 
 SceneLook default_scene_look() { return SceneLook{}; }
-
-std::vector<Obstacle> default_scene_obstacles(const ProceduralRiver& river) {
-  Obstacle in_river;
-  in_river.centre = on_ground(river, 1.5f, 2.0f) + glm::vec3(0.0f, 0.3f, 0.0f);
-  in_river.radius = kInRiverRadius;
-  // Rolls from the right bank (x < centreline looking downstream +Z) into the river, 0 .. 4 s.
-  Obstacle moving;
-  const float z = -12.0f;
-  const glm::vec3 bank = on_ground(river, -11.0f, z) + glm::vec3(0.0f, kMovingRadius * 0.6f, 0.0f);
-  const glm::vec3 water = on_ground(river, -2.0f, z) + glm::vec3(0.0f, kMovingRadius * 0.4f, 0.0f);
-  moving.centre = bank;
-  moving.radius = kMovingRadius;
-  moving.keys = {{0.0, bank}, {1.0, bank}, {4.0, water}};
-  return {in_river, moving};
-}
-
-ProceduralRiverParams default_river_params() { return ProceduralRiverParams{}; }
 
 SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles) {
   SceneGeometry geometry;

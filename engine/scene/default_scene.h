@@ -9,6 +9,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "default_river.h"
 #include "shaders/shared.h"
 #include "siviflow/renderer.h"
 #include "sim/obstacle.h"
@@ -31,10 +32,6 @@ struct SceneGeometry {
   std::vector<Instance> obstacle_boulders;
 };
 
-// The objects in the water, as obstacles for the flow: the boulder in mid-river, and the one that
-// rolls in from the right bank (the moving one, keyed, last in the list).
-std::vector<Obstacle> default_scene_obstacles(const ProceduralRiver& river);
-
 // Tunables of the look of the default scene, in one place.
 struct SceneLook {
   glm::vec3 sun_direction{0.45f, 0.62f, 0.35f};  // towards the sun; normalised on use
@@ -44,7 +41,6 @@ struct SceneLook {
 };
 
 SceneLook default_scene_look();
-ProceduralRiverParams default_river_params();
 // Terrain of the river's valley, trees and boulders on its banks, and a boulder for each obstacle.
 SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles);
 // For a river from a file, which brings no terrain: its bed (the surface lowered by the depth

@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <memory>
 #include <utility>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "default_river.h"
+#include "river_simulation.h"
 #include "scene/gltf_import.h"
 #include "sim/procedural_river.h"
 #include "sim/river_surface.h"
@@ -185,6 +188,93 @@ Status scene_object_obstacles(const SceneFile& scene, std::span<const glm::vec3>
     obstacles.push_back(std::move(obstacle));
   }
   *out = std::move(obstacles);
+  return Status::success();
+}
+
+WaterRiver SceneRiverData::river() const {
+  WaterRiver river;
+  river.positions = mesh.positions;
+  river.indices = mesh.indices;
+  river.depth = mesh.depth;
+  river.slope = slope;
+  river.flow = flow;
+  river.obstacles = obstacles;
+  return river;
+}
+
+namespace {
+
+// The host form of a flow obstacle of the scene (keys and all).
+WaterObstacle water_obstacle(const Obstacle& obstacle) {
+  WaterObstacle out;
+  out.centre = obstacle.centre;
+  out.radius = obstacle.radius;
+  out.polygon = obstacle.polygon;
+  for (const ObstacleKey& key : obstacle.keys) out.keys.push_back({key.t, key.centre});
+  return out;
+}
+
+// A glTF river's depth (the profile of kGltfRiverDepth) and the slope of that bed across.
+Status gltf_river_data(TriangleMesh gltf, SceneRiverData* out) {
+  RiverSurface surface;
+  SIVIFLOW_TRY(RiverSurface::build(gltf.positions, gltf.indices, RiverSurfaceOptions{}, &surface));
+  out->mesh.positions = std::move(gltf.positions);
+  out->mesh.indices = std::move(gltf.indices);
+  const size_t count = out->mesh.positions.size();
+  out->mesh.depth.resize(count);
+  out->slope.resize(count);
+  for (size_t v = 0; v < count; ++v) {
+    const RiverVertex vertex = surface.vertex(v);
+    const float w2 = vertex.width * vertex.width;
+    out->mesh.depth[v] = kGltfRiverDepth * 4.0f * vertex.d_left * vertex.d_right / w2;
+    out->slope[v] = std::abs(kGltfRiverDepth * 4.0f * (vertex.d_right - vertex.d_left) / w2);
+  }
+  return Status::success();
+}
+
+}  // namespace
+
+Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverData* out) {
+  const size_t rivers = scene == nullptr ? 1 : scene->rivers.size();
+  if (river_index >= rivers) {
+    return Status::error((scene == nullptr ? std::string("the default scene") : scene->path) +
+                         ": no river " + std::to_string(river_index) + " (it has " +
+                         std::to_string(rivers) + ")");
+  }
+  SceneRiverData data;
+  std::vector<Obstacle> obstacles;
+  if (scene == nullptr) {
+    data.procedural.emplace(default_river_params());
+    obstacles = default_scene_obstacles(*data.procedural);
+  } else {
+    const SceneRiver& river = scene->rivers[river_index];
+    data.flow = {river.flow.discharge, river.flow.p, river.flow.search_radius};
+    if (river.source == SceneRiver::Source::kGltf) {
+      TriangleMesh gltf;
+      Status status = load_river_mesh(river.gltf, river.mesh, &gltf);
+      if (status.ok()) status = gltf_river_data(std::move(gltf), &data);
+      if (!status.ok()) return in_scene(*scene, status);
+    } else {
+      const Status status = ProceduralRiver::validate(river.procedural);
+      if (!status.ok()) return in_scene(*scene, status);
+      data.procedural.emplace(river.procedural);
+    }
+  }
+  if (data.procedural) {
+    RiverInput input;
+    const Status status = procedural_river_input(*data.procedural, &input);
+    if (!status.ok()) return scene == nullptr ? status : in_scene(*scene, status);
+    data.mesh = std::move(input.mesh);
+    data.slope = std::move(input.slope);
+  }
+  if (scene != nullptr) {
+    obstacles = scene->obstacles;
+    std::vector<Obstacle> from_objects;
+    SIVIFLOW_TRY(scene_object_obstacles(*scene, data.mesh.positions, &from_objects));
+    obstacles.insert(obstacles.end(), from_objects.begin(), from_objects.end());
+  }
+  for (const Obstacle& obstacle : obstacles) data.obstacles.push_back(water_obstacle(obstacle));
+  *out = std::move(data);
   return Status::success();
 }
 

@@ -10,10 +10,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "entry_guard.h"
-#include "passes/passes.h"
+#include "scene/scene_pass.h"
 #include "scene/default_scene.h"
 #include "scene/detail_texture.h"
-#include "scene/river_simulation.h"
 #include "scene/scene_objects.h"
 #include "siviflow/scene_river.h"
 #include "static_assets.h"
@@ -102,19 +101,17 @@ struct World::Impl {
 };
 
 Status World::Impl::load_scene() {
-  RiverInput input;
-  std::optional<ProceduralRiver> procedural;
-  SIVIFLOW_TRY(scene_river_input(info.scene, 0, &input, &procedural));
-  river_from_file = !procedural.has_value();
-  if (procedural) river = *procedural;
-  river_mesh = std::move(input.mesh);
+  SceneRiverData first;
+  SIVIFLOW_TRY(scene_river_data(info.scene, 0, &first));
+  river_from_file = !first.procedural.has_value();
+  if (first.procedural) river = *first.procedural;
+  river_mesh = std::move(first.mesh);
   // The scene's other rivers: their valleys (procedural) or beds (glTF), without boulders.
   const size_t rivers = info.scene != nullptr ? info.scene->rivers.size() : 1;
   for (size_t i = 1; i < rivers; ++i) {
-    RiverInput other;
-    std::optional<ProceduralRiver> other_procedural;
-    SIVIFLOW_TRY(scene_river_input(info.scene, i, &other, &other_procedural));
-    other_rivers.push_back(other_procedural ? build_scene_geometry(*other_procedural, {})
+    SceneRiverData other;
+    SIVIFLOW_TRY(scene_river_data(info.scene, i, &other));
+    other_rivers.push_back(other.procedural ? build_scene_geometry(*other.procedural, {})
                                             : build_riverbed_geometry(other.mesh, {}));
   }
   obstacles = info.scene != nullptr ? info.scene->obstacles : default_scene_obstacles(river);

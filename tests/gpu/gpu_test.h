@@ -11,6 +11,7 @@
 
 #include "siviflow/headless_context.h"
 #include "siviflow/renderer.h"
+#include "siviflow/scene_river.h"
 #include "siviflow/world.h"
 
 namespace siviflow::testing {
@@ -44,15 +45,24 @@ class GpuTest : public ::testing::Test {
     return info;
   }
 
-  // The built-in world of info.scene as the host's world (reflected through the callback unless
-  // the info has a callback of its own), then the renderer.
-  Status create_renderer(CreateInfo info) {
+  // The built-in world of `scene` (null: the default scene) as the host's world (reflected
+  // through the callback unless the info has a callback of its own), then the renderer of the
+  // scene's first river, with the scene's look unless the info has one.
+  Status create_renderer(CreateInfo info, const SceneFile* scene = nullptr) {
     renderer_.reset();
     world_.reset();
     WorldCreateInfo world_info = context_->world_create_info(info.color_format, info.depth_format);
     world_info.frames_in_flight = info.frames_in_flight;
-    world_info.scene = info.scene;
+    world_info.scene = scene;
     SIVIFLOW_TRY(World::create(world_info, &world_));
+    SceneRiverData river;  // read by create() only
+    WaterRiver water;
+    if (scene != nullptr) {
+      SIVIFLOW_TRY(scene_river_data(scene, 0, &river));
+      water = river.river();
+      info.river = &water;
+      if (info.look == nullptr) info.look = &scene->look;
+    }
     if (info.reflection == nullptr) {
       info.reflection = &World::draw_reflection;
       info.reflection_user = world_.get();

@@ -279,5 +279,91 @@ TEST_F(HostEmbeddingTest, ShippingPathWithoutReadbackMatchesTheGoldenFrame) {
   EXPECT_TRUE(result.pass) << result.message;
 }
 
+// A straight channel along +Z of its own, as an engine would describe its river: 7 vertices
+// across 8 m, one section a metre, 1 m deep in mid-river.
+struct Channel {
+  std::vector<glm::vec3> positions;
+  std::vector<uint32_t> indices;
+  std::vector<float> depth;
+  std::vector<float> slope;
+  WaterRiver river() const {
+    WaterRiver r;
+    r.positions = positions;
+    r.indices = indices;
+    r.depth = depth;
+    r.slope = slope;
+    r.flow.discharge = 6.0f;
+    return r;
+  }
+};
+
+Channel straight_channel() {
+  Channel c;
+  constexpr int kSections = 60, kAcross = 7;
+  for (int k = 0; k < kSections; ++k) {
+    for (int j = 0; j < kAcross; ++j) {
+      const float u = static_cast<float>(j) / (kAcross - 1);  // 0 on the left bank (+X)
+      c.positions.push_back({4.0f - 8.0f * u, 0.0f, static_cast<float>(k)});
+      c.depth.push_back(4.0f * u * (1.0f - u));
+      c.slope.push_back(std::abs(4.0f * (1.0f - 2.0f * u)) / 8.0f);
+    }
+  }
+  for (uint32_t k = 0; k + 1 < kSections; ++k) {
+    for (uint32_t j = 0; j + 1 < kAcross; ++j) {
+      const uint32_t a = k * kAcross + j, b = a + 1, d = a + kAcross, e = d + 1;
+      c.indices.insert(c.indices.end(), {a, d, b, b, d, e});
+    }
+  }
+  return c;
+}
+
+TEST_F(HostEmbeddingTest, HostsOwnRiverFlowsAndBadArraysAreRefusedByName) {
+  // The world draws the default valley (any host world will do); the water is the host's
+  // channel, which runs down +Z at Q / width = 0.75 m/s in mid-river or so.
+  create(nullptr, true);
+  const Channel channel = straight_channel();
+  const WaterRiver river = channel.river();
+  CreateInfo info = make_create_info(kWidth, kHeight);
+  info.readback_images = readback_bit(ReadbackImage::kDepth) | readback_bit(ReadbackImage::kWaterMask);
+  info.reflection = &World::draw_reflection;
+  info.reflection_user = world_.get();
+  info.river = &river;
+  Status status = Renderer::create(info, &renderer_);
+  ASSERT_TRUE(status.ok()) << status.message();
+  Camera camera;
+  camera.position = {0.0f, 12.0f, -8.0f};
+  camera.target = {0.0f, 0.0f, 20.0f};
+  const HostShot shot = shoot(camera_view(camera, {kWidth, kHeight}), 0.0);
+  size_t water = 0;
+  for (const float m : shot.mask) water += m == 1.0f ? 1 : 0;
+  EXPECT_GT(water, 1000u) << "the host's channel is drawn";
+  EXPECT_EQ(renderer_->flow_solves(), 1u);
+
+  const auto refused = [&](const WaterRiver& bad, const char* part) {
+    CreateInfo bad_info = info;
+    bad_info.river = &bad;
+    std::unique_ptr<Renderer> renderer;
+    const Status s = Renderer::create(bad_info, &renderer);
+    ASSERT_FALSE(s.ok()) << part;
+    EXPECT_NE(s.message().find(part), std::string::npos) << s.message();
+    EXPECT_EQ(renderer, nullptr);
+  };
+  WaterRiver short_depth = river;
+  short_depth.depth = short_depth.depth.first(10);
+  refused(short_depth, "CreateInfo::river->depth has 10 values for 420 positions");
+  Channel broken = channel;
+  broken.positions[7].y = NAN;
+  refused(broken.river(), "CreateInfo::river->positions[7] is not finite");
+  broken = channel;
+  broken.slope[3] = -1.0f;
+  refused(broken.river(), "CreateInfo::river->slope[3] -1");
+  WaterObstacle flat;
+  flat.polygon = {{0.0f, 0.0f}, {1.0f, 0.0f}, {2.0f, 0.0f}};
+  const WaterObstacle obstacles[] = {flat};
+  WaterRiver with_flat = river;
+  with_flat.obstacles = obstacles;
+  refused(with_flat, "CreateInfo::river->obstacles: obstacle 0");
+}
+
 }  // namespace
 }  // namespace siviflow::testing

@@ -11,6 +11,7 @@
 
 #include "render_frames.h"
 #include "scene/default_scene.h"
+#include "renderer_inspect.h"
 #include "siviflow/host_frame.h"
 #include "shaders/shared.h"
 #include "sim/flow_textures.h"
@@ -126,7 +127,7 @@ TEST_F(RenderTest, MovingObstacleReroutesTheParticlesFlow) {
     }
     double speed = 0.0;
     *count = 0;
-    for (const Particle& p : renderer_->particle_field().particles()) {
+    for (const Particle& p : particle_field(*renderer_).particles()) {
       const glm::vec3& v = mesh.positions[p.vertex];
       if (glm::length(glm::vec2(v.x - in_water.x, v.z - in_water.z)) > 0.9f * moving.radius) continue;
       speed += glm::length(p.flow);
@@ -195,7 +196,7 @@ TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
   // Two frames: the second reuses the images and the other staging slot.
   const std::vector<Frame> frames = render(0, 2);
   ASSERT_EQ(frames.size(), 2u);
-  const ParticleField& field = renderer_->particle_field();
+  const ParticleField& field = particle_field(*renderer_);
   ASSERT_FALSE(field.particles().empty());
   FlowTextures textures;
   ASSERT_TRUE(FlowTextures::create(field, kDefaultFlowTexelPx, &textures).ok());
@@ -246,16 +247,16 @@ TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
   const Frame& frame = frames[1];
   const TileTableLayout& table = renderer_->tile_table_layout();
   ASSERT_EQ(frame.tile_table.size(), size_t{table.width} * table.height * 4);
-  const FlowTextureLayout& layout = renderer_->flow_texture_layout();
+  const FlowTextureLayout& layout = flow_texture_layout(*renderer_);
   std::vector<std::byte> staging(layout.total_bytes);
   std::memcpy(staging.data() + layout.flow_offset, frame.flow_texture.data(), layout.flow_bytes);
   const glm::mat4 view_proj = view_proj_of(world_->scene_camera(1.0 / 30.0), kWidth, kHeight);
-  const float water_level = renderer_->particle_field().particles().front().world.y;  // level river
+  const float water_level = particle_field(*renderer_).particles().front().world.y;  // level river
   const glm::vec2 texels = glm::vec2(kWidth, kHeight) / float(layout.texel_px);
   const glm::ivec2 size(table.width, table.height);
   const glm::ivec2 corner(table.corner_x, table.corner_z);
   std::vector<glm::vec3> particle_at(UINT16_MAX + 1);  // by slot
-  for (const Particle& p : renderer_->particle_field().particles()) particle_at[p.slot] = p.world;
+  for (const Particle& p : particle_field(*renderer_).particles()) particle_at[p.slot] = p.world;
   size_t checked = 0;
   size_t agreeing = 0;
   for (int y = 0; y < size.y; ++y) {
@@ -308,9 +309,7 @@ TEST_F(RenderTest, TileTableWindowHoldsEveryTileInViewOfALongRiver) {
       R"("camera":{"keys":[{"t":0,"position":[0,6,-400],"target":[0,0,-305]}]}})",
       "long.json", ".", &scene);
   ASSERT_TRUE(parsed.ok()) << parsed.message();
-  CreateInfo info = make_create_info(kWidth, kHeight);
-  info.scene = &scene;
-  ASSERT_TRUE(create_renderer(info).ok());
+  ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight), &scene).ok());
   const std::vector<Frame> frames = render(0, 1);
   ASSERT_EQ(frames.size(), 1u);
   const Frame& frame = frames[0];

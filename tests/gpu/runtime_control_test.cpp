@@ -39,10 +39,11 @@ class RuntimeControlTest : public RenderTest {
     return obstacle;
   }
 
-  std::vector<Frame> render_with(const CreateInfo& info, uint32_t first, uint32_t end) {
+  std::vector<Frame> render_with(const CreateInfo& info, uint32_t first, uint32_t end,
+                                 const SceneFile* scene = nullptr) {
     renderer_.reset();
     world_.reset();
-    const Status status = create_renderer(info);
+    const Status status = create_renderer(info, scene);
     EXPECT_TRUE(status.ok()) << status.message();
     return render(first, end);
   }
@@ -76,9 +77,7 @@ TEST_F(RuntimeControlTest, ObstacleAddedAtRuntimeReroutesTheNextFrameAsAFreshSol
   as_scene.centre = added.centre;
   as_scene.radius = added.radius;
   const SceneFile with_boat = default_scene_file({as_scene});
-  CreateInfo fresh_info = make_create_info(kWidth, kHeight);
-  fresh_info.scene = &with_boat;
-  const std::vector<Frame> fresh = render_with(fresh_info, 0, 3);
+  const std::vector<Frame> fresh = render_with(make_create_info(kWidth, kHeight), 0, 3, &with_boat);
 
   // Frame 0 without the boat, frame 1 with it (added between the frames), frame 2 without.
   ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
@@ -138,9 +137,7 @@ TEST_F(RuntimeControlTest, LookChangesTheWaterOnlyAndEqualsTheSceneFileLook) {
 
   SceneFile scene = default_scene_file();
   scene.look = peat;
-  CreateInfo from_file = make_create_info(kWidth, kHeight);
-  from_file.scene = &scene;
-  const std::vector<Frame> file = render_with(from_file, 0, 2);
+  const std::vector<Frame> file = render_with(make_create_info(kWidth, kHeight), 0, 2, &scene);
   ASSERT_EQ(plain.size(), 2u);
   ASSERT_EQ(runtime.size(), 1u);
   ASSERT_EQ(file.size(), 2u);

@@ -19,7 +19,9 @@
 #include "gltf_test_files.h"
 #include "gpu_test.h"
 #include "run_command.h"
+#include "renderer_inspect.h"
 #include "siviflow/host_frame.h"
+#include "siviflow/scene_river.h"
 
 namespace siviflow::testing {
 namespace {
@@ -55,11 +57,17 @@ class SharedRiverTest : public GpuTest {
     CreateInfo info = make_create_info(extent.width, extent.height);
     info.readback_images = readback_bit(ReadbackImage::kColor) | readback_bit(ReadbackImage::kFlowTexture);
     if (scene != nullptr) info.readback_images |= readback_bit(ReadbackImage::kWaterMask);
-    info.scene = scene;
-    info.river_index = river;
     info.reflection = &World::draw_reflection;
     info.reflection_user = world_.get();
     info.share_river_with = share;
+    SceneRiverData data;  // read by create() only
+    WaterRiver water;
+    if (scene != nullptr) {
+      const Status read = scene_river_data(scene, river, &data);
+      EXPECT_TRUE(read.ok()) << read.message();
+      water = data.river();
+      info.river = &water;
+    }
     std::unique_ptr<Renderer> renderer;
     const Status status = Renderer::create(info, &renderer);
     EXPECT_TRUE(status.ok()) << status.message();
@@ -139,18 +147,6 @@ class SharedRiverTest : public GpuTest {
     return view;
   }
 
-  // A renderer of river `river` of `scene` that should fail to be made.
-  Status make_status(VkExtent2D extent, const SceneFile* scene, uint32_t river) {
-    CreateInfo info = make_create_info(extent.width, extent.height);
-    info.scene = scene;
-    info.river_index = river;
-    std::unique_ptr<Renderer> renderer;
-    const Status status = Renderer::create(info, &renderer);
-    if (!status.ok()) {
-      EXPECT_NE(status.message().find("no river 2 (it has 2)"), std::string::npos) << status.message();
-    }
-    return status;
-  }
 
   std::vector<std::unique_ptr<HostTargets>> targets_;
 };
@@ -253,7 +249,7 @@ TEST_F(SharedRiverTest, ObstacleAddedThroughOneViewReroutesTheOther) {
 double mean_particle_speed(const Renderer& renderer, size_t* count) {
   double sum = 0.0;
   *count = 0;
-  for (const Particle& p : renderer.particle_field().particles()) {
+  for (const Particle& p : particle_field(renderer).particles()) {
     if (!p.live()) continue;
     sum += glm::length(p.flow);
     ++*count;
@@ -278,7 +274,10 @@ TEST_F(SharedRiverTest, TwoRiversOfASceneRenderEachWithItsOwnFlow) {
   const VkExtent2D extent{kWidth, kHeight};
   auto slow = make(extent, nullptr, &scene, 0);
   auto fast = make(extent, nullptr, &scene, 1);
-  EXPECT_FALSE(make_status(extent, &scene, 2).ok());
+  SceneRiverData none;
+  const Status missing = scene_river_data(&scene, 2, &none);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.message().find("no river 2 (it has 2)"), std::string::npos) << missing.message();
   HostTargets* screen = targets(extent);
   Pane a{slow.get(), 0.0, screen, {{0, 0}, extent}};
   Pane b{fast.get(), 0.0, screen, {{0, 0}, extent}, false};

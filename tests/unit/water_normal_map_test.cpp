@@ -8,7 +8,7 @@
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 
-#include "scene/water_normal_map.h"
+#include "water_normal_map.h"
 
 namespace siviflow {
 namespace {

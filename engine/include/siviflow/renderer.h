@@ -33,10 +33,8 @@
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan.h>
 
-#include "siviflow/scene_file.h"
 #include "siviflow/water_look.h"
-#include "sim/flow_textures.h"
-#include "sim/particles.h"
+#include "siviflow/water_river.h"
 #include "sim/status.h"
 
 namespace siviflow {
@@ -81,16 +79,15 @@ struct CreateInfo {
   // the shipping path: no copies and no AOV attachments.
   uint32_t readback_images = 0;
   uint64_t seed = 0;                   // seed of the river particles' random choices
-  // The scene to render (its river, flow, obstacles, objects and camera keys); null: the
-  // built-in default scene. Read by create() only: the renderer copies what it needs.
-  const SceneFile* scene = nullptr;
-  uint32_t river_index = 0;  // which of the scene's rivers this renderer draws (0: the first)
-  // The water's starting look; null: the scene's "look" (or WaterLook's defaults). Read by
-  // create() only; set_look() changes it.
+  // The river to render (siviflow/water_river.h); null: the built-in default river with its two
+  // boulders. Read by create() only: the renderer copies what it needs.
+  const WaterRiver* river = nullptr;
+  // The water's starting look; null: WaterLook's defaults. Read by create() only; set_look()
+  // changes it.
   const WaterLook* look = nullptr;
   // Another view of the same river: a renderer on the same device whose river this one shares
   // (its surface, flow, obstacles and static GPU data: no second flow solve), with particles,
-  // flow textures, tile table and reflection of its own; `scene` is then not read. Obstacles
+  // flow textures, tile table and reflection of its own; `river` is then not read. Obstacles
   // added through either renderer re-route both. Null: a river of its own.
   const Renderer* share_river_with = nullptr;
   bool enable_timing = false;          // GPU timestamps around every pass (see pass_times()),
@@ -142,16 +139,6 @@ struct Camera {
 // The standard-depth view of `camera` over a viewport of `extent` at the images' origin.
 View camera_view(const Camera& camera, VkExtent2D extent);
 
-// An obstacle the host places at runtime (a boat the player steers, a log): its footprint on the
-// water seen from above, which the flow goes round (its outline becomes a streamline).
-struct WaterObstacle {
-  glm::vec3 centre{0.0f};  // world position; the footprint lies around it in x and z
-  float radius = 0.0f;     // a circle of this radius (metres) when `polygon` is empty
-  // A polygon footprint: (x, z) offsets from the centre, 3 .. 4096 points, simple, either winding.
-  std::vector<glm::vec2> polygon;
-  float rotation_rad = 0.0f;  // turns the polygon about +Y as glm::rotate does (+X towards -Z)
-};
-
 // An image's synchronisation state: what last touched it and its layout.
 struct ImageState {
   VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
@@ -177,7 +164,7 @@ enum class ReadbackImage : uint32_t {
   kColor,        // the host's colour with the water, in its format's texels
   kDepth,        // the host's depth (the water writes none), its depth aspect's 4-byte texels
   kWaterMask,    // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
-  kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h), flow_texture_layout()
+  kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h)
   kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)
   kNormal,       // RGBA32F: the final water normal in world space (xyz) on water, 0 elsewhere
   kReflection,   // RGBA32F: the reflection sample of the water material before blending
@@ -255,7 +242,8 @@ class Renderer {
   // Runtime obstacles. Each call re-solves the flow only around the old and new footprints
   // (the result equals a fresh solve) and the next update() carries the new flow. Call outside
   // begin_frame/record. An obstacle with a non-finite or degenerate footprint, or an unknown id,
-  // is an error naming the field or id, and nothing changes.
+  // is an error naming the field or id, and nothing changes. An added obstacle's keys move it
+  // as update()'s time goes.
   Status add_obstacle(const WaterObstacle& obstacle, uint32_t* id);
   // Moves obstacle `id` to `centre`, its polygon turned to `rotation_rad`.
   Status move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad = 0.0f);
@@ -274,10 +262,6 @@ class Renderer {
   // `slot`. Call only after the host waited for that slot's frame.
   Status pass_times(uint32_t slot, std::vector<PassTime>* out) const;
 
-  // The particles of the last simulated frame (particles() in id order, their parameters).
-  const ParticleField& particle_field() const;
-  // Where the flow texture's and the aux data's texels are (sizes, texel size in pixels).
-  const FlowTextureLayout& flow_texture_layout() const;
   const TileTableLayout& tile_table_layout() const;
   // The index of the next frame update() or simulate() will advance to.
   uint64_t next_frame() const;
@@ -294,6 +278,7 @@ class Renderer {
   struct Impl;
 
  private:
+  friend class RendererInspector;  // what our tools and tests read of the simulation
   explicit Renderer(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

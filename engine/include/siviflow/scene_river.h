@@ -1,8 +1,10 @@
-// The river of a scene file, solved: its mesh (glTF or procedural) turned into a river surface
-// and a stream-function flow with the scene's obstacles placed at a given time.
+// The rivers of a scene file: in the form the water renderer takes (scene_river_data), and
+// solved on their own (build_scene_river_flow: a river surface and a stream-function flow with
+// the scene's obstacles placed at a given time).
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -10,11 +12,33 @@
 #include <glm/vec3.hpp>
 
 #include "siviflow/scene_file.h"
+#include "siviflow/water_river.h"
 #include "sim/obstacle.h"
+#include "sim/procedural_river.h"
 #include "sim/status.h"
 #include "sim/stream_function.h"
 
 namespace siviflow {
+
+// A glTF river has no riverbed: its depth is this much in mid-river, falling as a parabola to
+// nothing at the banks (4 d_left d_right / width^2 of it).
+inline constexpr float kGltfRiverDepth = 1.5f;
+
+// A river of a scene in the form the renderer takes: CreateInfo::river = &river() (spans into
+// this object, which must outlive create()). Also what the built-in world draws around it.
+struct SceneRiverData {
+  RiverMesh mesh;                        // positions, indices, depth under each vertex
+  std::vector<float> slope;              // the bed's slope under each vertex
+  std::vector<WaterObstacle> obstacles;  // the scene's, then those of objects marked obstacle
+  RiverFlowParams flow;
+  std::optional<ProceduralRiver> procedural;  // the generator it came from, if it did
+  WaterRiver river() const;
+};
+
+// River `river_index` of `scene` (null: the built-in default river, procedural, with its two
+// boulders): a procedural river with its terrain's slope, a glTF river with the depth profile
+// above. Errors name the scene file (and the glTF file), or the index the scene lacks.
+Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverData* out);
 
 struct SceneRiverFlow {
   std::vector<glm::vec3> positions;  // the river primitive's vertices, in the file's accessor order

@@ -1,4 +1,4 @@
-// The simulation half of a frame for the scene's river, on the CPU: the river surface and its
+// The simulation half of a frame for a river, on the CPU: the river surface and its
 // stream-function flow (solved once, shared by every view of the river), and per view the
 // screen-space particles and flow textures (kept every frame). No Vulkan: the renderer copies
 // pack()'s bytes into its staging block.
@@ -6,7 +6,6 @@
 
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <span>
 #include <vector>
 
@@ -14,8 +13,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "scene/gltf_import.h"
-#include "siviflow/scene_file.h"
+#include "siviflow/water_river.h"
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "sim/procedural_river.h"
@@ -27,10 +25,6 @@
 
 namespace siviflow {
 
-// A glTF river has no riverbed: its depth is this much in mid-river, falling as a parabola to
-// nothing at the banks (4 d_left d_right / width^2 of it).
-inline constexpr float kGltfRiverDepth = 1.5f;
-
 // What the simulation runs on: the river's mesh (positions, indices, depth), the riverbed slope
 // under each vertex (rise over run), and the surface built from the mesh (built once).
 struct RiverInput {
@@ -41,12 +35,15 @@ struct RiverInput {
 
 // The procedural river, with the slope of the terrain under each vertex.
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
-// A glTF river with the depth profile above, and the slope of that riverbed across.
-Status gltf_river_input(TriangleMesh gltf, RiverInput* out);
-// River `river_index` of a scene file (null: the default scene's one river), and the procedural
-// river it was made from, if it was. Errors name the scene file, or the index it lacks.
-Status scene_river_input(const SceneFile* scene, size_t river_index, RiverInput* out,
-                         std::optional<ProceduralRiver>* procedural);
+// A host's river (CreateInfo::river): its arrays checked (sizes, finite, non-negative depth and
+// slope) and copied, its surface built. Errors name the field and the vertex.
+Status river_input_from(const WaterRiver& river, RiverInput* out);
+
+// The flow's obstacle for a host's: the polygon turned about +Y (x' = x cos + z sin,
+// z' = -x sin + z cos, as glm::rotate turns +X towards -Z), the keys as they are.
+Obstacle flow_obstacle(const WaterObstacle& placed);
+// A host's obstacle checked as the flow would check it; the message names it by `index`.
+Status check_obstacle(const WaterObstacle& placed, size_t index);
 
 // The river every view of it shares: its mesh, its flow (solved once, then re-solved only
 // around obstacles that move, come or go) and the ray-cast structure of its surface. Its

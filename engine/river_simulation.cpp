@@ -1,13 +1,12 @@
-#include "scene/river_simulation.h"
+#include "river_simulation.h"
 
 #include <cmath>
 #include <string>
 
 #include <glm/geometric.hpp>
 
-#include "scene/default_scene.h"
-#include "siviflow/scene_river.h"
 #include "sim/river_surface.h"
+#include "sim/text_format.h"
 
 namespace siviflow {
 namespace {
@@ -32,49 +31,61 @@ Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   return Status::success();
 }
 
-Status gltf_river_input(TriangleMesh gltf, RiverInput* out) {
-  RiverInput input;
-  SIVIFLOW_TRY(RiverSurface::build(gltf.positions, gltf.indices, RiverSurfaceOptions{}, &input.surface));
-  input.mesh.positions = std::move(gltf.positions);
-  input.mesh.indices = std::move(gltf.indices);
-  const size_t count = input.mesh.positions.size();
-  input.mesh.depth.resize(count);
-  input.slope.resize(count);
+Status river_input_from(const WaterRiver& river, RiverInput* out) {
+  const size_t count = river.positions.size();
+  const auto per_vertex = [count](size_t size, const char* field) {
+    if (size == count) return Status::success();
+    return Status::error(text_format("CreateInfo::river->%s has %zu values for %zu positions", field,
+                                     size, count));
+  };
+  SIVIFLOW_TRY(per_vertex(river.depth.size(), "depth"));
+  SIVIFLOW_TRY(per_vertex(river.slope.size(), "slope"));
   for (size_t v = 0; v < count; ++v) {
-    const RiverVertex vertex = input.surface.vertex(v);
-    const float w2 = vertex.width * vertex.width;
-    input.mesh.depth[v] = kGltfRiverDepth * 4.0f * vertex.d_left * vertex.d_right / w2;
-    input.slope[v] = std::abs(kGltfRiverDepth * 4.0f * (vertex.d_right - vertex.d_left) / w2);
+    const glm::vec3& p = river.positions[v];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      return Status::error(text_format("CreateInfo::river->positions[%zu] is not finite", v));
+    }
+    if (!(river.depth[v] >= 0.0f) || !std::isfinite(river.depth[v])) {
+      return Status::error(text_format("CreateInfo::river->depth[%zu] %g is not a finite depth >= 0",
+                                       v, double(river.depth[v])));
+    }
+    if (!(river.slope[v] >= 0.0f) || !std::isfinite(river.slope[v])) {
+      return Status::error(text_format("CreateInfo::river->slope[%zu] %g is not a finite slope >= 0",
+                                       v, double(river.slope[v])));
+    }
   }
+  RiverInput input;
+  input.mesh.positions.assign(river.positions.begin(), river.positions.end());
+  input.mesh.indices.assign(river.indices.begin(), river.indices.end());
+  input.mesh.depth.assign(river.depth.begin(), river.depth.end());
+  input.slope.assign(river.slope.begin(), river.slope.end());
+  const Status built = RiverSurface::build(input.mesh.positions, input.mesh.indices,
+                                           RiverSurfaceOptions{}, &input.surface);
+  if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
   *out = std::move(input);
   return Status::success();
 }
 
-Status scene_river_input(const SceneFile* scene, size_t river_index, RiverInput* out,
-                         std::optional<ProceduralRiver>* procedural) {
-  const size_t rivers = scene == nullptr ? 1 : scene->rivers.size();
-  if (river_index >= rivers) {
-    return Status::error((scene == nullptr ? std::string("the default scene") : scene->path) +
-                         ": no river " + std::to_string(river_index) + " (it has " +
-                         std::to_string(rivers) + ")");
+Obstacle flow_obstacle(const WaterObstacle& placed) {
+  Obstacle obstacle;
+  obstacle.centre = placed.centre;
+  obstacle.radius = placed.radius;
+  const float c = std::cos(placed.rotation_rad);
+  const float s = std::sin(placed.rotation_rad);
+  obstacle.polygon.reserve(placed.polygon.size());
+  for (const glm::vec2& p : placed.polygon) {
+    obstacle.polygon.push_back({c * p.x + s * p.y, -s * p.x + c * p.y});
   }
-  if (scene == nullptr) {
-    procedural->emplace(default_river_params());
-    return procedural_river_input(**procedural, out);
+  for (const WaterObstacleKey& key : placed.keys) obstacle.keys.push_back({key.t, key.centre});
+  return obstacle;
+}
+
+Status check_obstacle(const WaterObstacle& placed, size_t index) {
+  if (!std::isfinite(placed.rotation_rad)) {
+    return Status::error(text_format("obstacle %zu: WaterObstacle::rotation_rad %g is not finite",
+                                     index, double(placed.rotation_rad)));
   }
-  const auto in_scene = [scene](const Status& status) {
-    return status.ok() ? status : Status::error(scene->path + ": " + status.message(), status.code());
-  };
-  const SceneRiver& river = scene->rivers[river_index];
-  if (river.source == SceneRiver::Source::kGltf) {
-    TriangleMesh gltf;
-    SIVIFLOW_TRY(in_scene(load_river_mesh(river.gltf, river.mesh, &gltf)));
-    procedural->reset();
-    return in_scene(gltf_river_input(std::move(gltf), out));
-  }
-  SIVIFLOW_TRY(in_scene(ProceduralRiver::validate(river.procedural)));
-  procedural->emplace(river.procedural);
-  return in_scene(procedural_river_input(**procedural, out));
+  return validate_obstacle(flow_obstacle(placed), index);
 }
 
 Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles) {

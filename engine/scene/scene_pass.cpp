@@ -1,4 +1,4 @@
-#include "passes/passes.h"
+#include "scene/scene_pass.h"
 
 #include <cstddef>
 
@@ -32,12 +32,12 @@ Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat 
   scene.color_format = color_format;
   scene.depth_format = depth_format;
   scene.dynamic_depth_compare = true;  // the view's depth convention
-  scene.bindings = {{0, sizeof(SceneVertex), VK_VERTEX_INPUT_RATE_VERTEX}};
+  scene.bindings = {{0, sizeof(gpu::SceneVertex), VK_VERTEX_INPUT_RATE_VERTEX}};
   scene.attributes = {
-      {SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SceneVertex, position)},
-      {SIVIFLOW_ATTR_NORMAL, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(SceneVertex, normal)},
-      {SIVIFLOW_ATTR_COLOR, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(SceneVertex, color)},
-      {SIVIFLOW_ATTR_TEXCOORD, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(SceneVertex, texcoord)}};
+      {SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(gpu::SceneVertex, position)},
+      {SIVIFLOW_ATTR_NORMAL, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(gpu::SceneVertex, normal)},
+      {SIVIFLOW_ATTR_COLOR, 0, VK_FORMAT_R32G32B32A32_SFLOAT, offsetof(gpu::SceneVertex, color)},
+      {SIVIFLOW_ATTR_TEXCOORD, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(gpu::SceneVertex, texcoord)}};
   SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, scene, &scene_pipeline_));
   GraphicsPipelineDesc object = scene;
   object.fragment_shader = "object.frag";

@@ -1,4 +1,4 @@
-#include "scene/water_normal_map.h"
+#include "water_normal_map.h"
 
 #include <algorithm>
 #include <array>

@@ -1,0 +1,52 @@
+// A river as the water renderer takes it (CreateInfo::river): its water surface, the water's
+// depth and the bed's slope under each vertex, its flow and the obstacles in it. The renderer
+// copies what it needs at create(); the host may free the arrays afterwards. A scene file's
+// rivers come in this form from siviflow/scene_river.h.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+namespace siviflow {
+
+struct WaterObstacleKey {
+  double t = 0.0;            // seconds; keys strictly increasing in t
+  glm::vec3 centre{0.0f};    // world position of the obstacle's centre at t
+};
+
+// An obstacle on the water (a boulder, a boat the player steers, a log): its footprint seen
+// from above, which the flow goes round (its outline becomes a streamline).
+struct WaterObstacle {
+  glm::vec3 centre{0.0f};  // world position; the footprint lies around it in x and z
+  float radius = 0.0f;     // a circle of this radius (metres) when `polygon` is empty
+  // A polygon footprint: (x, z) offsets from the centre, 3 .. 4096 points, simple, either winding.
+  std::vector<glm::vec2> polygon;
+  float rotation_rad = 0.0f;  // turns the polygon about +Y as glm::rotate does (+X towards -Z)
+  // The centre moves through these keys (linear between them, held before the first and after
+  // the last) as update()'s time goes; empty: it stays at `centre`.
+  std::vector<WaterObstacleKey> keys;
+};
+
+struct RiverFlowParams {
+  float discharge = 20.0f;    // Q in m^2/s: psi from the right bank (0) to the left (Q)
+  float shepard_power = 1.5f; // p of the interpolation weights; 1 gives plug flow
+  float search_radius = 0.0f; // s in metres; 0: 3 x the widest section
+};
+
+struct WaterRiver {
+  // The water surface: a strip of quads from bank to bank, one row of vertices per
+  // cross-section (sections may differ in width and vertex count), triangles as index triples.
+  // The upstream end is the section holding vertex 0; world metres, +Y up.
+  std::span<const glm::vec3> positions;
+  std::span<const uint32_t> indices;
+  std::span<const float> depth;  // per vertex: water depth under it, metres, >= 0
+  std::span<const float> slope;  // per vertex: the bed's slope under it (rise over run), >= 0
+  RiverFlowParams flow;
+  std::span<const WaterObstacle> obstacles;
+};
+
+}  // namespace siviflow

@@ -1,0 +1,26 @@
+// What our tools and tests read of a renderer's simulation, beyond the embedding interface (not
+// installed): the particles of the last simulated frame and the flow texture's layout.
+#pragma once
+
+#include "siviflow/renderer.h"
+#include "sim/flow_textures.h"
+#include "sim/particles.h"
+
+namespace siviflow {
+
+class RendererInspector {
+ public:
+  // The particles of the last simulated frame (particles() in id order, their parameters).
+  static const ParticleField& particle_field(const Renderer& renderer);
+  // Where the flow texture's and the aux data's texels are (sizes, texel size in pixels).
+  static const FlowTextureLayout& flow_texture_layout(const Renderer& renderer);
+};
+
+inline const ParticleField& particle_field(const Renderer& renderer) {
+  return RendererInspector::particle_field(renderer);
+}
+inline const FlowTextureLayout& flow_texture_layout(const Renderer& renderer) {
+  return RendererInspector::flow_texture_layout(renderer);
+}
+
+}  // namespace siviflow
