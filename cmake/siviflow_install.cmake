@@ -1,34 +1,60 @@
-# Installs the libraries, the public headers and a CMake package, so that an engine can embed
-# SiViFlow with find_package(siviflow) and link siviflow::engine (and siviflow::capture).
+# Installs the libraries, the public headers and a CMake package with components, so that an
+# engine embeds the water with find_package(siviflow COMPONENTS water) and links siviflow::water
+# alone, pulling in no file-format library; siviflow::scene, ::headless and ::capture come with
+# their components (all of them when none is named).
 include(CMakePackageConfigHelpers)
 
-# Exported as siviflow::sim, siviflow::engine, ... — the same names as the in-tree aliases.
-foreach(target sim engine capture shaders warnings)
+# Exported as siviflow::sim, siviflow::water, ... — the same names as the in-tree aliases.
+foreach(target sim water scene headless capture shaders warnings)
   set_target_properties(siviflow_${target} PROPERTIES EXPORT_NAME ${target})
 endforeach()
-install(TARGETS siviflow_sim siviflow_engine siviflow_capture siviflow_shaders siviflow_warnings
-        EXPORT siviflowTargets
-        ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+# One export set per component: water (with what it links), scene (with the headless host), capture.
+install(TARGETS siviflow_sim siviflow_water siviflow_shaders siviflow_warnings
+        EXPORT siviflowWaterTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+install(TARGETS siviflow_scene siviflow_headless
+        EXPORT siviflowSceneTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+install(TARGETS siviflow_capture
+        EXPORT siviflowCaptureTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+foreach(component Water Scene Capture)
+  install(EXPORT siviflow${component}Targets NAMESPACE siviflow:: FILE siviflow${component}Targets.cmake
+          DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/siviflow)
+endforeach()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/siviflow
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/sim DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
 # The GPU layouts the sim's packing writes (included as "shaders/shared.h").
 install(FILES ${PROJECT_SOURCE_DIR}/shaders/shared.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/shaders)
-install(EXPORT siviflowTargets NAMESPACE siviflow:: FILE siviflowTargets.cmake
-        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/siviflow)
 
 file(WRITE ${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in [=[
 @PACKAGE_INIT@
 include(CMakeFindDependencyMacro)
+set(_siviflow_components ${siviflow_FIND_COMPONENTS})
+if(NOT _siviflow_components)
+  set(_siviflow_components water scene headless capture)
+endif()
+# water: Vulkan headers and GLM; scene (and headless, which needs it): glTF, JSON, PNG, JPEG;
+# capture: OpenEXR and PNG.
 find_dependency(glm)
 find_dependency(VulkanHeaders CONFIG)
-find_dependency(TinyGLTF CONFIG)
-find_dependency(nlohmann_json 3 CONFIG)
-find_dependency(OpenEXR 3 CONFIG)
-find_dependency(PNG)
-find_dependency(JPEG)
-include("${CMAKE_CURRENT_LIST_DIR}/siviflowTargets.cmake")
+include("${CMAKE_CURRENT_LIST_DIR}/siviflowWaterTargets.cmake")
+set(siviflow_water_FOUND TRUE)
+if("scene" IN_LIST _siviflow_components OR "headless" IN_LIST _siviflow_components)
+  find_dependency(TinyGLTF CONFIG)
+  find_dependency(nlohmann_json 3 CONFIG)
+  find_dependency(PNG)
+  find_dependency(JPEG)
+  include("${CMAKE_CURRENT_LIST_DIR}/siviflowSceneTargets.cmake")
+  set(siviflow_scene_FOUND TRUE)
+  set(siviflow_headless_FOUND TRUE)
+endif()
+if("capture" IN_LIST _siviflow_components)
+  find_dependency(OpenEXR 3 CONFIG)
+  find_dependency(PNG)
+  include("${CMAKE_CURRENT_LIST_DIR}/siviflowCaptureTargets.cmake")
+  set(siviflow_capture_FOUND TRUE)
+endif()
+check_required_components(siviflow)
 ]=])
 configure_package_config_file(${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in
   ${PROJECT_BINARY_DIR}/siviflowConfig.cmake

@@ -1,67 +1,336 @@
-// Embeds an installed SiViFlow as an engine would: the host owns the device (here the small
-// headless host), the command buffer and its colour and depth images; it draws its world into
-// them (here the built-in one), and SiViFlow records the water over them.
-// Exits 0 only when the frame rendered, read back non-black, with no validation error.
+// Embeds an installed SiViFlow as an engine would, linking siviflow::water alone: the engine
+// creates its own instance and device (with the validation layer when it is installed), its
+// colour and depth images, command buffer and fence; it draws its world into the images (here
+// a sky-blue clear and a depth that puts the ground 60 m away), and SiViFlow records the default
+// river's water over them. Exits 0 only when water covers part of the frame, the rest keeps the
+// engine's colour, and the validation layer reported no error.
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <memory>
+#include <vector>
 
-#include <siviflow/headless_context.h>
-#include <siviflow/host_frame.h>
 #include <siviflow/renderer.h>
-#include <siviflow/world.h>
+#include <vulkan/vulkan.h>
+
+namespace {
+
+constexpr VkExtent2D kExtent{96, 54};
+constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
+constexpr float kSky[4] = {0.45f, 0.6f, 0.8f, 1.0f};
+
+unsigned g_validation_errors = 0;
+
+VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                          VkDebugUtilsMessageTypeFlagsEXT,
+                                          const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+  if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
+    ++g_validation_errors;
+    std::fprintf(stderr, "validation: %s\n", data->pMessage);
+  }
+  return VK_FALSE;
+}
+
+bool has_layer(const char* name) {
+  uint32_t count = 0;
+  vkEnumerateInstanceLayerProperties(&count, nullptr);
+  std::vector<VkLayerProperties> layers(count);
+  vkEnumerateInstanceLayerProperties(&count, layers.data());
+  for (const VkLayerProperties& layer : layers) {
+    if (std::strcmp(layer.layerName, name) == 0) return true;
+  }
+  return false;
+}
+
+uint32_t memory_type(VkPhysicalDevice gpu, uint32_t bits, VkMemoryPropertyFlags wanted) {
+  VkPhysicalDeviceMemoryProperties props;
+  vkGetPhysicalDeviceMemoryProperties(gpu, &props);
+  for (uint32_t i = 0; i < props.memoryTypeCount; ++i) {
+    if ((bits & (1u << i)) && (props.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+  }
+  return UINT32_MAX;
+}
+
+struct Engine {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice gpu = VK_NULL_HANDLE;
+  uint32_t family = 0;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  std::vector<VkImage> images;
+  std::vector<VkImageView> views;
+  std::vector<VkDeviceMemory> memories;
+  VkBuffer readback = VK_NULL_HANDLE;
+  VkCommandPool pool = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+
+  ~Engine() {
+    if (device != VK_NULL_HANDLE) {
+      vkDeviceWaitIdle(device);
+      vkDestroyFence(device, fence, nullptr);
+      vkDestroyCommandPool(device, pool, nullptr);
+      vkDestroyBuffer(device, readback, nullptr);
+      for (VkImageView view : views) vkDestroyImageView(device, view, nullptr);
+      for (VkImage image : images) vkDestroyImage(device, image, nullptr);
+      for (VkDeviceMemory memory : memories) vkFreeMemory(device, memory, nullptr);
+      vkDestroyDevice(device, nullptr);
+    }
+    if (messenger != VK_NULL_HANDLE) {
+      auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+          vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
+      destroy(instance, messenger, nullptr);
+    }
+    if (instance != VK_NULL_HANDLE) vkDestroyInstance(instance, nullptr);
+  }
+
+  bool bind(VkMemoryRequirements needs, VkMemoryPropertyFlags wanted, VkDeviceMemory* out) {
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = needs.size;
+    alloc.memoryTypeIndex = memory_type(gpu, needs.memoryTypeBits, wanted);
+    if (alloc.memoryTypeIndex == UINT32_MAX) return false;
+    if (vkAllocateMemory(device, &alloc, nullptr, out) != VK_SUCCESS) return false;
+    memories.push_back(*out);
+    return true;
+  }
+
+  bool image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect, VkImage* out,
+             VkImageView* view) {
+    VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    info.imageType = VK_IMAGE_TYPE_2D;
+    info.format = format;
+    info.extent = {kExtent.width, kExtent.height, 1};
+    info.mipLevels = 1;
+    info.arrayLayers = 1;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.usage = usage;
+    if (vkCreateImage(device, &info, nullptr, out) != VK_SUCCESS) return false;
+    images.push_back(*out);
+    VkMemoryRequirements needs;
+    vkGetImageMemoryRequirements(device, *out, &needs);
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    if (!bind(needs, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, &memory)) return false;
+    vkBindImageMemory(device, *out, memory, 0);
+    VkImageViewCreateInfo view_info{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    view_info.image = *out;
+    view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view_info.format = format;
+    view_info.subresourceRange = {aspect, 0, 1, 0, 1};
+    if (vkCreateImageView(device, &view_info, nullptr, view) != VK_SUCCESS) return false;
+    views.push_back(*view);
+    return true;
+  }
+};
+
+int fail(const char* what) {
+  std::fprintf(stderr, "embed_example: %s\n", what);
+  return 1;
+}
+
+}  // namespace
 
 int main() {
-  using namespace siviflow;
-  HeadlessContextOptions options;
-  options.enable_validation = true;
-  options.require_validation = true;
-  std::unique_ptr<HeadlessContext> host;
-  Status status = HeadlessContext::create(options, &host);
-  if (!status.ok()) return std::fprintf(stderr, "%s\n", status.message().c_str()), 1;
-
-  const VkExtent2D extent{64, 36};
-  const VkFormat color = VK_FORMAT_R8G8B8A8_UNORM;
-  const VkFormat depth = VK_FORMAT_D32_SFLOAT;
-  std::unique_ptr<World> world;
-  status = World::create(host->world_create_info(color, depth), &world);
-  if (!status.ok()) return std::fprintf(stderr, "%s\n", status.message().c_str()), 1;
-  CreateInfo info = host->renderer_create_info(extent, color);
-  info.depth_format = depth;
-  info.readback_images = kAllReadbackImages;
-  info.reflection = &World::draw_reflection;
-  info.reflection_user = world.get();
-  std::unique_ptr<Renderer> renderer;
-  status = Renderer::create(info, &renderer);
-  if (!status.ok()) return std::fprintf(stderr, "%s\n", status.message().c_str()), 1;
-
-  HostTargets targets;
-  if (!create_host_targets(*host, color, depth, extent,
-                           {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_GENERAL},
-                           &targets).ok()) {
-    return 1;
+  Engine e;
+  // The engine's instance: Vulkan 1.3, the validation layer (synchronization validation on)
+  // when it is installed.
+  const bool validate = has_layer("VK_LAYER_KHRONOS_validation");
+  const char* layer = "VK_LAYER_KHRONOS_validation";
+  const char* debug_utils = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+  const VkValidationFeatureEnableEXT sync = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = &sync;
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "embed_example";
+  app.apiVersion = VK_API_VERSION_1_3;
+  VkInstanceCreateInfo instance_info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  instance_info.pApplicationInfo = &app;
+  if (validate) {
+    instance_info.pNext = &features;
+    instance_info.enabledLayerCount = 1;
+    instance_info.ppEnabledLayerNames = &layer;
+    instance_info.enabledExtensionCount = 1;
+    instance_info.ppEnabledExtensionNames = &debug_utils;
   }
-  HostBuffer readback[kReadbackImageCount];
-  ReadbackTargets buffers;
-  for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
-    if (!host->create_readback_buffer(renderer->readback_bytes(static_cast<ReadbackImage>(i)), &readback[i]).ok()) {
-      return 1;
+  if (vkCreateInstance(&instance_info, nullptr, &e.instance) != VK_SUCCESS) return fail("vkCreateInstance");
+  if (validate) {
+    VkDebugUtilsMessengerCreateInfoEXT messenger{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    messenger.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    messenger.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+    messenger.pfnUserCallback = &on_message;
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(e.instance, "vkCreateDebugUtilsMessengerEXT"));
+    if (create(e.instance, &messenger, nullptr, &e.messenger) != VK_SUCCESS) return fail("messenger");
+  }
+
+  // The first device with a graphics queue and every feature SiViFlow needs.
+  uint32_t count = 0;
+  vkEnumeratePhysicalDevices(e.instance, &count, nullptr);
+  std::vector<VkPhysicalDevice> gpus(count);
+  vkEnumeratePhysicalDevices(e.instance, &count, gpus.data());
+  siviflow::RequiredDeviceFeatures required = siviflow::required_device_features();
+  required.link();
+  for (VkPhysicalDevice gpu : gpus) {
+    siviflow::RequiredDeviceFeatures supported{};
+    supported.features2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    supported.vulkan13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+    supported.link();
+    vkGetPhysicalDeviceFeatures2(gpu, &supported.features2);
+    if (!siviflow::missing_device_features(&supported.features2).empty()) continue;
+    uint32_t families = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(gpu, &families, nullptr);
+    std::vector<VkQueueFamilyProperties> props(families);
+    vkGetPhysicalDeviceQueueFamilyProperties(gpu, &families, props.data());
+    for (uint32_t f = 0; f < families && e.gpu == VK_NULL_HANDLE; ++f) {
+      if (props[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) {
+        e.gpu = gpu;
+        e.family = f;
+      }
     }
-    buffers.buffers[i] = readback[i].buffer;
+    if (e.gpu != VK_NULL_HANDLE) break;
   }
+  if (e.gpu == VK_NULL_HANDLE) return fail("no device with SiViFlow's required features");
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue_info.queueFamilyIndex = e.family;
+  queue_info.queueCount = 1;
+  queue_info.pQueuePriorities = &priority;
+  VkDeviceCreateInfo device_info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  device_info.pNext = &required.features2;
+  device_info.queueCreateInfoCount = 1;
+  device_info.pQueueCreateInfos = &queue_info;
+  if (vkCreateDevice(e.gpu, &device_info, nullptr, &e.device) != VK_SUCCESS) return fail("vkCreateDevice");
+  vkGetDeviceQueue(e.device, e.family, 0, &e.queue);
+
+  // The engine's render targets, a readback buffer for the colour, a command buffer and fence.
+  VkImage color = VK_NULL_HANDLE, depth = VK_NULL_HANDLE;
+  VkImageView color_view = VK_NULL_HANDLE, depth_view = VK_NULL_HANDLE;
+  if (!e.image(kColorFormat,
+               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                   VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+               VK_IMAGE_ASPECT_COLOR_BIT, &color, &color_view) ||
+      !e.image(kDepthFormat,
+               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                   VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+               VK_IMAGE_ASPECT_DEPTH_BIT, &depth, &depth_view)) {
+    return fail("images");
+  }
+  const VkDeviceSize bytes = VkDeviceSize{kExtent.width} * kExtent.height * 4;
+  VkBufferCreateInfo buffer_info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  buffer_info.size = bytes;
+  buffer_info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  if (vkCreateBuffer(e.device, &buffer_info, nullptr, &e.readback) != VK_SUCCESS) return fail("buffer");
+  VkMemoryRequirements needs;
+  vkGetBufferMemoryRequirements(e.device, e.readback, &needs);
+  VkDeviceMemory readback_memory = VK_NULL_HANDLE;
+  if (!e.bind(needs, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+              &readback_memory)) {
+    return fail("readback memory");
+  }
+  vkBindBufferMemory(e.device, e.readback, readback_memory, 0);
+  VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool_info.queueFamilyIndex = e.family;
+  if (vkCreateCommandPool(e.device, &pool_info, nullptr, &e.pool) != VK_SUCCESS) return fail("pool");
+  VkCommandBufferAllocateInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cmd_info.commandPool = e.pool;
+  cmd_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cmd_info.commandBufferCount = 1;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
-  const View view = camera_view(world->scene_camera(0.0), extent);
-  if (!host->begin_slot(0, &cmd).ok() || !renderer->begin_frame(0).ok() ||
-      !renderer->update(view, 0.0).ok() ||
-      !record_world_and_water(cmd, 0, *world, *renderer, view, 0.0, buffers, &targets).ok() ||
-      !host->end_slot_and_submit(0).ok() || !host->wait_slot(0).ok()) {
-    return std::fprintf(stderr, "frame failed\n"), 1;
+  if (vkAllocateCommandBuffers(e.device, &cmd_info, &cmd) != VK_SUCCESS) return fail("command buffer");
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  if (vkCreateFence(e.device, &fence_info, nullptr, &e.fence) != VK_SUCCESS) return fail("fence");
+
+  // SiViFlow: the default river, one frame slot, readback of the colour into our buffer.
+  siviflow::CreateInfo info{};
+  info.instance = e.instance;
+  info.physical_device = e.gpu;
+  info.device = e.device;
+  info.get_instance_proc_addr = vkGetInstanceProcAddr;
+  info.get_device_proc_addr = vkGetDeviceProcAddr;
+  info.enabled_features = &required.features2;
+  info.queue_family_index = e.family;
+  info.frames_in_flight = 1;
+  info.color_format = kColorFormat;
+  info.depth_format = kDepthFormat;
+  info.extent = kExtent;
+  info.readback_images = siviflow::readback_bit(siviflow::ReadbackImage::kColor);
+  std::unique_ptr<siviflow::Renderer> water;
+  siviflow::Status status = siviflow::Renderer::create(info, &water);
+  if (!status.ok()) return fail(status.message().c_str());
+
+  siviflow::Camera camera;
+  camera.position = {0.0f, 10.0f, -30.0f};
+  camera.target = {6.0f, 0.0f, 0.0f};
+  const siviflow::View view = siviflow::camera_view(camera, kExtent);
+  if (!water->begin_frame(0).ok() || !water->update(view, 0.0).ok()) return fail("update");
+
+  // The engine's world: its colour and depth cleared (a sky, and ground far below the water).
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  vkBeginCommandBuffer(cmd, &begin);
+  VkImageMemoryBarrier2 to_clear[2] = {{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2},
+                                       {VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2}};
+  const VkImage targets[2] = {color, depth};
+  const VkImageAspectFlags aspects[2] = {VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_ASPECT_DEPTH_BIT};
+  for (int i = 0; i < 2; ++i) {
+    to_clear[i].dstStageMask = VK_PIPELINE_STAGE_2_CLEAR_BIT;
+    to_clear[i].dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    to_clear[i].oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    to_clear[i].newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    to_clear[i].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    to_clear[i].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    to_clear[i].image = targets[i];
+    to_clear[i].subresourceRange = {aspects[i], 0, 1, 0, 1};
   }
-  const auto* texels = static_cast<const unsigned char*>(readback[0].data);
-  unsigned long sum = 0;
-  for (int i = 0; i < 64 * 36 * 4; ++i) sum += texels[i];
-  renderer.reset();
-  world.reset();
-  const unsigned errors = host->validation_error_count();
-  std::printf("mean texel %.1f, validation errors %u\n", sum / (64.0 * 36 * 4), errors);
-  return sum > 0 && errors == 0 ? 0 : 1;
+  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dependency.imageMemoryBarrierCount = 2;
+  dependency.pImageMemoryBarriers = to_clear;
+  vkCmdPipelineBarrier2(cmd, &dependency);
+  VkClearColorValue sky;
+  std::memcpy(sky.float32, kSky, sizeof(kSky));
+  const VkImageSubresourceRange color_range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  const VkImageSubresourceRange depth_range{VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+  vkCmdClearColorImage(cmd, color, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &sky, 1, &color_range);
+  const VkClearDepthStencilValue ground{0.9999f, 0};
+  vkCmdClearDepthStencilImage(cmd, depth, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &ground, 1, &depth_range);
+
+  // The water over them; the colour left ready to copy, the depth for the engine's next pass.
+  const siviflow::ImageState cleared{VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL};
+  siviflow::FrameInputs inputs;
+  inputs.color = {color, color_view, kColorFormat, kExtent, cleared,
+                  {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
+                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL}};
+  inputs.depth = {depth, depth_view, kDepthFormat, kExtent, cleared,
+                  {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                   VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL}};
+  inputs.readback[siviflow::ReadbackImage::kColor] = e.readback;
+  status = water->record(cmd, inputs);
+  if (!status.ok()) return fail(status.message().c_str());
+  vkEndCommandBuffer(cmd);
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cmd;
+  if (vkQueueSubmit(e.queue, 1, &submit, e.fence) != VK_SUCCESS) return fail("submit");
+  if (vkWaitForFences(e.device, 1, &e.fence, VK_TRUE, 10'000'000'000ull) != VK_SUCCESS) return fail("wait");
+
+  // Water on part of the frame, the engine's sky everywhere else.
+  void* mapped = nullptr;
+  vkMapMemory(e.device, readback_memory, 0, bytes, 0, &mapped);
+  const auto* texels = static_cast<const unsigned char*>(mapped);
+  unsigned sky_texels = 0, water_texels = 0;
+  for (VkDeviceSize i = 0; i < bytes; i += 4) {
+    bool is_sky = true;
+    for (int c = 0; c < 4; ++c) {
+      const int expected = static_cast<int>(kSky[c] * 255.0f + 0.5f);
+      is_sky = is_sky && std::abs(texels[i + c] - expected) <= 1;
+    }
+    (is_sky ? sky_texels : water_texels) += 1;
+  }
+  vkUnmapMemory(e.device, readback_memory);
+  water.reset();
+  std::printf("water texels %u, sky texels %u, validation %s, errors %u\n", water_texels, sky_texels,
+              validate ? "on" : "not installed", g_validation_errors);
+  return water_texels > 100 && sky_texels > 100 && g_validation_errors == 0 ? 0 : 1;
 }

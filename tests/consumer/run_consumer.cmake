@@ -1,4 +1,5 @@
-# Installs the build into a scratch prefix, builds tests/consumer against it and runs it.
+# Installs the build into a scratch prefix, builds tests/consumer against it, runs it, and checks
+# its binary needs no file-format library.
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix
                 RESULT_VARIABLE rc OUTPUT_QUIET)
@@ -19,3 +20,18 @@ execute_process(COMMAND ${WORK}/build/embed_example RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the consumer's frame failed")
 endif()
+# The binary of an engine that links siviflow::water alone needs no file-format library.
+execute_process(COMMAND readelf -d ${WORK}/build/embed_example OUTPUT_VARIABLE dynamic RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "readelf failed on the consumer")
+endif()
+string(REGEX MATCHALL "\\(NEEDED\\)[^\n]*" needed "${dynamic}")
+foreach(library IN LISTS needed)
+  if(library MATCHES "OpenEXR|Imath|png|jpeg|tinygltf|Iex")
+    message(FATAL_ERROR "the consumer needs a file-format library: ${library}")
+  endif()
+endforeach()
+if(NOT needed MATCHES "libvulkan")
+  message(FATAL_ERROR "readelf found no NEEDED entries we understand: ${needed}")
+endif()
+message(STATUS "consumer needs: ${needed}")
