@@ -212,7 +212,9 @@ Status Renderer::Impl::create_river() {
 // This view's particles and flow textures, tile table size, staging ring and water passes.
 Status Renderer::Impl::create_view_resources() {
   SIVIFLOW_TRY(simulation.create(river->flow, info.seed, {info.extent.width, info.extent.height}));
-  size_tile_table();
+  tile_lattice.size(river->water_lo, river->water_hi, look.tile_size_m);
+  tile_constants.heights =
+      glm::vec4(river->heights_origin, river->heights_spacing, look.tile_size_m);
   // Every frame's flow textures must fit a slot's staging block.
   info.staging_bytes_per_slot = std::max(info.staging_bytes_per_slot,
                                          VkDeviceSize{simulation.layout().total_bytes} + kStagingAlignment);
@@ -220,47 +222,6 @@ Status Renderer::Impl::create_view_resources() {
   return flow_pass.create(gpu, info.pipeline_cache, info.color_format, info.depth_format,
                           info.frames_in_flight, (info.readback_images & kAovReadbackImages) != 0,
                           info.enable_timing);
-}
-
-// The tile table covers the lattice points around the water at the starting tile size (or as
-// many as SIVIFLOW_TILE_TABLE_MAX allows, then a window around the camera).
-void Renderer::Impl::size_tile_table() {
-  place_tile_lattice();
-  const auto table_side = [](int points) {
-    return std::min(std::bit_ceil(static_cast<uint32_t>(points)), SIVIFLOW_TILE_TABLE_MAX);
-  };
-  tile_table.width = table_side(lattice_hi.x - lattice_lo.x + 1);
-  tile_table.height = table_side(lattice_hi.y - lattice_lo.y + 1);
-  tile_constants.heights =
-      glm::vec4(river->heights_origin, river->heights_spacing, look.tile_size_m);
-}
-
-// The lattice points around the water at the look's tile size: those within a tile of it.
-void Renderer::Impl::place_tile_lattice() {
-  const float tile = look.tile_size_m;
-  const float half_tile = 0.5f * tile;
-  lattice_lo = glm::ivec2(glm::floor((river->water_lo - tile) / half_tile));
-  lattice_hi = glm::ivec2(glm::ceil((river->water_hi + tile) / half_tile));
-  tile_table.tile_size_m = tile;
-}
-
-// The lattice point of the tile table's window corner: the river's first point when the table
-// holds them all, else a window reaching as far ahead of the camera as it can (what lies behind
-// is not seen), kept over the river. Water beyond the window, farther than the table's reach
-// (768 m at SIVIFLOW_TILE_TABLE_MAX), takes the tiles of points a table size away.
-glm::ivec2 Renderer::Impl::tile_window() const {
-  const glm::ivec2 size(tile_table.width, tile_table.height);
-  const float half_tile = 0.5f * look.tile_size_m;
-  const glm::vec2 position = glm::vec2(view.camera_position.x, view.camera_position.z) / half_tile;
-  // The view looks down its -Z axis: the world direction of that axis is the third row of the
-  // view matrix's rotation, negated (read from the inverse's third column).
-  const glm::mat4 to_world = glm::inverse(view_view);
-  glm::vec2 forward(-to_world[2][0], -to_world[2][2]);
-  forward = glm::length(forward) > 0.0f ? glm::normalize(forward) : glm::vec2(0.0f);
-  // The window's centre half a window ahead, less a tile, so the camera's own tiles stay in it.
-  const glm::vec2 ahead = forward * (0.5f * glm::vec2(size) - 2.0f);
-  const glm::ivec2 centre(glm::round(position + ahead));
-  return glm::clamp(centre - size / 2, lattice_lo, glm::max(lattice_lo, lattice_hi - size + 1));
 }
 
 ImageHandle Renderer::Impl::frame_image(ImageHandle handle, bool persistent) {
@@ -322,7 +283,8 @@ Status Renderer::Impl::declare_graph() {
   }
   water.water_heights = river_assets.images[SharedRiver::kWaterHeights];
   water.tile_table = frame_image(graph.create_image(
-      {"tile table", FlowPass::kTileTableFormat, {tile_table.width, tile_table.height}, {}}));
+      {"tile table", FlowPass::kTileTableFormat,
+       {tile_lattice.layout().width, tile_lattice.layout().height}, {}}));
   flow_pass.declare_tiles(graph, &tile_constants, &water);
   flow_pass.declare(graph, &flow_constants, river->index_count, &water);
   if (info.enable_timing) {
@@ -508,7 +470,6 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   SIVIFLOW_TRY(river->flow.set_time(time_seconds));
   SIVIFLOW_TRY(simulation.simulate(math.view_proj, dt));
   view = math;
-  view_view = host_view.view;
   viewport = rect;
 
   // The reflection is the world mirrored about the water plane y = h, seen from the real
@@ -535,17 +496,18 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   frame_look.deep_color = glm::vec4(look.deep_color, look.opacity_per_metre);
   frame_look.sun_color = glm::vec4(look.sun_color, look.ripple_strength);
   frame_look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, 0.0f, 0.0f);
-  place_tile_lattice();
+  // The view looks down its -Z axis: that axis's world direction is the inverse's third column.
+  const glm::vec3 forward = -glm::vec3(glm::inverse(host_view.view)[2]);
+  tile_lattice.place(river->water_lo, river->water_hi, look.tile_size_m, view.camera_position,
+                     forward);
+  const TileTableLayout& tiles = tile_lattice.layout();
   tile_constants.heights.w = look.tile_size_m;
   tile_constants.ripples = glm::vec4(repeat_tiles, 0.0f, 0.0f, 0.0f);
   flow_constants.screen = glm::vec4(rect.offset.x, rect.offset.y,
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
   tile_constants.view_proj = view.view_proj;
-  const glm::ivec2 corner = tile_window();
-  tile_table.corner_x = corner.x;
-  tile_table.corner_z = corner.y;
-  tile_constants.lattice = glm::vec4(corner, tile_table.width, tile_table.height);
+  tile_constants.lattice = glm::vec4(tiles.corner_x, tiles.corner_z, tiles.width, tiles.height);
   tile_constants.screen =
       glm::vec4(info.extent.width, info.extent.height, static_cast<float>(layout.texel_px),
                 static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
@@ -774,7 +736,7 @@ VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
     case ReadbackImage::kReflection:
       return pixels * 4 * sizeof(float);
     case ReadbackImage::kTileTable:
-      return VkDeviceSize{impl_->tile_table.width} * impl_->tile_table.height * 4 *
+      return VkDeviceSize{impl_->tile_lattice.layout().width} * impl_->tile_lattice.layout().height * 4 *
              sizeof(uint32_t);
   }
   return 0;
@@ -802,7 +764,7 @@ const char* readback_image_name(ReadbackImage image) {
   return "readback";
 }
 
-const TileTableLayout& Renderer::tile_table_layout() const { return impl_->tile_table; }
+const TileTableLayout& Renderer::tile_table_layout() const { return impl_->tile_lattice.layout(); }
 const ParticleField& RendererInspector::particle_field(const Renderer& renderer) {
   return renderer.impl_->simulation.particle_field();
 }

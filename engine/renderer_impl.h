@@ -15,6 +15,7 @@
 #include "siviflow/renderer.h"
 #include "shared_river.h"
 #include "static_assets.h"
+#include "tile_lattice.h"
 #include "view_math.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
@@ -59,14 +60,9 @@ struct Renderer::Impl {
   gpu::FlowConstants flow_constants{};
   gpu::FlowTileConstants tile_constants{};
   ViewMath view;        // of the frame being prepared
-  glm::mat4 view_view{1.0f};  // its world -> view matrix
   VkRect2D viewport{};  // in the host's images
   ReflectionView reflection_view{};
-  // The tile table's lattice (shaders/shared.h): the points around the water at this frame's
-  // tile size, and the table's size, a power of two per axis (fixed at create).
-  glm::ivec2 lattice_lo{0};
-  glm::ivec2 lattice_hi{0};
-  TileTableLayout tile_table;  // its corner moves with the camera when the river is larger
+  TileLattice tile_lattice;  // the tile table's size and, per frame, its lattice and window
 
   // With CreateInfo::enable_timing: per slot, two timestamps around each pass of the graph.
   std::vector<VkQueryPool> query_pools;
@@ -87,9 +83,6 @@ struct Renderer::Impl {
   ImageHandle frame_image(ImageHandle handle, bool persistent = false);
   Status create_frame_images();
   const Image* find_frame_image(ImageHandle handle) const;
-  void size_tile_table();
-  void place_tile_lattice();
-  glm::ivec2 tile_window() const;
   size_t runtime_obstacle_index(uint32_t id) const;  // in runtime_obstacles; size() when unknown
   Status add_obstacle(const WaterObstacle& obstacle, uint32_t* id);
   Status move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad);
