@@ -32,7 +32,6 @@ constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we co
 constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
 constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
-constexpr uint32_t kMaxTimedPasses = 16;
 
 constexpr float kTdfRepeatTiles = 3.5f;  // normal-map repeat in tiles at ripple scale 1 (van Hoesel 35/10)
 constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
@@ -380,35 +379,9 @@ void Renderer::Impl::destroy() {
   if (gpu.table == nullptr) return;  // failed before any Vulkan object existed
   flow_pass.destroy(gpu);
   for (FrameImage& f : frame_images) destroy_image(gpu, &f.image);
-  for (VkQueryPool pool : query_pools) table.vkDestroyQueryPool(table.device, pool, gpu.allocation_callbacks);
+  timer.destroy(gpu);
   ring.destroy();
   river.reset();  // the last view of the river frees its static data
-}
-
-Status Renderer::Impl::create_query_pools() {
-  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
-  table.vkGetPhysicalDeviceProperties2(info.physical_device, &props);
-  timestamp_period_ns = props.properties.limits.timestampPeriod;
-  uint32_t family_count = 0;
-  table.vkGetPhysicalDeviceQueueFamilyProperties(info.physical_device, &family_count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(family_count);
-  table.vkGetPhysicalDeviceQueueFamilyProperties(info.physical_device, &family_count, families.data());
-  const uint32_t bits = families[info.queue_family_index].timestampValidBits;
-  if (bits == 0) {
-    return Status::error("siviflow::Renderer: enable_timing: the queue family has no timestamps",
-                         VK_ERROR_FEATURE_NOT_PRESENT);
-  }
-  timestamp_mask = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
-  VkQueryPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-  pool_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-  pool_info.queryCount = 2 * kMaxTimedPasses;
-  query_pools.assign(info.frames_in_flight, VK_NULL_HANDLE);
-  timed_passes.assign(info.frames_in_flight, 0);
-  for (VkQueryPool& pool : query_pools) {
-    SIVIFLOW_TRY(vk_status(table.vkCreateQueryPool(table.device, &pool_info, gpu.allocation_callbacks, &pool),
-                           "vkCreateQueryPool"));
-  }
-  return Status::success();
 }
 
 Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) {
@@ -422,7 +395,10 @@ Status Renderer::create(const CreateInfo& info, std::unique_ptr<Renderer>* out) 
       if (status.ok()) status = impl->create_river();
       if (status.ok()) status = impl->create_view_resources();
       if (status.ok()) status = impl->declare_graph();
-      if (status.ok() && info.enable_timing) status = impl->create_query_pools();
+      if (status.ok() && info.enable_timing) {
+        status = impl->timer.create(impl->gpu, info.physical_device, info.queue_family_index,
+                                    impl->info.frames_in_flight);
+      }
       if (status.ok()) out->reset(new Renderer(std::move(impl)));
     } catch (...) {
       impl->destroy();  // the Vulkan objects made so far
@@ -670,15 +646,11 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
     }
     SIVIFLOW_TRY(r.bind_frame(inputs));
     FrameGraph::Timestamps timestamps;
-    if (!r.query_pools.empty()) {
-      const uint32_t passes = static_cast<uint32_t>(r.graph.pass_order().size());
-      if (passes > kMaxTimedPasses) return argument_error("too many passes to time");
-      timestamps.pool = r.query_pools[r.current_slot];
-      r.table.vkCmdResetQueryPool(cmd, timestamps.pool, 0, 2 * passes);
-      r.timed_passes[r.current_slot] = passes;
+    if (r.timer.enabled()) {
+      const auto passes = static_cast<uint32_t>(r.graph.pass_order().size());
+      SIVIFLOW_TRY(r.timer.begin(r.table, cmd, r.current_slot, passes, &timestamps));
     }
-    SIVIFLOW_TRY(
-        r.graph.execute(r.table, cmd, r.bindings, r.query_pools.empty() ? nullptr : &timestamps));
+    SIVIFLOW_TRY(r.graph.execute(r.table, cmd, r.bindings, r.timer.enabled() ? &timestamps : nullptr));
     if (!assets.uploaded()) assets.finish_upload(r.ring, r.river->gpu);
     r.frame_images_new = false;
     r.frame_begun = false;
@@ -780,29 +752,10 @@ Status Renderer::pass_times(uint32_t slot, std::vector<PassTime>* out) const {
 }
 
 Status Renderer::Impl::pass_times(uint32_t slot, std::vector<PassTime>* out) const {
-  const Impl& r = *this;
   out->clear();
-  if (r.query_pools.empty()) return argument_error("pass_times needs CreateInfo::enable_timing");
-  if (slot >= r.query_pools.size()) return argument_error("pass_times: slot out of range");
-  const uint32_t passes = r.timed_passes[slot];
-  if (passes == 0) return Status::success();
-  std::vector<uint64_t> ticks(2 * passes);
-  SIVIFLOW_TRY(vk_status(r.table.vkGetQueryPoolResults(r.table.device, r.query_pools[slot], 0, 2 * passes,
-                                                       ticks.size() * sizeof(uint64_t), ticks.data(),
-                                                       sizeof(uint64_t),
-                                                       VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-                         "vkGetQueryPoolResults"));
-  const std::vector<std::string> names = r.graph.pass_order();
-  for (uint32_t i = 0; i < passes && i < names.size(); ++i) {
-    // Differences modulo the valid bits, so a counter that wrapped still gives the right span.
-    const auto span = [&](uint64_t from, uint64_t to) {
-      return static_cast<double>((to - from) & r.timestamp_mask) * r.timestamp_period_ns;
-    };
-    const double begin_ns = span(ticks[0], ticks[2 * i]);
-    const double ns = span(ticks[2 * i], ticks[2 * i + 1]);
-    out->push_back({names[i], begin_ns * 1e-6, ns * 1e-6});
-  }
-  return Status::success();
+  if (!timer.enabled()) return argument_error("pass_times needs CreateInfo::enable_timing");
+  if (slot >= info.frames_in_flight) return argument_error("pass_times: slot out of range");
+  return timer.pass_times(table, slot, graph.pass_order(), out);
 }
 
 std::string Renderer::dump_frame_graph() const { return impl_->graph.dump_text(); }

@@ -11,6 +11,7 @@
 #include <glm/vec2.hpp>
 
 #include "entry_guard.h"
+#include "gpu_timer.h"
 #include "passes/passes.h"
 #include "siviflow/renderer.h"
 #include "shared_river.h"
@@ -64,12 +65,8 @@ struct Renderer::Impl {
   ReflectionView reflection_view{};
   TileLattice tile_lattice;  // the tile table's size and, per frame, its lattice and window
 
-  // With CreateInfo::enable_timing: per slot, two timestamps around each pass of the graph.
-  std::vector<VkQueryPool> query_pools;
-  std::vector<uint32_t> timed_passes;  // per slot: passes recorded with timestamps
+  GpuTimer timer;  // with CreateInfo::enable_timing
   uint32_t current_slot = 0;
-  float timestamp_period_ns = 1.0f;
-  uint64_t timestamp_mask = ~uint64_t{0};  // the queue's valid timestamp bits
 
   bool unusable = false;  // a resize failed half-way
   bool frame_begun = false;
@@ -92,7 +89,6 @@ struct Renderer::Impl {
   float visible_water_level();
   Status check_inputs(const FrameInputs& inputs) const;
   Status bind_frame(const FrameInputs& inputs);
-  Status create_query_pools();
   Status resize(VkExtent2D extent);
   Status pass_times(uint32_t slot, std::vector<PassTime>* out) const;
   void declare_reflection(ImageHandle* color);
