@@ -212,7 +212,7 @@ Status Renderer::Impl::create_river() {
 Status Renderer::Impl::create_view_resources() {
   SIVIFLOW_TRY(simulation.create(river->flow, info.seed, {info.extent.width, info.extent.height}));
   tile_lattice.size(river->water_lo, river->water_hi, look.tile_size_m);
-  tile_constants.heights =
+  water_frame.tiles.heights =
       glm::vec4(river->heights_origin, river->heights_spacing, look.tile_size_m);
   // Every frame's flow textures must fit a slot's staging block.
   info.staging_bytes_per_slot = std::max(info.staging_bytes_per_slot,
@@ -248,14 +248,15 @@ Status Renderer::Impl::declare_graph() {
       graph.create_persistent_image({"particle aux", kParticleAuxFormat, aux_extent, {}}), true);
   frame_uploads.buffers.clear();
   frame_uploads.images = {{0, flow_texture, flow_extent, 0}, {0, particle_aux, aux_extent, 0}};
-  add_upload_pass(graph, frame_staging, &frame_uploads);
+  uploads_data = add_upload_pass(graph, frame_staging, &frame_uploads);
 
   // reflection: the host's world mirrored about the water plane, clipped below it.
   ImageHandle reflection =
       frame_image(graph.create_image({"reflection", info.color_format, reflection_extent, transparent}));
   reflection_depth = frame_image(
       graph.create_image({"reflection depth", kReflectionDepthFormat, reflection_extent, {}}));
-  declare_reflection(&reflection);
+  reflection_data = add_reflection_pass(graph, &reflection, &reflection_depth, info.reflection,
+                                        info.reflection_user);
 
   // The host's images, in the states the host states per frame (record()); their declared
   // extent is the view's, the viewport is placed inside them when recording.
@@ -284,12 +285,12 @@ Status Renderer::Impl::declare_graph() {
   water.tile_table = frame_image(graph.create_image(
       {"tile table", FlowPass::kTileTableFormat,
        {tile_lattice.layout().width, tile_lattice.layout().height}, {}}));
-  flow_pass.declare_tiles(graph, &tile_constants, &water);
-  flow_pass.declare(graph, &flow_constants, river->index_count, &water);
+  flow_pass.declare_tiles(graph, &water);
+  flow_pass.declare(graph, river->index_count, &water);
   if (info.enable_timing) {
     const ImageHandle floor =
         frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
-    flow_pass.declare_floor(graph, &flow_constants, river->index_count, water, floor);
+    flow_pass.declare_floor(graph, river->index_count, water, floor);
   }
 
   if (info.readback_images != 0) {
@@ -311,7 +312,7 @@ Status Renderer::Impl::declare_graph() {
       readbacks.push_back({images[i], buffer, {}});
       readback_kinds.push_back(kind);
     }
-    add_readback_pass(graph, &readbacks);
+    readbacks_data = add_readback_pass(graph, &readbacks);
   }
   SIVIFLOW_TRY(graph.compile());
   SIVIFLOW_TRY(create_frame_images());
@@ -328,23 +329,6 @@ Status Renderer::Impl::declare_graph() {
       gpu_context.table->vkDestroyDescriptorPool(gpu_context.table->device, pool,
                                                  gpu_context.allocation_callbacks);
     });
-  });
-}
-
-// Cleared colour (transparent: "nothing reflected") and depth (the far value of the frame's
-// convention), then the host's callback, if any, draws its world mirrored.
-void Renderer::Impl::declare_reflection(ImageHandle* color) {
-  PassBuilder pass = graph.add_pass("reflection", PassKind::Graphics);
-  *color = pass.color_write(*color, LoadOp::Clear);
-  reflection_depth = pass.depth_write(reflection_depth, LoadOp::Clear);
-  if (info.reflection == nullptr) return;
-  const ImageHandle target = *color;
-  pass.record([this, target](const PassContext& ctx) {
-    ReflectionView mirrored = reflection_view;
-    mirrored.extent = ctx.extent(target);
-    set_viewport(ctx.table(), ctx.cmd(), mirrored.extent);
-    info.reflection(ctx.cmd(), mirrored, info.reflection_user);
-    return Status::success();
   });
 }
 
@@ -462,29 +446,29 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   reflection_view.reverse_z = view.reverse_z;
 
   const FlowTextureLayout& layout = simulation.layout();
-  flow_constants.view_proj = view.view_proj;
-  flow_constants.camera_position = glm::vec4(view.camera_position, view.depth_ratio_constant);
-  flow_constants.sun_direction = glm::vec4(glm::normalize(look.sun_direction), 0.0f);
-  flow_constants.water = glm::vec4(h, look.reflection_distortion, look.tile_size_m,
+  water_frame.flow.view_proj = view.view_proj;
+  water_frame.flow.camera_position = glm::vec4(view.camera_position, view.depth_ratio_constant);
+  water_frame.flow.sun_direction = glm::vec4(glm::normalize(look.sun_direction), 0.0f);
+  water_frame.flow.water = glm::vec4(h, look.reflection_distortion, look.tile_size_m,
                                    static_cast<float>(layout.texel_px));
   const float repeat_tiles = kTdfRepeatTiles * look.ripple_scale;
-  frame_look.water_color = glm::vec4(look.water_color, look.absorption_per_metre);
-  frame_look.deep_color = glm::vec4(look.deep_color, look.opacity_per_metre);
-  frame_look.sun_color = glm::vec4(look.sun_color, look.ripple_strength);
-  frame_look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, 0.0f, 0.0f);
+  water_frame.look.water_color = glm::vec4(look.water_color, look.absorption_per_metre);
+  water_frame.look.deep_color = glm::vec4(look.deep_color, look.opacity_per_metre);
+  water_frame.look.sun_color = glm::vec4(look.sun_color, look.ripple_strength);
+  water_frame.look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, 0.0f, 0.0f);
   // The view looks down its -Z axis: that axis's world direction is the inverse's third column.
   const glm::vec3 forward = -glm::vec3(glm::inverse(host_view.view)[2]);
   tile_lattice.place(river->water_lo, river->water_hi, look.tile_size_m, view.camera_position,
                      forward);
   const TileTableLayout& tiles = tile_lattice.layout();
-  tile_constants.heights.w = look.tile_size_m;
-  tile_constants.ripples = glm::vec4(repeat_tiles, 0.0f, 0.0f, 0.0f);
-  flow_constants.screen = glm::vec4(rect.offset.x, rect.offset.y,
+  water_frame.tiles.heights.w = look.tile_size_m;
+  water_frame.tiles.ripples = glm::vec4(repeat_tiles, 0.0f, 0.0f, 0.0f);
+  water_frame.flow.screen = glm::vec4(rect.offset.x, rect.offset.y,
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
-  tile_constants.view_proj = view.view_proj;
-  tile_constants.lattice = glm::vec4(tiles.corner_x, tiles.corner_z, tiles.width, tiles.height);
-  tile_constants.screen =
+  water_frame.tiles.view_proj = view.view_proj;
+  water_frame.tiles.lattice = glm::vec4(tiles.corner_x, tiles.corner_z, tiles.width, tiles.height);
+  water_frame.tiles.screen =
       glm::vec4(info.extent.width, info.extent.height, static_cast<float>(layout.texel_px),
                 static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
   last_time = time_seconds;
@@ -630,7 +614,16 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
     destroy_view();
     throw;
   }
-  flow_pass.set_frame(gpu, {current_slot, depth_view, view.reverse_z, viewport, frame_look});
+  water_frame.slot = current_slot;
+  water_frame.host_depth = depth_view;
+  water_frame.reverse_z = view.reverse_z;
+  water_frame.viewport = viewport;
+  flow_pass.prepare_frame(gpu, water_frame);
+  // What the passes read as they record: this frame's, through the graph's data handles.
+  b.bind_data(flow_pass.frame_data(), &water_frame);
+  b.bind_data(uploads_data, &frame_uploads);
+  b.bind_data(reflection_data, &reflection_view);
+  if (readbacks_data.valid()) b.bind_data(readbacks_data, &readbacks);
   return Status::success();
 }
 

@@ -32,7 +32,6 @@ struct Renderer::Impl {
   FrameRing ring;
   std::vector<float> particle_heights;  // this frame's live particles' heights
   WaterLook look;                    // from the next update() on (set_look)
-  gpu::WaterLookConstants frame_look{};  // of the frame being prepared
   // The river, its flow and its static GPU data, shared with the other views of it.
   std::shared_ptr<SharedRiver> river;
   RiverView simulation;  // this view's particles and flow textures, on the CPU
@@ -58,8 +57,11 @@ struct Renderer::Impl {
   std::vector<ReadbackCopy> readbacks;  // one per image CreateInfo::readback_images asks for
   std::vector<ReadbackImage> readback_kinds;  // which image each of them copies
   FrameBindings bindings;
-  gpu::FlowConstants flow_constants{};
-  gpu::FlowTileConstants tile_constants{};
+  FlowPass::Frame water_frame;  // of the frame being prepared: push constants, look, host depth
+  // Where the graph's passes read this frame's upload list, readback copies and reflection view.
+  DataHandle<UploadList> uploads_data;
+  DataHandle<std::vector<ReadbackCopy>> readbacks_data;
+  DataHandle<ReflectionView> reflection_data;
   ViewMath view;        // of the frame being prepared
   VkRect2D viewport{};  // in the host's images
   ReflectionView reflection_view{};
@@ -91,7 +93,6 @@ struct Renderer::Impl {
   Status bind_frame(const FrameInputs& inputs);
   Status resize(VkExtent2D extent);
   Status pass_times(uint32_t slot, std::vector<PassTime>* out) const;
-  void declare_reflection(ImageHandle* color);
   void retire_frame_images();
   void destroy();
 };

@@ -36,7 +36,7 @@ Status StaticAssets::create(const GpuContext& gpu) {
       uploads_.images.push_back({0, handle, extent, level});
     }
   }
-  add_upload_pass(upload_graph_, staging_handle_, &uploads_);
+  uploads_data_ = add_upload_pass(upload_graph_, staging_handle_, &uploads_);
   SIVIFLOW_TRY(upload_graph_.compile());
   for (size_t n = 0; n < images_.size(); ++n) {
     StaticImage& i = images_[n];
@@ -94,6 +94,7 @@ Status StaticAssets::record_upload(const DeviceTable& table, VkCommandBuffer cmd
     bindings.bind_image(uploads_.images[upload].destination, i.image.image, i.image.view);
     upload += i.spec.mip_offsets.size();
   }
+  bindings.bind_data(uploads_data_, &uploads_);
   return upload_graph_.execute(table, cmd, bindings);
 }
 

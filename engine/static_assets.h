@@ -86,6 +86,7 @@ class StaticAssets {
   FrameGraph upload_graph_;
   BufferHandle staging_handle_;
   UploadList uploads_;
+  DataHandle<UploadList> uploads_data_;  // where the upload graph reads uploads_
   Buffer staging_;
   bool uploaded_ = false;
 };

@@ -164,8 +164,7 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   return Status::success();
 }
 
-void FlowPass::set_frame(const GpuContext& gpu, const Frame& frame) {
-  frame_ = frame;
+void FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
   // The slot's previous frame is done (the host waited on it), so its set and its look block
   // may change; host-coherent writes are visible to the commands submitted after them.
   std::memcpy(static_cast<std::byte*>(look_buffer_.mapped) + kLookStride * frame.slot, &frame.look,
@@ -181,8 +180,7 @@ void FlowPass::set_frame(const GpuContext& gpu, const Frame& frame) {
   gpu.table->vkUpdateDescriptorSets(gpu.table->device, 1, &w, 0, nullptr);
 }
 
-void FlowPass::declare(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
-                       Handles* handles) {
+void FlowPass::declare(FrameGraph& graph, uint32_t index_count, Handles* handles) {
   PassBuilder pass = graph.add_pass("flow", PassKind::Graphics);
   handles->color = pass.color_write(handles->color, LoadOp::Load);
   if (with_aovs_) {
@@ -200,27 +198,28 @@ void FlowPass::declare(FrameGraph& graph, const gpu::FlowConstants* constants, u
   pass.vertex_read(handles->vertices);
   pass.index_read(handles->indices);
   const Handles h = *handles;
-  pass.record([this, h, constants, index_count](const PassContext& ctx) {
-    draw_river(ctx, pipeline_, h, constants, index_count);
+  pass.record([this, h, index_count](const PassContext& ctx) {
+    draw_river(ctx, pipeline_, h, index_count);
     return Status::success();
   });
 }
 
-void FlowPass::declare_tiles(FrameGraph& graph, const gpu::FlowTileConstants* constants,
-                             Handles* handles) {
+void FlowPass::declare_tiles(FrameGraph& graph, Handles* handles) {
+  frame_data_ = graph.declare_data<Frame>("water frame");
   PassBuilder pass = graph.add_pass("flow tiles", PassKind::Compute);
   handles->tile_table = pass.storage_write(handles->tile_table);  // every texel written
   pass.sampled(handles->flow, ShaderStage::Compute);
   pass.sampled(handles->water_heights, ShaderStage::Compute);
   const ImageHandle table = handles->tile_table;
-  pass.record([this, table, constants](const PassContext& ctx) {
+  const DataHandle<Frame> frame = frame_data_;
+  pass.record([this, table, frame](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
     const VkCommandBuffer cmd = ctx.cmd();
     vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tiles_pipeline_);
     vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, tiles_layout_, 0, 1,
                                &tiles_set_, 0, nullptr);
     vk.vkCmdPushConstants(cmd, tiles_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0,
-                          sizeof(gpu::FlowTileConstants), constants);
+                          sizeof(gpu::FlowTileConstants), &ctx.data(frame).tiles);
     const VkExtent2D extent = ctx.extent(table);
     vk.vkCmdDispatch(cmd, (extent.width + kTileGroupSide - 1) / kTileGroupSide,
                      (extent.height + kTileGroupSide - 1) / kTileGroupSide, 1);
@@ -228,8 +227,8 @@ void FlowPass::declare_tiles(FrameGraph& graph, const gpu::FlowTileConstants* co
   });
 }
 
-void FlowPass::declare_floor(FrameGraph& graph, const gpu::FlowConstants* constants,
-                             uint32_t index_count, const Handles& inputs, ImageHandle target) {
+void FlowPass::declare_floor(FrameGraph& graph, uint32_t index_count, const Handles& inputs,
+                             ImageHandle target) {
   PassBuilder pass = graph.add_pass("flow floor", PassKind::Graphics);
   pass.color_write(target, LoadOp::DontCare);  // its new version: nothing reads it
   pass.depth_read(inputs.depth);
@@ -243,25 +242,26 @@ void FlowPass::declare_floor(FrameGraph& graph, const gpu::FlowConstants* consta
   pass.index_read(inputs.indices);
   pass.side_effect();
   const Handles h = inputs;
-  pass.record([this, h, constants, index_count](const PassContext& ctx) {
-    draw_river(ctx, floor_pipeline_, h, constants, index_count);
+  pass.record([this, h, index_count](const PassContext& ctx) {
+    draw_river(ctx, floor_pipeline_, h, index_count);
     return Status::success();
   });
 }
 
 void FlowPass::draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h,
-                          const gpu::FlowConstants* constants, uint32_t index_count) const {
+                          uint32_t index_count) const {
   const DeviceTable& vk = ctx.table();
   const VkCommandBuffer cmd = ctx.cmd();
-  set_viewport(vk, cmd, frame_.viewport);
+  const Frame& frame = ctx.data(frame_data_);
+  set_viewport(vk, cmd, frame.viewport);
   vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1,
-                             &sets_[frame_.slot], 0, nullptr);
+                             &sets_[frame.slot], 0, nullptr);
   vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                        sizeof(gpu::FlowConstants), constants);
+                        sizeof(gpu::FlowConstants), &frame.flow);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
   // Not written, only tested: water in front of (or level with) what the host drew.
-  vk.vkCmdSetDepthCompareOp(cmd, frame_.reverse_z ? VK_COMPARE_OP_GREATER_OR_EQUAL
-                                                  : VK_COMPARE_OP_LESS_OR_EQUAL);
+  vk.vkCmdSetDepthCompareOp(cmd, frame.reverse_z ? VK_COMPARE_OP_GREATER_OR_EQUAL
+                                                 : VK_COMPARE_OP_LESS_OR_EQUAL);
   const VkBuffer vertices = ctx.buffer(h.vertices);
   const VkDeviceSize offset = 0;
   vk.vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);

@@ -9,6 +9,7 @@
 #include <vulkan/vulkan.h>
 
 #include "shared.h"
+#include "siviflow/renderer.h"
 #include "sim/status.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
@@ -44,8 +45,18 @@ struct UploadList {
 
 // Declares the pass: it writes every destination of `list` (their handles are replaced by the
 // written versions; the levels of one image must be listed one after another) from the
-// imported staging buffer. `list` is read again when the pass records.
-void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list);
+// imported staging buffer. Each execute binds the frame's list (those destinations, this frame's
+// staging offsets) to the returned handle.
+DataHandle<UploadList> add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list);
+
+// ---- reflection: the host's world mirrored about the water plane ----
+
+// Declares the reflection target's pass: colour cleared to transparent ("nothing reflected"),
+// depth cleared to the far value the frame sets (FrameBindings::set_clear), then `callback` (if
+// any) draws the host's world as each execute's bound ReflectionView says (its extent filled in).
+DataHandle<ReflectionView> add_reflection_pass(FrameGraph& graph, ImageHandle* color,
+                                               ImageHandle* depth, ReflectionCallback callback,
+                                               void* user);
 
 // ---- flow: the water material of Algorithm 3, drawn over the scene ----
 
@@ -83,17 +94,23 @@ class FlowPass {
   Status bind_textures(const GpuContext& gpu, const Textures& textures,
                        const std::function<void(VkDescriptorPool)>& retire);
 
-  // What the next recording of the passes draws with: the frame slot (whose previous frame the
-  // host has waited for), a view of the host depth's depth aspect, the depth convention, the
-  // viewport in the host's images and the water's look.
+  // What a frame draws with: the frame slot (whose previous frame the host has waited for), a
+  // view of the host depth's depth aspect, the depth convention, the viewport in the host's
+  // images, the water's look and the passes' push constants.
   struct Frame {
     uint32_t slot = 0;
     VkImageView host_depth = VK_NULL_HANDLE;
     bool reverse_z = false;
     VkRect2D viewport{};
     gpu::WaterLookConstants look{};
+    gpu::FlowConstants flow{};
+    gpu::FlowTileConstants tiles{};
   };
-  void set_frame(const GpuContext& gpu, const Frame& frame);
+  // Before recording a frame: points the slot's descriptor set at the frame's host depth and
+  // writes its look block.
+  void prepare_frame(const GpuContext& gpu, const Frame& frame);
+  // Where the declared passes read the frame when the graph executes (bind it every execute).
+  DataHandle<Frame> frame_data() const { return frame_data_; }
 
   struct Handles {
     ImageHandle color;       // the host's colour: loaded, blended over
@@ -112,22 +129,21 @@ class FlowPass {
   };
   // The tile table of this frame (shaders/flow_tiles.comp), before declare; the new version of
   // handles->tile_table goes back into `handles`.
-  void declare_tiles(FrameGraph& graph, const gpu::FlowTileConstants* constants, Handles* handles);
-  void declare(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
-               Handles* handles);
+  void declare_tiles(FrameGraph& graph, Handles* handles);
+  void declare(FrameGraph& graph, uint32_t index_count, Handles* handles);
   // The floor of the flow pass for benchmarks: the same pixels (river mesh, depth test) making
   // the same texture reads with next to no arithmetic, blended into `target` (of the colour
   // format); kept although nothing reads it.
-  void declare_floor(FrameGraph& graph, const gpu::FlowConstants* constants, uint32_t index_count,
-                     const Handles& inputs, ImageHandle target);
+  void declare_floor(FrameGraph& graph, uint32_t index_count, const Handles& inputs,
+                     ImageHandle target);
 
  private:
   void draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h,
-                  const gpu::FlowConstants* constants, uint32_t index_count) const;
+                  uint32_t index_count) const;
 
   bool with_aovs_ = false;
   uint32_t slot_count_ = 1;
-  Frame frame_;
+  DataHandle<Frame> frame_data_;  // declared by declare_tiles, in the graph of the passes
   VkPipeline floor_pipeline_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
@@ -152,7 +168,9 @@ struct ReadbackCopy {
   BufferHandle buffer;  // imported, handed back in the HostRead state; replaced by the written version
   VkRect2D region{};    // the part copied, read when the pass records; 0x0: the whole image
 };
-// `copies` is read again when the pass records.
-void add_readback_pass(FrameGraph& graph, std::vector<ReadbackCopy>* copies);
+// Declares the copies (their buffers replaced by the written versions); each execute binds the
+// frame's copies (the same, with this frame's regions) to the returned handle.
+DataHandle<std::vector<ReadbackCopy>> add_readback_pass(FrameGraph& graph,
+                                                        std::vector<ReadbackCopy>* copies);
 
 }  // namespace siviflow

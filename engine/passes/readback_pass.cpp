@@ -4,16 +4,18 @@
 
 namespace siviflow {
 
-void add_readback_pass(FrameGraph& graph, std::vector<ReadbackCopy>* copies) {
+DataHandle<std::vector<ReadbackCopy>> add_readback_pass(FrameGraph& graph,
+                                                        std::vector<ReadbackCopy>* copies) {
+  const auto frame_copies = graph.declare_data<std::vector<ReadbackCopy>>("readback copies");
   PassBuilder pass = graph.add_pass("readback", PassKind::Transfer);
   for (ReadbackCopy& copy : *copies) {
     pass.transfer_read(copy.image);
     copy.buffer = pass.transfer_write(copy.buffer);
   }
   pass.side_effect();
-  pass.record([copies](const PassContext& ctx) {
+  pass.record([frame_copies](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
-    for (const ReadbackCopy& copy : *copies) {
+    for (const ReadbackCopy& copy : ctx.data(frame_copies)) {
       const bool whole = copy.region.extent.width == 0 || copy.region.extent.height == 0;
       const VkExtent2D extent = whole ? ctx.extent(copy.image) : copy.region.extent;
       VkBufferImageCopy region{};
@@ -31,6 +33,7 @@ void add_readback_pass(FrameGraph& graph, std::vector<ReadbackCopy>* copies) {
     }
     return Status::success();
   });
+  return frame_copies;
 }
 
 }  // namespace siviflow

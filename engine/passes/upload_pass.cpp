@@ -4,7 +4,8 @@
 
 namespace siviflow {
 
-void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list) {
+DataHandle<UploadList> add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list) {
+  const DataHandle<UploadList> frame_list = graph.declare_data<UploadList>("upload list");
   PassBuilder pass = graph.add_pass("upload", PassKind::Transfer);
   pass.transfer_read(staging);
   for (BufferUpload& upload : list->buffers) upload.destination = pass.transfer_write(upload.destination);
@@ -19,16 +20,17 @@ void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list) 
     }
   }
   // Lookups in the pass context go by resource, so the written versions name the same images.
-  pass.record([list, staging](const PassContext& ctx) {
+  pass.record([frame_list, staging](const PassContext& ctx) {
     const DeviceTable& vk = ctx.table();
     const VkBuffer source = ctx.buffer(staging);
     const VkDeviceSize source_base = ctx.offset(staging);
-    for (const BufferUpload& upload : list->buffers) {
+    const UploadList& uploads = ctx.data(frame_list);
+    for (const BufferUpload& upload : uploads.buffers) {
       const BufferHandle target = upload.destination;
       VkBufferCopy region{source_base + upload.staging_offset, ctx.offset(target), upload.size};
       vk.vkCmdCopyBuffer(ctx.cmd(), source, ctx.buffer(target), 1, &region);
     }
-    for (const ImageUpload& upload : list->images) {
+    for (const ImageUpload& upload : uploads.images) {
       const ImageHandle target = upload.destination;
       VkBufferImageCopy region{};
       region.bufferOffset = source_base + upload.staging_offset;
@@ -38,6 +40,7 @@ void add_upload_pass(FrameGraph& graph, BufferHandle staging, UploadList* list) 
     }
     return Status::success();
   });
+  return frame_list;
 }
 
 }  // namespace siviflow

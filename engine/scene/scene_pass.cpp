@@ -82,9 +82,10 @@ Status ScenePass::set_textures(const GpuContext& gpu, VkImageView detail,
   return Status::success();
 }
 
-void ScenePass::declare(FrameGraph& graph, const char* pass_name,
-                        const std::vector<SceneDraw>* draws, const Frame* frame,
-                        Handles* handles) {
+ScenePass::FrameData ScenePass::declare(FrameGraph& graph, const char* pass_name,
+                                        Handles* handles) {
+  const FrameData data{graph.declare_data<std::vector<SceneDraw>>("world draws"),
+                       graph.declare_data<Frame>("world view")};
   PassBuilder pass = graph.add_pass(pass_name, PassKind::Graphics);
   handles->color = pass.color_write(handles->color, LoadOp::Clear);
   handles->depth = pass.depth_write(handles->depth, LoadOp::Clear);
@@ -93,12 +94,14 @@ void ScenePass::declare(FrameGraph& graph, const char* pass_name,
   pass.sampled_fragment(handles->detail);
   for (ImageHandle base_color : handles->base_colors) pass.sampled_fragment(base_color);
   const Handles h = *handles;
-  pass.record([this, h, draws, frame](const PassContext& ctx) {
-    set_viewport(ctx.table(), ctx.cmd(), frame->viewport);
-    draw(ctx.table(), ctx.cmd(), ctx.buffer(h.vertices), ctx.buffer(h.indices), *draws,
-         frame->reverse_z);
+  pass.record([this, h, data](const PassContext& ctx) {
+    const Frame& frame = ctx.data(data.view);
+    set_viewport(ctx.table(), ctx.cmd(), frame.viewport);
+    draw(ctx.table(), ctx.cmd(), ctx.buffer(h.vertices), ctx.buffer(h.indices),
+         ctx.data(data.draws), frame.reverse_z);
     return Status::success();
   });
+  return data;
 }
 
 void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices,

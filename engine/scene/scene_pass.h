@@ -49,11 +49,14 @@ class ScenePass {
     bool reverse_z = false;
     VkRect2D viewport{};
   };
-  // Declares a pass clearing colour and depth, then drawing the scene's `draws` and the sky;
-  // the new versions of colour and depth go back into `handles`. `draws` and `frame` are read
-  // when the pass records.
-  void declare(FrameGraph& graph, const char* pass_name, const std::vector<SceneDraw>* draws,
-               const Frame* frame, Handles* handles);
+  // What each execute binds: the frame's draws and view.
+  struct FrameData {
+    DataHandle<std::vector<SceneDraw>> draws;
+    DataHandle<Frame> view;
+  };
+  // Declares a pass clearing colour and depth, then drawing the frame's draws and the sky; the
+  // new versions of colour and depth go back into `handles`.
+  FrameData declare(FrameGraph& graph, const char* pass_name, Handles* handles);
   // Records `draws` then the sky into the rendering begun by the caller (viewport set).
   void draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices, VkBuffer indices,
             const std::vector<SceneDraw>& draws, bool reverse_z) const;

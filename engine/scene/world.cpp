@@ -82,6 +82,7 @@ struct World::Impl {
   std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main, then mirrored
   double time = 0.0;  // of the last record(), for the reflection
   ScenePass::Frame frame;  // the main view's depth convention and viewport
+  ScenePass::FrameData frame_data;  // where `graph` reads the draws and `frame`
 
   FrameGraph graph;
   ImageHandle color;
@@ -198,7 +199,7 @@ Status World::Impl::declare_graph() {
   for (uint32_t n = kFirstBaseColor; n < assets.image_count(); ++n) {
     handles.base_colors.push_back(asset_handles.images[n]);
   }
-  main_pass.declare(graph, "world", &main_draws, &frame, &handles);
+  frame_data = main_pass.declare(graph, "world", &handles);
   return graph.compile();
 }
 
@@ -346,6 +347,8 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
   if (w.frame.viewport.extent.width == 0 && w.frame.viewport.extent.height == 0) {
     w.frame.viewport.extent = host_color.extent;
   }
+  b.bind_data(w.frame_data.draws, &w.main_draws);
+  b.bind_data(w.frame_data.view, &w.frame);
   b.set_render_area(w.color, w.frame.viewport);  // the view's part only: cleared, then drawn
   VkClearValue far{};
   far.depthStencil = {far_depth(math.reverse_z), 0};

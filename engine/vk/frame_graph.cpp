@@ -700,6 +700,11 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
   const Barriers* barriers = barriers_for(bindings, &state_status);
   if (barriers == nullptr) return state_status;
 
+  for (uint32_t id = 0; id < data_names_.size(); ++id) {
+    if (bindings.find_data(id) == nullptr) {
+      return Status::error("frame graph: the frame's '" + data_names_[id] + "' is not bound");
+    }
+  }
   // Every handle is checked before the first command, so a binding error records nothing.
   auto check_bound = [&](uint32_t id, const Pass* pass, bool need_view) -> Status {
     const Resource& r = resources_[id];

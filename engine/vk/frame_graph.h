@@ -40,6 +40,10 @@
 //   execute's; with the same states every frame (or none), it neither derives nor allocates.
 // - execute() records into the caller's command buffer, outside any render pass; it never
 //   submits or waits. If it returns an error after recording started, discard the buffer.
+// - Per-frame data a callback reads (push constants, the host's view, this frame's copies) is
+//   declared like a resource (declare_data) and bound per execute (FrameBindings::bind_data):
+//   callbacks read it through PassContext::data, never through pointers captured at declaration.
+//   execute() refuses to record when a declared datum is not bound, naming it.
 // - Not thread-safe; handles and PassBuilders must not outlive (or be moved away from) their
 //   graph. Record callbacks run inside execute() and should capture handles by value.
 #pragma once
@@ -83,6 +87,13 @@ struct BufferHandle {
   bool operator==(const BufferHandle&) const = default;
 };
 
+// Per-frame data of type T that passes read when they record.
+template <typename T>
+struct DataHandle {
+  uint32_t id = kNoResource;
+  bool valid() const { return id != kNoResource; }
+};
+
 struct ImageDesc {
   std::string name;
   VkFormat format = VK_FORMAT_UNDEFINED;
@@ -112,7 +123,16 @@ class FrameBindings {
   // The part of an imported image that passes drawing into it render (and clear) this execute,
   // when it is not the declared extent: one view in a host's image that holds several.
   void set_render_area(ImageHandle image, VkRect2D area);
-  void reset() { bound_.clear(); }
+  // This execute's value of a declared datum (it must outlive the execute).
+  template <typename T>
+  void bind_data(DataHandle<T> handle, const T* data) {
+    if (handle.id >= data_.size()) data_.resize(handle.id + 1, nullptr);
+    data_[handle.id] = data;
+  }
+  void reset() {
+    bound_.clear();
+    data_.clear();
+  }
 
  private:
   friend class FrameGraph;
@@ -129,7 +149,9 @@ class FrameBindings {
   };
   Bound& slot(uint32_t id);
   const Bound* find(uint32_t id) const { return id < bound_.size() ? &bound_[id] : nullptr; }
+  const void* find_data(uint32_t id) const { return id < data_.size() ? data_[id] : nullptr; }
   std::vector<Bound> bound_;
+  std::vector<const void*> data_;  // by DataHandle id
 };
 
 class FrameGraph;
@@ -147,6 +169,11 @@ class PassContext {
   VkBuffer buffer(BufferHandle buffer) const;
   VkDeviceSize offset(BufferHandle buffer) const;
   VkDeviceSize size(BufferHandle buffer) const;
+  // This execute's value of a declared datum (execute() checked that it is bound).
+  template <typename T>
+  const T& data(DataHandle<T> handle) const {
+    return *static_cast<const T*>(bindings_->find_data(handle.id));
+  }
 
  private:
   friend class FrameGraph;
@@ -213,6 +240,12 @@ class FrameGraph {
                              std::optional<ResourceState> outgoing = std::nullopt);
 
   PassBuilder add_pass(std::string name, PassKind kind);
+  // Per-frame data, bound per execute by FrameBindings::bind_data.
+  template <typename T>
+  DataHandle<T> declare_data(std::string name) {
+    data_names_.push_back(std::move(name));
+    return {static_cast<uint32_t>(data_names_.size() - 1)};
+  }
 
   // Pure CPU, no device. Steps: validate, cull, order, usage flags, attachments, barriers.
   Status compile();
@@ -243,6 +276,7 @@ class FrameGraph {
   std::string dump_graphviz() const;
 
  private:
+  std::vector<std::string> data_names_;  // by DataHandle id
   friend class PassBuilder;
   friend class PassContext;
   enum class Origin : uint8_t { Transient, Persistent, Imported };

@@ -550,6 +550,38 @@ TEST(FrameGraphExecute, PerExecuteStatesOverrideTheImportAndCallbackErrorsPropag
   EXPECT_EQ(status.message(), "frame graph: pass 'flow': no pipeline");
 }
 
+TEST(FrameGraphExecute, CallbacksReadTheFramesDataAndUnboundDataIsRefusedByName) {
+  std::vector<std::string> calls;
+  g_calls = &calls;
+  FrameGraph graph;
+  const ResourceState host_sampled = state_of(Access::SampledFragment);
+  const ImageHandle out = graph.import_image({"host_out", VK_FORMAT_B8G8R8A8_UNORM, kExtent, {}},
+                                             host_sampled, host_sampled);
+  const DataHandle<int> level = graph.declare_data<int>("water level");
+  PassBuilder flow = graph.add_pass("flow", PassKind::Graphics);
+  flow.color_write(out);
+  flow.record([level](const PassContext& ctx) {
+    g_calls->push_back("level " + std::to_string(ctx.data(level)));
+    return Status::success();
+  });
+  ASSERT_TRUE(graph.compile().ok());
+  FrameBindings bindings;
+  bindings.bind_image(out, fake_handle<VkImage>(0x50), fake_handle<VkImageView>(0x51));
+  const Status unbound = graph.execute(fake_table(false), fake_handle<VkCommandBuffer>(0x1), bindings);
+  ASSERT_FALSE(unbound.ok());
+  EXPECT_EQ(unbound.message(), "frame graph: the frame's 'water level' is not bound");
+  EXPECT_TRUE(calls.empty()) << "nothing recorded";
+  for (const int frame_level : {3, 7}) {  // each execute reads what it is given
+    bindings.bind_data(level, &frame_level);
+    ASSERT_TRUE(graph.execute(fake_table(false), fake_handle<VkCommandBuffer>(0x1), bindings).ok());
+  }
+  std::vector<std::string> levels;
+  for (const std::string& call : calls) {
+    if (call.rfind("level ", 0) == 0) levels.push_back(call);
+  }
+  EXPECT_EQ(levels, (std::vector<std::string>{"level 3", "level 7"}));
+}
+
 // One line per image or buffer barrier, with the image's handle value and the full states.
 VKAPI_ATTR void VKAPI_CALL detail_barrier(VkCommandBuffer, const VkDependencyInfo* dependency) {
   for (uint32_t i = 0; i < dependency->imageMemoryBarrierCount; ++i) {
