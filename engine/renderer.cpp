@@ -1,20 +1,15 @@
 #include "siviflow/renderer.h"
 
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <cmath>
 #include <cstring>
-#include <limits>
-#include <optional>
 #include <string>
-#include <string_view>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "default_river.h"
 #include "renderer_impl.h"
 #include "renderer_inspect.h"
-#include "default_river.h"
 #include "sim/text_format.h"
 #include "vk/pipeline.h"
 
@@ -25,32 +20,9 @@ constexpr uint32_t kDefaultFramesInFlight = 2;
 constexpr uint32_t kMaxFramesInFlight = 8;
 constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDefaultDepthFormat = VK_FORMAT_D32_SFLOAT;
-constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkDeviceSize kDefaultStagingBytes = 8ull << 20;
-constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we copy
-// Layouts documented in shaders/shared.h.
-constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
-constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
-constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
-
 constexpr float kTdfRepeatTiles = 3.5f;  // normal-map repeat in tiles at ripple scale 1 (van Hoesel 35/10)
 constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
-
-uint32_t texel_bytes(VkFormat format) {
-  switch (format) {
-    case VK_FORMAT_R8G8B8A8_UNORM:
-    case VK_FORMAT_R8G8B8A8_SRGB:
-    case VK_FORMAT_B8G8R8A8_UNORM:
-    case VK_FORMAT_B8G8R8A8_SRGB:
-      return 4;
-    case VK_FORMAT_R16G16B16A16_SFLOAT:
-      return 8;
-    case VK_FORMAT_R32G32B32A32_SFLOAT:
-      return 16;
-    default:
-      return 0;
-  }
-}
 
 bool is_host_depth_format(VkFormat format) {
   return format == VK_FORMAT_D32_SFLOAT || format == VK_FORMAT_D24_UNORM_S8_UINT ||
@@ -221,142 +193,6 @@ Status Renderer::Impl::create_view_resources() {
   return flow_pass.create(gpu, info.pipeline_cache, info.color_format, info.depth_format,
                           info.frames_in_flight, (info.readback_images & kAovReadbackImages) != 0,
                           info.enable_timing);
-}
-
-ImageHandle Renderer::Impl::frame_image(ImageHandle handle, bool persistent) {
-  frame_images.push_back({handle, Image{}, persistent});
-  return handle;
-}
-
-Status Renderer::Impl::declare_graph() {
-  const VkExtent2D extent = info.extent;
-  const VkExtent2D reflection_extent{
-      std::max(1u, static_cast<uint32_t>(std::lround(extent.width * kDefaultReflectionScale))),
-      std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
-  frame_images.clear();
-  river_assets = river->assets.import_into(graph);
-  VkClearValue transparent{};
-
-  // upload: this frame's flow texture and particle aux data, through the slot's staging block.
-  const FlowTextureLayout& layout = simulation.layout();
-  const VkExtent2D flow_extent{layout.flow_extent.x, layout.flow_extent.y};
-  const VkExtent2D aux_extent{layout.aux_extent.x, layout.aux_extent.y};
-  frame_staging = graph.import_buffer({"frame staging", 0}, ResourceState{});
-  const ImageHandle flow_texture = frame_image(
-      graph.create_persistent_image({"flow texture", kFlowTextureFormat, flow_extent, {}}), true);
-  const ImageHandle particle_aux = frame_image(
-      graph.create_persistent_image({"particle aux", kParticleAuxFormat, aux_extent, {}}), true);
-  frame_uploads.buffers.clear();
-  frame_uploads.images = {{0, flow_texture, flow_extent, 0}, {0, particle_aux, aux_extent, 0}};
-  uploads_data = add_upload_pass(graph, frame_staging, &frame_uploads);
-
-  // reflection: the host's world mirrored about the water plane, clipped below it.
-  ImageHandle reflection =
-      frame_image(graph.create_image({"reflection", info.color_format, reflection_extent, transparent}));
-  reflection_depth = frame_image(
-      graph.create_image({"reflection depth", kReflectionDepthFormat, reflection_extent, {}}));
-  reflection_data = add_reflection_pass(graph, &reflection, &reflection_depth, info.reflection,
-                                        info.reflection_user);
-
-  // The host's images, in the states the host states per frame (record()); their declared
-  // extent is the view's, the viewport is placed inside them when recording.
-  host_color = graph.import_image({"host colour", info.color_format, extent, {}}, ResourceState{},
-                                  state_of(Access::SampledFragment));
-  host_depth = graph.import_image({"host depth", info.depth_format, extent, {}}, ResourceState{},
-                                  state_of(Access::DepthAttachmentRead));
-
-  // flow: the water material over the host's colour.
-  FlowPass::Handles water;
-  water.color = host_color;
-  water.depth = host_depth;
-  water.flow = frame_uploads.images[0].destination;
-  water.aux = frame_uploads.images[1].destination;
-  water.reflection = reflection;
-  water.normal_map = river_assets.images[SharedRiver::kNormalMap];
-  water.vertices = river_assets.buffers[SharedRiver::kRiverVertices];
-  water.indices = river_assets.buffers[SharedRiver::kRiverIndices];
-  if ((info.readback_images & kAovReadbackImages) != 0) {
-    water.mask = frame_image(graph.create_image({"water mask", FlowPass::kMaskFormat, extent, transparent}));
-    water.normal = frame_image(graph.create_image({"water normal", FlowPass::kNormalFormat, extent, transparent}));
-    water.reflection_sample = frame_image(
-        graph.create_image({"reflection sample", FlowPass::kReflectionFormat, extent, transparent}));
-  }
-  water.water_heights = river_assets.images[SharedRiver::kWaterHeights];
-  water.tile_table = frame_image(graph.create_image(
-      {"tile table", FlowPass::kTileTableFormat,
-       {tile_lattice.layout().width, tile_lattice.layout().height}, {}}));
-  flow_pass.declare_tiles(graph, &water);
-  flow_pass.declare(graph, river->index_count, &water);
-  if (info.enable_timing) {
-    const ImageHandle floor =
-        frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
-    flow_pass.declare_floor(graph, river->index_count, water, floor);
-  }
-
-  if (info.readback_images != 0) {
-    const ImageHandle images[kReadbackImageCount] = {water.color,
-                                                     host_depth,
-                                                     water.mask,
-                                                     frame_uploads.images[0].destination,
-                                                     frame_uploads.images[1].destination,
-                                                     water.normal,
-                                                     water.reflection_sample,
-                                                     water.tile_table};
-    readbacks.clear();
-    readback_kinds.clear();
-    for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
-      const auto kind = static_cast<ReadbackImage>(i);
-      if ((info.readback_images & readback_bit(kind)) == 0) continue;
-      const BufferHandle buffer = graph.import_buffer({readback_image_name(kind), 0},
-                                                      ResourceState{}, state_of(Access::HostRead));
-      readbacks.push_back({images[i], buffer, {}});
-      readback_kinds.push_back(kind);
-    }
-    readbacks_data = add_readback_pass(graph, &readbacks);
-  }
-  SIVIFLOW_TRY(graph.compile());
-  SIVIFLOW_TRY(create_frame_images());
-
-  FlowPass::Textures textures;
-  textures.flow = find_frame_image(flow_texture)->view;
-  textures.aux = find_frame_image(particle_aux)->view;
-  textures.reflection = find_frame_image(reflection)->view;
-  textures.normal_map = river->assets.image(SharedRiver::kNormalMap).view;
-  textures.tile_table = find_frame_image(water.tile_table)->view;
-  textures.water_heights = river->assets.image(SharedRiver::kWaterHeights).view;
-  return flow_pass.bind_textures(gpu, textures, [this](VkDescriptorPool pool) {
-    ring.defer_deletion_until_all_slots([gpu_context = gpu, pool] {
-      gpu_context.table->vkDestroyDescriptorPool(gpu_context.table->device, pool,
-                                                 gpu_context.allocation_callbacks);
-    });
-  });
-}
-
-Status Renderer::Impl::create_frame_images() {
-  for (FrameImage& f : frame_images) {
-    const ImageDesc* desc = graph.image_desc(f.handle);
-    const VkImageUsageFlags usage = graph.image_usage(f.handle);
-    if (usage == 0) continue;  // no surviving pass uses it
-    SIVIFLOW_TRY(create_image(gpu, desc->format, desc->extent, usage, desc->name.c_str(), &f.image));
-  }
-  frame_images_new = true;
-  return Status::success();
-}
-
-const Image* Renderer::Impl::find_frame_image(ImageHandle handle) const {
-  for (const FrameImage& f : frame_images) {
-    if (f.handle.id == handle.id) return &f.image;
-  }
-  return nullptr;
-}
-
-void Renderer::Impl::retire_frame_images() {
-  // Frames of any slot still in flight may use them: free them once every slot came round.
-  for (FrameImage& f : frame_images) {
-    ring.defer_deletion_until_all_slots(
-        [gpu_context = gpu, retired = f.image]() mutable { destroy_image(gpu_context, &retired); });
-  }
-  frame_images.clear();
 }
 
 void Renderer::Impl::destroy() {
@@ -561,72 +397,6 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
   return Status::success();
 }
 
-// Binds this frame's resources: the static assets, the frame images, the host's images with
-// their states, a view of the host depth's depth aspect for sampling, the readback buffers.
-Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
-  FrameBindings& b = bindings;
-  b.reset();
-  river->assets.bind(b, river_assets);
-  for (const FrameImage& f : frame_images) {
-    b.bind_image(f.handle, f.image.image, f.image.view);
-    // Persistent images start without contents (only the upload writes them, whole).
-    if (frame_images_new && f.persistent) b.set_incoming(f.handle, ResourceState{});
-  }
-  VkClearValue far{};
-  far.depthStencil = {far_depth(view.reverse_z), 0};
-  b.set_clear(reflection_depth, far);
-  const auto bind_host = [&b](ImageHandle handle, const ExternalImage& image) {
-    b.bind_image(handle, image.image, image.view);
-    b.set_incoming(handle, {image.current.stage, image.current.access, image.current.layout});
-    b.set_outgoing(handle, {image.final.stage, image.final.access, image.final.layout});
-  };
-  bind_host(host_color, inputs.color);
-  bind_host(host_depth, inputs.depth);
-  // The water renders over the view's part of the host's images only.
-  b.set_render_area(host_color, viewport);
-  b.bind_buffer(frame_staging, ring.staging_buffer());
-  for (size_t i = 0; i < readbacks.size(); ++i) {
-    const ReadbackImage kind = readback_kinds[i];
-    b.bind_buffer(readbacks[i].buffer, inputs.readback.buffers[static_cast<uint32_t>(kind)]);
-    // The host's images are read back over the view's viewport only.
-    const bool host_image = kind == ReadbackImage::kColor || kind == ReadbackImage::kDepth;
-    readbacks[i].region = host_image ? viewport : VkRect2D{};
-  }
-
-  // The host's view may cover stencil too: the material samples depth alone, through a view of
-  // its own, freed when this slot comes round again.
-  VkImageViewCreateInfo view_info{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-  view_info.image = inputs.depth.image;
-  view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
-  view_info.format = info.depth_format;
-  view_info.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
-  VkImageView depth_view = VK_NULL_HANDLE;
-  SIVIFLOW_TRY(vk_status(
-      table.vkCreateImageView(table.device, &view_info, gpu.allocation_callbacks, &depth_view),
-      "vkCreateImageView (host depth)"));
-  const auto destroy_view = [gpu_context = gpu, depth_view] {
-    gpu_context.table->vkDestroyImageView(gpu_context.table->device, depth_view,
-                                          gpu_context.allocation_callbacks);
-  };
-  try {
-    ring.defer_deletion(destroy_view);
-  } catch (...) {  // not queued: nothing has used the view yet
-    destroy_view();
-    throw;
-  }
-  water_frame.slot = current_slot;
-  water_frame.host_depth = depth_view;
-  water_frame.reverse_z = view.reverse_z;
-  water_frame.viewport = viewport;
-  flow_pass.prepare_frame(gpu, water_frame);
-  // What the passes read as they record: this frame's, through the graph's data handles.
-  b.bind_data(flow_pass.frame_data(), &water_frame);
-  b.bind_data(uploads_data, &frame_uploads);
-  b.bind_data(reflection_data, &reflection_view);
-  if (readbacks_data.valid()) b.bind_data(readbacks_data, &readbacks);
-  return Status::success();
-}
-
 Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   Impl& r = *impl_;
   return guarded(r.info, [&]() -> Status {
@@ -683,50 +453,6 @@ Status Renderer::Impl::resize(VkExtent2D extent) {
   }
   r.unusable = !status.ok();
   return status;
-}
-
-VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
-  const VkDeviceSize pixels = VkDeviceSize{impl_->info.extent.width} * impl_->info.extent.height;
-  switch (image) {
-    case ReadbackImage::kColor:
-      return pixels * texel_bytes(impl_->info.color_format);
-    case ReadbackImage::kDepth:
-    case ReadbackImage::kWaterMask:
-      return pixels * sizeof(float);
-    case ReadbackImage::kFlowTexture:
-      return impl_->simulation.layout().flow_bytes;
-    case ReadbackImage::kParticleAux:
-      return impl_->simulation.layout().aux_bytes;
-    case ReadbackImage::kNormal:
-    case ReadbackImage::kReflection:
-      return pixels * 4 * sizeof(float);
-    case ReadbackImage::kTileTable:
-      return VkDeviceSize{impl_->tile_lattice.layout().width} * impl_->tile_lattice.layout().height * 4 *
-             sizeof(uint32_t);
-  }
-  return 0;
-}
-
-const char* readback_image_name(ReadbackImage image) {
-  switch (image) {
-    case ReadbackImage::kColor:
-      return "readback colour";
-    case ReadbackImage::kDepth:
-      return "readback depth";
-    case ReadbackImage::kWaterMask:
-      return "readback water mask";
-    case ReadbackImage::kFlowTexture:
-      return "readback flow texture";
-    case ReadbackImage::kParticleAux:
-      return "readback particle aux";
-    case ReadbackImage::kNormal:
-      return "readback water normal";
-    case ReadbackImage::kReflection:
-      return "readback reflection sample";
-    case ReadbackImage::kTileTable:
-      return "readback tile table";
-  }
-  return "readback";
 }
 
 const TileTableLayout& Renderer::tile_table_layout() const { return impl_->tile_lattice.layout(); }

@@ -100,6 +100,10 @@ struct Renderer::Impl {
 // An error in what the caller passed: no Vulkan result stands behind it.
 Status argument_error(const std::string& message);
 
+// Bytes per texel of a host colour format we take (RGBA8, RGBA16F, RGBA32F); 0 for any other.
+uint32_t texel_bytes(VkFormat format);
+inline constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we copy
+
 inline constexpr std::string_view kRendererErrorPrefix = "siviflow::Renderer: ";
 
 // A public entry point's body, guarded (entry_guard.h) with the renderer's prefix and log.
