@@ -18,9 +18,10 @@ Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFo
   HostImage depth;
   SIVIFLOW_TRY(context.create_target_image(color_format, extent, &color));
   SIVIFLOW_TRY(context.create_depth_image(depth_format, extent, &depth));
-  out->color = {color.image, color.view, color_format, extent, ImageState{}, color_final};
+  out->color = {color.image, color.view, color_format, extent, ImageState{}, color_final,
+                color.usage};
   out->depth = {depth.image, depth.view, depth_format, extent, ImageState{},
-                image_state(Access::DepthAttachmentRead, depth_format)};
+                image_state(Access::DepthAttachmentRead, depth_format), depth.usage};
   return Status::success();
 }
 

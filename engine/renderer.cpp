@@ -357,8 +357,10 @@ Status Renderer::update(const View& view, double time_seconds) {
 // The host's word on an image against the configuration: an error names the image and the
 // value, before any command is recorded.
 Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
-  const auto check = [this](const ExternalImage& image, const char* name, VkFormat format) {
+  const auto check = [this](const ExternalImage& image, const char* name, VkFormat format,
+                            VkImageUsageFlags needs, ReadbackImage copy) {
     const std::string field = std::string("FrameInputs::") + name;
+    if ((info.readback_images & readback_bit(copy)) != 0) needs |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     if (image.image == VK_NULL_HANDLE || image.view == VK_NULL_HANDLE) {
       return argument_error(field + " needs an image and a view");
     }
@@ -378,6 +380,11 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
                             std::to_string(viewport.offset.y) + ") + " +
                             extent_text(viewport.extent));
     }
+    if ((image.usage & needs) != needs) {
+      return argument_error(field + ".usage " + text_format("0x%x", image.usage) + " lacks " +
+                            text_format("0x%x", needs & ~image.usage) +
+                            " (VkImageUsageFlagBits the water needs of it)");
+    }
     return Status::success();
   };
   // The AOV attachments are the view's size: they cannot sit at an offset in the host's images.
@@ -386,8 +393,11 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
     return argument_error("with the water mask, normal or reflection read back, View::viewport "
                           "must start at the images' origin");
   }
-  SIVIFLOW_TRY(check(inputs.color, "color", info.color_format));
-  SIVIFLOW_TRY(check(inputs.depth, "depth", info.depth_format));
+  SIVIFLOW_TRY(check(inputs.color, "color", info.color_format,
+                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, ReadbackImage::kColor));
+  SIVIFLOW_TRY(check(inputs.depth, "depth", info.depth_format,
+                     VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                     ReadbackImage::kDepth));
   for (const ReadbackImage kind : readback_kinds) {
     if (inputs.readback.buffers[static_cast<uint32_t>(kind)] == VK_NULL_HANDLE) {
       return argument_error(std::string("CreateInfo::readback_images asks for the ") +

@@ -503,23 +503,21 @@ Status HeadlessContext::wait_idle() {
 
 Status HeadlessContext::create_target_image(VkFormat format, VkExtent2D extent, HostImage* out) {
   Image image;
-  SIVIFLOW_TRY(create_image(impl_->gpu, format, extent,
-                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                                VK_IMAGE_USAGE_SAMPLED_BIT,
-                            "host target", &image));
+  const VkImageUsageFlags usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+                                  VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+  SIVIFLOW_TRY(create_image(impl_->gpu, format, extent, usage, "host target", &image));
   impl_->host_images.push_back(image);
-  *out = HostImage{image.image, image.view};
+  *out = HostImage{image.image, image.view, usage};
   return Status::success();
 }
 
 Status HeadlessContext::create_depth_image(VkFormat format, VkExtent2D extent, HostImage* out) {
   Image image;
-  SIVIFLOW_TRY(create_image(impl_->gpu, format, extent,
-                            VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
-                                VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
-                            "host depth", &image));
+  const VkImageUsageFlags usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                                  VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+  SIVIFLOW_TRY(create_image(impl_->gpu, format, extent, usage, "host depth", &image));
   impl_->host_images.push_back(image);
-  *out = HostImage{image.image, image.view};
+  *out = HostImage{image.image, image.view, usage};
   return Status::success();
 }
 

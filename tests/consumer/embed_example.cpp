@@ -19,6 +19,11 @@ constexpr VkExtent2D kExtent{96, 54};
 constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr float kSky[4] = {0.45f, 0.6f, 0.8f, 1.0f};
+constexpr VkImageUsageFlags kColorUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
+                                          VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                          VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+constexpr VkImageUsageFlags kDepthUsage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
 
 unsigned g_validation_errors = 0;
 
@@ -206,14 +211,8 @@ int main() {
   // The engine's render targets, a readback buffer for the colour, a command buffer and fence.
   VkImage color = VK_NULL_HANDLE, depth = VK_NULL_HANDLE;
   VkImageView color_view = VK_NULL_HANDLE, depth_view = VK_NULL_HANDLE;
-  if (!e.image(kColorFormat,
-               VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                   VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-               VK_IMAGE_ASPECT_COLOR_BIT, &color, &color_view) ||
-      !e.image(kDepthFormat,
-               VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                   VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-               VK_IMAGE_ASPECT_DEPTH_BIT, &depth, &depth_view)) {
+  if (!e.image(kColorFormat, kColorUsage, VK_IMAGE_ASPECT_COLOR_BIT, &color, &color_view) ||
+      !e.image(kDepthFormat, kDepthUsage, VK_IMAGE_ASPECT_DEPTH_BIT, &depth, &depth_view)) {
     return fail("images");
   }
   const VkDeviceSize bytes = VkDeviceSize{kExtent.width} * kExtent.height * 4;
@@ -301,10 +300,12 @@ int main() {
   siviflow::FrameInputs inputs;
   inputs.color = {color, color_view, kColorFormat, kExtent, cleared,
                   {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
-                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL}};
+                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL},
+                  kColorUsage};
   inputs.depth = {depth, depth_view, kDepthFormat, kExtent, cleared,
                   {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                   VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL}};
+                   VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL},
+                  kDepthUsage};
   inputs.readback[siviflow::ReadbackImage::kColor] = e.readback;
   status = water->record(cmd, inputs);
   if (!status.ok()) return fail(status.message().c_str());

@@ -104,12 +104,13 @@ class HostEmbeddingTest : public GpuTest {
     Status status = renderer_->update(view, time);
     EXPECT_TRUE(status.ok()) << status.message();
     ExternalImage color{color_image.image, color_image.view, VK_FORMAT_R16G16B16A16_SFLOAT,
-                        {kWidth, kHeight}, ImageState{}, kCopySource};
+                        {kWidth, kHeight}, ImageState{}, kCopySource, color_image.usage};
     ExternalImage depth{depth_image.image, depth_image.view, VK_FORMAT_D32_SFLOAT,
                         {kWidth, kHeight}, ImageState{},
                         {VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL}};
+                         VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL},
+                        depth_image.usage};
     EXPECT_TRUE(world_->begin_frame(0).ok());
     status = world_->record(cmd, view, time, color, depth);
     EXPECT_TRUE(status.ok()) << status.message();

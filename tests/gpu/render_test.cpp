@@ -578,6 +578,9 @@ TEST_F(RenderTest, BadHostImagesAndViewsAreRefusedByName) {
   inputs.color = targets.color;
   inputs.depth.view = VK_NULL_HANDLE;
   refused(inputs, "FrameInputs::depth needs an image and a view");
+  inputs.depth = targets.depth;
+  inputs.depth.usage &= ~VkImageUsageFlags{VK_IMAGE_USAGE_SAMPLED_BIT};  // the water reads it
+  refused(inputs, "FrameInputs::depth.usage 0x21 lacks 0x4");
   ASSERT_TRUE(context_->end_slot_and_submit(0).ok());  // an empty command buffer is fine
   ASSERT_TRUE(context_->wait_slot(0).ok());
 }

@@ -44,6 +44,7 @@ struct DeviceReport {
 struct HostImage {
   VkImage image = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;
+  VkImageUsageFlags usage = 0;  // what it was created with
 };
 struct HostBuffer {
   VkBuffer buffer = VK_NULL_HANDLE;
@@ -93,9 +94,8 @@ class HeadlessContext {
   uint32_t validation_error_count() const;
   std::vector<std::string> validation_errors() const;
 
-  struct Impl;
-
  private:
+  struct Impl;
   explicit HeadlessContext(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

@@ -147,8 +147,8 @@ struct ImageState {
 };
 
 // A host image we use. `current` is its state when our commands start; `final` the state the
-// host wants when they end, which must name a real layout (not UNDEFINED). The format and
-// extent are the host's word for what the image is, checked against the configuration.
+// host wants when they end, which must name a real layout (not UNDEFINED). The format, extent
+// and usage are the host's word for what the image is, checked against what we need.
 struct ExternalImage {
   VkImage image = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;  // depth: covering the depth aspect (and stencil, if any)
@@ -156,6 +156,9 @@ struct ExternalImage {
   VkExtent2D extent = {0, 0};
   ImageState current;
   ImageState final;
+  // The usage it was created with. Colour: COLOR_ATTACHMENT; depth: DEPTH_STENCIL_ATTACHMENT and
+  // SAMPLED; either: TRANSFER_SRC when CreateInfo::readback_images copies it.
+  VkImageUsageFlags usage = 0;
 };
 
 // What CreateInfo::readback_images can copy each frame into host-visible buffers, tightly packed
@@ -275,9 +278,9 @@ class Renderer {
   std::string dump_frame_graph() const;
   std::string dump_frame_graph_graphviz() const;
 
-  struct Impl;
 
  private:
+  struct Impl;
   friend class RendererInspector;  // what our tools and tests read of the simulation
   explicit Renderer(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;

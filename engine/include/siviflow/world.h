@@ -62,9 +62,8 @@ class World {
   // mirrored and clipped as `view` says.
   static void draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, void* world);
 
-  struct Impl;
-
  private:
+  struct Impl;
   explicit World(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
