@@ -2,6 +2,7 @@
 // (beauty plus the water mask, normal and reflection AOVs, with SIVIFLOW_FLOW_AOVS defined).
 #extension GL_GOOGLE_include_directive : require
 #include "shared.h"
+#include "sky_common.glsl"
 #include "tiled_directional_flow.glsl"
 
 layout(push_constant) uniform Push { FlowConstants flow; };
@@ -24,7 +25,13 @@ layout(location = 3) out vec4 out_reflection;
 // Tunables of the material that are not the artist's look (that comes in `look`).
 const float kShoreFadeMetres = 0.12;     // water thinner than this fades out at the banks
 const float kFadeInfluence = 0.25;       // how much a fading particle calms its cell
-const vec3 kSkyFallback = vec3(0.46, 0.60, 0.78);  // reflected where the reflection is empty
+// The sun's glint (GGX): roughness from calm water's to rippled water's, and the sun's
+// brightness on the scale of the sky's (whose disc is 20).
+const float kCalmRoughness = 0.07;
+const float kRoughnessPerRipple = 0.45;  // per unit of applied ripple strength
+const float kMaxRoughness = 0.45;
+const float kSunIntensity = 8.0;
+const float kPi = 3.14159265;
 const float kMaxWaterPath = 1.0e4;       // metres: the host's far plane or sky behind the water
 
 void main() {
@@ -55,11 +62,14 @@ void main() {
                              look.surface.y, tile_table, normal_map);
   vec3 n = tdf.normal;
 
-  // Reflection: the mirrored scene at this pixel, offset by the normal's tilt (paper §4.3); a
-  // plain sky where the host's reflection drew nothing.
+  // Reflection: the mirrored scene at this pixel, offset by the normal's tilt (paper §4.3); the
+  // sky seen along the reflected ray where the host's reflection drew nothing.
   vec2 uv = pixel * flow.screen.zw + tdf.tilt * flow.water.y;
   vec4 mirrored = texture(reflection_map, clamp(uv, vec2(0.0), vec2(1.0)));
-  vec3 reflection = mix(kSkyFallback, mirrored.rgb, mirrored.a);
+  vec3 reflected_ray = reflect(-to_eye, n);
+  reflected_ray.y = abs(reflected_ray.y);  // a ray tilted under the horizon sees the sky's edge
+  vec3 sky = sky_radiance(normalize(reflected_ray), flow.sun_direction.xyz, 0.0);
+  vec3 reflection = mix(sky, mirrored.rgb, mirrored.a);
   float cos_theta = max(dot(n, to_eye), 0.0);
   float grazing = 1.0 - cos_theta;
   float grazing_sq = grazing * grazing;
@@ -74,6 +84,27 @@ void main() {
   float opacity = 1.0 - exp(-look.deep_color.w * path);
   vec3 colour = mix(body, reflection, fresnel);
   float alpha = clamp(mix(opacity, 1.0, fresnel), 0.0, 1.0) * shore;
+
+  // Sunlight: the sun's specular glint on the rippled surface (GGX distribution, Schlick Fresnel,
+  // no shadowing), as broad as the applied ripples make the water rough: sharp glints on calm
+  // water, a broad sheen on rough. It is light the surface adds, whatever shows through it:
+  // divided by alpha so that blending adds it whole.
+  vec3 sun = flow.sun_direction.xyz;
+  vec3 half_vector = normalize(sun + to_eye);
+  // (The shore's calm, not the particles' fade: a per-particle roughness would print their cells.)
+  float ripple = look.sun_color.w * shore * shore;
+  float roughness = clamp(kCalmRoughness + kRoughnessPerRipple * ripple, kCalmRoughness, kMaxRoughness);
+  float a2 = roughness * roughness * roughness * roughness;
+  float n_dot_h = max(dot(n, half_vector), 0.0);
+  float d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+  float distribution = a2 / (kPi * d * d);
+  float v_dot_h = 1.0 - max(dot(half_vector, to_eye), 0.0);
+  float v_dot_h_sq = v_dot_h * v_dot_h;
+  float sun_fresnel = f0 + (1.0 - f0) * v_dot_h_sq * v_dot_h_sq * v_dot_h;
+  float lit = step(0.0, dot(n, sun)) * step(0.0, sun.y);
+  vec3 glint = look.sun_color.rgb * (kSunIntensity * distribution * sun_fresnel * lit /
+                                     (4.0 * max(cos_theta, 0.1)));
+  colour += glint * shore / max(alpha, 1e-3);
   out_color = vec4(colour, alpha);
 #ifdef SIVIFLOW_FLOW_AOVS
   out_mask = 1.0;

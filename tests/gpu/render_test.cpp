@@ -162,7 +162,7 @@ TEST_F(RenderTest, HostCanReplaceWhatTheWaterReflects) {
   ASSERT_EQ(ours.size(), 1u);
   ASSERT_TRUE(context_->wait_idle().ok());
   renderer_.reset();
-  // A host that draws nothing into the reflection: the water reflects a plain sky colour.
+  // A host that draws nothing into the reflection: the water reflects the sky.
   HostReflectionLog log;
   CreateInfo info = make_create_info(kWidth, kHeight);
   info.reflection = &record_nothing;
@@ -177,19 +177,16 @@ TEST_F(RenderTest, HostCanReplaceWhatTheWaterReflects) {
   EXPECT_LT(log.last.camera_position[1], 0.0f) << "the mirrored camera is below the water";
   size_t water = 0;
   size_t same = 0;
-  const float* plain = nullptr;  // the sky colour of the first water pixel, all others equal it
   for (size_t i = 0; i < host.front().water_mask.size(); ++i) {
     if (host.front().water_mask[i] != 1.0f) continue;
     ++water;
     const float* reflected = &host.front().reflection[i * 4];
-    if (plain == nullptr) plain = reflected;
-    for (int c = 0; c < 3; ++c) EXPECT_EQ(reflected[c], plain[c]) << "pixel " << i;
-    EXPECT_GT(reflected[2], reflected[0]) << "a blue sky";
+    EXPECT_GT(reflected[2], reflected[0]) << "the sky along the reflected ray, blue; pixel " << i;
     if (std::memcmp(&ours.front().reflection[i * 4], reflected, 3 * sizeof(float)) == 0) ++same;
     if (HasFailure()) break;
   }
   EXPECT_GT(water, 100u);
-  EXPECT_LT(same, water / 10) << "our world's reflection differs from the plain sky";
+  EXPECT_LT(same, water / 10) << "our world's reflection differs from the sky alone";
 }
 
 TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {

@@ -4,10 +4,12 @@
 // are refused by name and change nothing.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 #include "render_frames.h"
@@ -158,6 +160,51 @@ TEST_F(RuntimeControlTest, LookChangesTheWaterOnlyAndEqualsTheSceneFileLook) {
   EXPECT_EQ(changed_dry, 0u) << "off the water the host's colour is untouched";
   EXPECT_EQ(differing(runtime[0].rgba, file[1].rgba), 0u)
       << "the same look from the scene file: the same frame";
+}
+
+// Luminance of the water's pixels in the middle ninth of the picture (mid-river, away from the
+// shallows where the bed shows through), sorted.
+std::vector<double> water_luminances(const Frame& frame) {
+  std::vector<double> values;
+  for (size_t i = 0; i < frame.water_mask.size(); ++i) {
+    const size_t x = i % kWidth, y = i / kWidth;
+    if (x < kWidth / 3 || x >= 2 * kWidth / 3 || y < kHeight / 3 || y >= 2 * kHeight / 3) continue;
+    if (frame.water_mask[i] != 1.0f) continue;
+    const float* p = &frame.rgba[i * 4];
+    values.push_back(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
+  }
+  std::sort(values.begin(), values.end());
+  return values;
+}
+
+TEST_F(RuntimeControlTest, SunGlintsOnlyWhereTheWaterMirrorsIt) {
+  // Calm water seen steeply from above (no bright horizon mirrored at grazing angles): with the
+  // sun where the camera's middle ray reflects to, the brightest water is far above the median;
+  // with the sun behind the camera, the water has no highlight.
+  ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
+  Camera camera;
+  camera.target = boat().centre;  // on the water, in mid-river
+  camera.position = camera.target + glm::vec3(0.0f, 10.0f, -5.0f);
+  const glm::vec3 ray = glm::normalize(camera.target - camera.position);
+  WaterLook calm;
+  calm.ripple_strength = 0.05f;
+  double ratio[2] = {};
+  const glm::vec3 suns[2] = {{ray.x, -ray.y, ray.z}, {-ray.x, -ray.y, -ray.z}};
+  for (int i = 0; i < 2; ++i) {
+    calm.sun_direction = suns[i];
+    ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
+    ASSERT_TRUE(renderer_->set_look(calm).ok());
+    const std::vector<Frame> frames =
+        render_views(0, 1, kWidth, kHeight, [&](double) { return camera_view(camera, {kWidth, kHeight}); });
+    ASSERT_EQ(frames.size(), 1u);
+    const std::vector<double> water = water_luminances(frames[0]);
+    ASSERT_GT(water.size(), 2000u) << "mid-river fills the middle of the picture";
+    const double brightest = water[water.size() - 1 - water.size() / 1000];  // 99.9th percentile
+    ratio[i] = brightest / water[water.size() / 2];
+  }
+  std::printf("brightest / median water: sun mirrored %.2f, sun behind %.2f\n", ratio[0], ratio[1]);
+  EXPECT_GT(ratio[0], 5.0) << "the sun's glint in the mirror direction";
+  EXPECT_LT(ratio[1], 2.0) << "no glint with the sun behind the camera";
 }
 
 TEST_F(RuntimeControlTest, BadObstaclesAndLooksAreRefusedByNameAndChangeNothing) {

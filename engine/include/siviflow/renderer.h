@@ -56,7 +56,7 @@ struct ReflectionView {
 // depth: VK_FORMAT_D32_SFLOAT, cleared to the far value of the view's depth convention) and
 // viewport and scissor set; the host binds its own pipelines (with that rendering format and
 // gl_ClipDistance against clip_plane) and must not end the rendering. Where the host leaves
-// the colour's alpha at 0, the water reflects a plain sky colour.
+// the colour's alpha at 0, the water reflects the sky along the reflected ray.
 using ReflectionCallback = void (*)(VkCommandBuffer cmd, const ReflectionView& view, void* user);
 using LogCallback = void (*)(LogLevel level, const char* message, void* user);
 
