@@ -27,6 +27,7 @@ std::string water_look_error(const WaterLook& look, std::string* problem) {
       {"tile_size_m", look.tile_size_m, kMinTileSizeM, kMaxTileSizeM},
       {"reflection_distortion", look.reflection_distortion, 0.0f, 0.5f},
       {"fresnel_f0", look.fresnel_f0, 0.0f, 1.0f},
+      {"sun_glint", look.sun_glint, 0.0f, 10.0f},
   };
   for (const auto& s : scalars) {
     if (!in_range(s.value, s.lo, s.hi)) {

@@ -30,7 +30,7 @@ const float kFadeInfluence = 0.25;       // how much a fading particle calms its
 const float kCalmRoughness = 0.07;
 const float kRoughnessPerRipple = 0.45;  // per unit of applied ripple strength
 const float kMaxRoughness = 0.45;
-const float kSunIntensity = 8.0;
+const float kSunIntensity = 8.0;  // at WaterLook::sun_glint 1
 const float kPi = 3.14159265;
 const float kMaxWaterPath = 1.0e4;       // metres: the host's far plane or sky behind the water
 
@@ -102,7 +102,7 @@ void main() {
   float v_dot_h_sq = v_dot_h * v_dot_h;
   float sun_fresnel = f0 + (1.0 - f0) * v_dot_h_sq * v_dot_h_sq * v_dot_h;
   float lit = step(0.0, dot(n, sun)) * step(0.0, sun.y);
-  vec3 glint = look.sun_color.rgb * (kSunIntensity * distribution * sun_fresnel * lit /
+  vec3 glint = look.sun_color.rgb * (kSunIntensity * look.surface.z * distribution * sun_fresnel * lit /
                                      (4.0 * max(cos_theta, 0.1)));
   colour += glint * shore / max(alpha, 1e-3);
   out_color = vec4(colour, alpha);

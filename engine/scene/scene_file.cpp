@@ -302,7 +302,8 @@ Status parse_look(const Reader& r, const Json& v, WaterLook* out) {
                  {"ripple_scale", &WaterLook::ripple_scale},
                  {"tile_size_m", &WaterLook::tile_size_m},
                  {"reflection_distortion", &WaterLook::reflection_distortion},
-                 {"fresnel_f0", &WaterLook::fresnel_f0}};
+                 {"fresnel_f0", &WaterLook::fresnel_f0},
+                 {"sun_glint", &WaterLook::sun_glint}};
   const struct {
     const char* name;
     glm::vec3 WaterLook::*member;

@@ -24,6 +24,7 @@ struct WaterLook {
   float fresnel_f0 = 0.02f;             // reflectance at normal incidence, in [0, 1]
   glm::vec3 sun_direction{0.45f, 0.62f, 0.35f};  // towards the sun, finite, any non-zero length
   glm::vec3 sun_color{1.0f, 1.0f, 1.0f};  // linear multiplier of sunlit water, each in [0, 100]
+  float sun_glint = 1.0f;  // strength of the sun's specular glint on the water, in [0, 10]
 };
 
 // Range limits of the tile size: the renderer sizes its water heights for the largest.
