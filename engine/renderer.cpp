@@ -292,10 +292,8 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   water_frame.look.deep_color = glm::vec4(look.deep_color, look.opacity_per_metre);
   water_frame.look.sun_color = glm::vec4(look.sun_color, look.ripple_strength);
   water_frame.look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, look.sun_glint, 0.0f);
-  // The view looks down its -Z axis: that axis's world direction is the inverse's third column.
-  const glm::vec3 forward = -glm::vec3(glm::inverse(host_view.view)[2]);
   tile_lattice.place(river->water_lo, river->water_hi, look.tile_size_m, view.camera_position,
-                     forward);
+                     view.forward);
   const TileTableLayout& tiles = tile_lattice.layout();
   water_frame.tiles.heights.w = look.tile_size_m;
   water_frame.tiles.ripples = glm::vec4(repeat_tiles, 0.0f, 0.0f, 0.0f);

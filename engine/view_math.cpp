@@ -51,7 +51,9 @@ Status derive_view_math(const glm::mat4& view, const glm::mat4& projection, View
   out->reverse_z = depth_at(p, 2.0f * forward) < depth_at(p, forward);
   out->depth_ratio_constant = p[2][2] / p[2][3];
   out->view_proj = projection * view;
-  out->camera_position = glm::vec3(glm::inverse(view)[3]);
+  const glm::mat4 to_world = glm::inverse(view);
+  out->camera_position = glm::vec3(to_world[3]);
+  out->forward = -glm::vec3(to_world[2]);
   return Status::success();
 }
 

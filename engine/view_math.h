@@ -16,6 +16,7 @@ namespace siviflow {
 struct ViewMath {
   glm::mat4 view_proj{1.0f};
   glm::vec3 camera_position{0.0f};
+  glm::vec3 forward{0.0f, 0.0f, -1.0f};  // world direction the view looks along (its -Z axis)
   // Near maps to depth 1 and far to 0: depth tests use GREATER_OR_EQUAL, cleared depth is 0.
   bool reverse_z = false;
   // P[2][2] / P[2][3]: along one pixel's ray, view distances are in the ratio of

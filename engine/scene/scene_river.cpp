@@ -280,35 +280,17 @@ Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverDa
 
 Status build_scene_river_flow(const SceneFile& scene, size_t river_index, double time_seconds,
                               SceneRiverFlow* out) {
-  if (river_index >= scene.rivers.size()) {
-    return Status::error(scene.path + ": no river " + std::to_string(river_index) + " (the scene has " +
-                         std::to_string(scene.rivers.size()) + ")");
-  }
-  const SceneRiver& river = scene.rivers[river_index];
-  std::vector<uint32_t> indices;
-  if (river.source == SceneRiver::Source::kGltf) {
-    TriangleMesh mesh;
-    SIVIFLOW_TRY(load_river_mesh(river.gltf, river.mesh, &mesh));
-    out->positions = std::move(mesh.positions);
-    indices = std::move(mesh.indices);
-  } else {
-    Status status = ProceduralRiver::validate(river.procedural);
-    if (!status.ok()) return in_scene(scene, status);
-    RiverMesh mesh;
-    status = ProceduralRiver(river.procedural).generate_mesh(&mesh);
-    if (!status.ok()) return in_scene(scene, status);
-    out->positions = std::move(mesh.positions);
-    indices = std::move(mesh.indices);
-  }
+  SceneRiverData data;
+  SIVIFLOW_TRY(scene_river_data(&scene, river_index, &data));
+  out->positions = std::move(data.mesh.positions);
   RiverSurface surface;
-  Status status = RiverSurface::build(out->positions, indices, RiverSurfaceOptions{}, &surface);
+  Status status = RiverSurface::build(out->positions, data.mesh.indices, RiverSurfaceOptions{}, &surface);
   if (!status.ok()) return in_scene(scene, status);
-  status = StreamFunction::create(std::move(surface), river.flow, &out->flow);
+  const FlowParams flow{data.flow.discharge, data.flow.shepard_power, data.flow.search_radius};
+  status = StreamFunction::create(std::move(surface), flow, &out->flow);
   if (!status.ok()) return in_scene(scene, status);
-  std::vector<Obstacle> obstacles = scene.obstacles;
-  std::vector<Obstacle> from_objects;
-  SIVIFLOW_TRY(scene_object_obstacles(scene, out->positions, &from_objects));
-  for (Obstacle& o : from_objects) obstacles.push_back(std::move(o));
+  std::vector<Obstacle> obstacles;
+  for (const WaterObstacle& obstacle : data.obstacles) obstacles.push_back(flow_obstacle(obstacle));
   status = out->flow.set_obstacles(std::move(obstacles), time_seconds);
   if (!status.ok()) return in_scene(scene, status);
   return Status::success();

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
 #include "view_math.h"
@@ -47,6 +48,8 @@ TEST(ViewMath, StandardProjectionIsNotReverseAndRecoversDistances) {
   const glm::mat4 p = standard(0.1f, 1000.0f);
   EXPECT_NEAR(distance_ratio(math, depth_of(p, 30.0f), depth_of(p, 10.0f)), 3.0f, 1e-3f);
   EXPECT_NEAR(glm::distance(math.camera_position, glm::vec3(1.0f, 5.0f, -20.0f)), 0.0f, 1e-4f);
+  const glm::vec3 towards_target = glm::normalize(-glm::vec3(1.0f, 5.0f, -20.0f));
+  EXPECT_NEAR(glm::distance(math.forward, towards_target), 0.0f, 1e-5f);
 }
 
 TEST(ViewMath, ReverseInfiniteProjectionIsReverseAndRecoversDistances) {
