@@ -99,7 +99,7 @@ Status Renderer::Impl::declare_graph() {
        {tile_lattice.layout().width, tile_lattice.layout().height}, {}}));
   flow_pass.declare_tiles(graph, &water);
   flow_pass.declare(graph, river->index_count, &water);
-  if (info.enable_timing) {
+  if (info.enable_timing && info.measure_flow_floor) {
     const ImageHandle floor =
         frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
     flow_pass.declare_floor(graph, river->index_count, water, floor);

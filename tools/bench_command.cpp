@@ -145,6 +145,7 @@ int run_bench(int argc, char** argv) {
   CreateInfo info = context->renderer_create_info(extent, kOutputFormat);
   info.frames_in_flight = 1;
   info.enable_timing = true;
+  info.measure_flow_floor = true;
   const SceneFile* scene_file = scene.has_value() ? &*scene : nullptr;
   SceneRiverData river;  // the scene's first river
   status = scene_river_data(scene_file, 0, &river);

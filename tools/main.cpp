@@ -14,6 +14,7 @@ void print_usage() {
       "  capture   render frames of the default scene into EXR files (and PNG previews)\n"
       "  flow      solve a scene's river flow and write it as CSV\n"
       "  bench     time every pass of the default scene's frames (GPU timestamps) and the CPU work\n"
+      "  view      a live window: fly along the river, drag boulders, tune the water\n"
       "  info      print the Vulkan device, driver, required features and validation layer\n"
       "Run 'siviflow <command> --help' for the options of a command.\n");
 }
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
   if (command == "info") return siviflow::run_info(argc, argv);
   if (command == "flow") return siviflow::run_flow(argc, argv);
   if (command == "bench") return siviflow::run_bench(argc, argv);
+  if (command == "view") return siviflow::run_view(argc, argv);
   std::fprintf(stderr, "siviflow: unknown command '%.*s' (try 'siviflow --help')\n",
                static_cast<int>(command.size()), command.data());
   return siviflow::cli::kExitError;

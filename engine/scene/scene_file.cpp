@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/gltf_import.h"
+#include "scene/look_fields.h"
 #include "sim/river_tuning.h"
 #include "sim/text_format.h"
 
@@ -293,33 +294,15 @@ Status parse_river(const Reader& r, const Json& v, const std::string& path,
 // the renderer accepts (so a file the parser takes is one the renderer takes).
 Status parse_look(const Reader& r, const Json& v, WaterLook* out) {
   SIVIFLOW_TRY(r.object(v, "look"));
-  const struct {
-    const char* name;
-    float WaterLook::*member;
-  } scalars[] = {{"absorption_per_metre", &WaterLook::absorption_per_metre},
-                 {"opacity_per_metre", &WaterLook::opacity_per_metre},
-                 {"ripple_strength", &WaterLook::ripple_strength},
-                 {"ripple_scale", &WaterLook::ripple_scale},
-                 {"tile_size_m", &WaterLook::tile_size_m},
-                 {"reflection_distortion", &WaterLook::reflection_distortion},
-                 {"fresnel_f0", &WaterLook::fresnel_f0},
-                 {"sun_glint", &WaterLook::sun_glint}};
-  const struct {
-    const char* name;
-    glm::vec3 WaterLook::*member;
-  } vectors[] = {{"water_color", &WaterLook::water_color},
-                 {"deep_color", &WaterLook::deep_color},
-                 {"sun_direction", &WaterLook::sun_direction},
-                 {"sun_color", &WaterLook::sun_color}};
   std::vector<std::string_view> allowed;
-  for (const auto& s : scalars) allowed.push_back(s.name);
-  for (const auto& s : vectors) allowed.push_back(s.name);
+  for (const auto& s : kLookScalarFields) allowed.push_back(s.name);
+  for (const auto& s : kLookVectorFields) allowed.push_back(s.name);
   SIVIFLOW_TRY(r.keys(v, "look", allowed));
   WaterLook look;
-  for (const auto& s : scalars) {
+  for (const auto& s : kLookScalarFields) {
     if (const Json* x = find(v, s.name)) SIVIFLOW_TRY(r.real(*x, join("look", s.name), &(look.*s.member)));
   }
-  for (const auto& s : vectors) {
+  for (const auto& s : kLookVectorFields) {
     if (const Json* x = find(v, s.name)) SIVIFLOW_TRY(r.vec3(*x, join("look", s.name), &(look.*s.member)));
   }
   std::string problem;

@@ -1,6 +1,7 @@
 #include "siviflow/world.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -62,6 +63,11 @@ struct World::Impl {
   RiverMesh river_mesh;          // for a glTF river's bed and overview camera
   std::vector<SceneGeometry> other_rivers;  // the scene's rivers after the first, until uploaded
   std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is at the frame's time
+  // Per boulder: where the host stood it (overriding its obstacle's keys), and whether it is
+  // drawn (spares start hidden).
+  std::vector<std::optional<glm::vec3>> placed;
+  std::vector<bool> shown;
+  std::vector<uint32_t> boulder_index_counts;
   SceneCamera camera_path;          // keys empty: the scene's default camera
   SceneLook look = default_scene_look();
 
@@ -116,6 +122,14 @@ Status World::Impl::load_scene() {
                                             : build_riverbed_geometry(other.mesh, {}));
   }
   obstacles = info.scene != nullptr ? info.scene->obstacles : default_scene_obstacles(river);
+  shown.assign(obstacles.size(), true);
+  for (uint32_t i = 0; i < info.spare_boulders; ++i) {
+    Obstacle spare;
+    spare.radius = info.spare_boulder_radius;
+    obstacles.push_back(spare);
+    shown.push_back(false);
+  }
+  placed.assign(obstacles.size(), std::nullopt);
   if (info.scene != nullptr) camera_path = info.scene->camera;
   return Status::success();
 }
@@ -131,6 +145,7 @@ Status World::Impl::create_resources() {
   reflection_draws = {{0, geometry.static_index_count, &reflection_constants}};
   for (size_t i = 0; i < geometry.obstacle_boulders.size(); ++i) {
     const SceneGeometry::Instance& boulder = geometry.obstacle_boulders[i];
+    boulder_index_counts.push_back(boulder.index_count);
     main_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i]});
     reflection_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i + 1]});
   }
@@ -217,8 +232,11 @@ gpu::SceneConstants World::Impl::view_constants(const glm::mat4& view_proj,
 
 // The boulders where their obstacles are at the frame's time; `which` 0 main view, 1 mirrored.
 void World::Impl::place_obstacles(size_t which, const gpu::SceneConstants& constants) {
+  std::vector<SceneDraw>& draws = which == 0 ? main_draws : reflection_draws;
   for (size_t i = 0; i < obstacles.size(); ++i) {
-    obstacle_constants[2 * i + which] = translated(constants, obstacle_centre_at(obstacles[i], time));
+    const glm::vec3 centre = placed[i] ? *placed[i] : obstacle_centre_at(obstacles[i], time);
+    obstacle_constants[2 * i + which] = translated(constants, centre);
+    draws[1 + i].index_count = shown[i] ? boulder_index_counts[i] : 0;  // after the valley
   }
 }
 
@@ -301,6 +319,30 @@ Camera World::scene_camera(double time_seconds) const {
   camera.position = glm::mix(a.position, after->position, u);
   camera.target = glm::mix(a.target, after->target, u);
   return camera;
+}
+
+uint32_t World::boulder_count() const { return static_cast<uint32_t>(impl_->obstacles.size()); }
+
+Status World::place_boulder(uint32_t index, const glm::vec3& centre) {
+  if (index >= boulder_count()) {
+    return world_error("place_boulder: no boulder " + std::to_string(index) + " (there are " +
+                       std::to_string(boulder_count()) + ")");
+  }
+  if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) {
+    return world_error("place_boulder: centre is not finite");
+  }
+  impl_->placed[index] = centre;
+  impl_->shown[index] = true;
+  return Status::success();
+}
+
+Status World::hide_boulder(uint32_t index) {
+  if (index >= boulder_count()) {
+    return world_error("hide_boulder: no boulder " + std::to_string(index) + " (there are " +
+                       std::to_string(boulder_count()) + ")");
+  }
+  impl_->shown[index] = false;
+  return Status::success();
 }
 
 Status World::begin_frame(uint32_t slot) {

@@ -90,8 +90,10 @@ struct CreateInfo {
   // flow textures, tile table and reflection of its own; `river` is then not read. Obstacles
   // added through either renderer re-route both. Null: a river of its own.
   const Renderer* share_river_with = nullptr;
-  bool enable_timing = false;          // GPU timestamps around every pass (see pass_times()),
-                                       // and the flow pass's floor pass, for benchmarks
+  bool enable_timing = false;          // GPU timestamps around every pass (see pass_times())
+  // With enable_timing: also the flow pass's floor (a pass over the water's pixels making the
+  // same texture reads and writes with next to no arithmetic), for benchmarks; it costs GPU time.
+  bool measure_flow_floor = false;
   VkDeviceSize staging_bytes_per_slot = 0;  // per-slot staging block; 0 means 8 MiB
   bool debug_utils = false;            // the host enabled VK_EXT_debug_utils: label passes, name objects
   VkPipelineCache pipeline_cache = VK_NULL_HANDLE;         // optional

@@ -14,6 +14,8 @@
 #include <cstdint>
 #include <memory>
 
+#include <glm/vec3.hpp>
+
 #include <vulkan/vulkan.h>
 
 #include "siviflow/renderer.h"
@@ -37,6 +39,10 @@ struct WorldCreateInfo {
   VkPipelineCache pipeline_cache = VK_NULL_HANDLE;              // optional
   const VkAllocationCallbacks* allocation_callbacks = nullptr;  // optional
   bool debug_utils = false;  // the host enabled VK_EXT_debug_utils: label the pass
+  // Boulders for obstacles a host adds at runtime (Renderer::add_obstacle), hidden until placed
+  // with place_boulder(); each `spare_boulder_radius` metres round.
+  uint32_t spare_boulders = 0;
+  float spare_boulder_radius = 1.5f;
 };
 
 class World {
@@ -49,6 +55,14 @@ class World {
   // The camera of the scene's own path at that time (the default scene glides downstream; a
   // glTF river without keys is seen from above its upstream end).
   Camera scene_camera(double time_seconds) const;
+
+  // The boulders: one per obstacle of the scene (its `obstacles`, in order), then the spares.
+  uint32_t boulder_count() const;
+  // Stands boulder `index` at `centre` from the next record() on (its keys no longer move it):
+  // a host that moves or adds an obstacle in the water renderer moves its boulder with it.
+  Status place_boulder(uint32_t index, const glm::vec3& centre);
+  // Draws boulder `index` no more until it is placed again (its obstacle was removed).
+  Status hide_boulder(uint32_t index);
 
   // The host has waited until the GPU finished the commands last recorded for this slot.
   Status begin_frame(uint32_t slot);

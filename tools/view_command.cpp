@@ -1,0 +1,100 @@
+// `siviflow view`: the live viewer (tools/view/viewer.h) from the command line.
+#include <cstdio>
+#include <string>
+
+#include "cli.h"
+#include "commands.h"
+#include "view/viewer.h"
+
+namespace siviflow {
+namespace {
+
+constexpr const char* kCommand = "view";
+
+void print_help() {
+  std::printf(
+      "usage: siviflow view [SCENE.json] [--size WxH] [--frames N] [--no-vsync] [--validation]\n"
+      "                     [--screenshot FILE.png] [--input-script FILE] [--flow-report FILE]\n"
+      "  A window with the scene (or the default scene) and its water, live. Controls: WASD\n"
+      "  move, Q/E down/up, hold the right button to look, wheel for speed, shift fast; drag a\n"
+      "  boulder with the left button, B adds one under the cursor, X removes the one under it;\n"
+      "  C follows the scene's camera path, space pauses; Esc or closing the window quits.\n"
+      "  --size WxH          window size (default 1280x720)\n"
+      "  --frames N          close after N presented frames (time then steps 1/60 s a frame)\n"
+      "  --no-vsync          present with MAILBOX or IMMEDIATE where offered (default FIFO)\n"
+      "  --validation        the Khronos validation layer with synchronization validation;\n"
+      "                      any error makes the exit status 1\n"
+      "  --screenshot FILE   with --frames: the last presented image as PNG\n"
+      "  --input-script FILE scripted mouse and key events per frame (for checks; see\n"
+      "                      tools/view/input_script.h)\n"
+      "  --flow-report FILE  at exit, CSV of the obstacles and the first river's particles\n"
+      "                      with their flow\n");
+}
+
+Status parse_options(int argc, char** argv, view::ViewOptions* options, bool* help) {
+  cli::ArgReader args(argc, argv, 2);
+  std::string_view value;
+  while (!args.done()) {
+    const std::string_view arg = args.next();
+    if (arg == "--help" || arg == "-h") {
+      *help = true;
+      return Status::success();
+    } else if (arg == "--size") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      cli::Size size;
+      SIVIFLOW_TRY(cli::parse_size(arg, value, &size));
+      options->width = size.width;
+      options->height = size.height;
+    } else if (arg == "--frames") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(cli::parse_uint(arg, value, &options->frames));
+      if (options->frames == 0) return Status::error("--frames must be at least 1");
+    } else if (arg == "--no-vsync") {
+      options->no_vsync = true;
+    } else if (arg == "--validation") {
+      options->validation = true;
+    } else if (arg == "--screenshot") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      options->screenshot = value;
+    } else if (arg == "--input-script") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      options->input_script = value;
+    } else if (arg == "--flow-report") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      options->flow_report = value;
+    } else if (!arg.empty() && arg[0] != '-' && options->scene_path.empty()) {
+      options->scene_path = arg;
+    } else {
+      return cli::unexpected_argument(arg);
+    }
+  }
+  if (!options->screenshot.empty() && options->frames == 0) {
+    return Status::error("--screenshot needs --frames N (the image of the last frame)");
+  }
+  return Status::success();
+}
+
+}  // namespace
+
+int run_view(int argc, char** argv) {
+  view::ViewOptions options;
+  bool help = false;
+  const Status parsed = parse_options(argc, argv, &options, &help);
+  if (!parsed.ok()) return cli::fail(kCommand, parsed.message());
+  if (help) {
+    print_help();
+    return cli::kExitOk;
+  }
+  view::ViewResult result;
+  const Status status = view::run_viewer(options, &result);
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  const double fps = result.seconds > 0.0 ? result.frames_presented / result.seconds : 0.0;
+  std::printf("view: %u frames presented in %.2f s (%.1f fps)\n", result.frames_presented,
+              result.seconds, fps);
+  if (result.validation_errors != 0) {
+    return cli::fail(kCommand, std::to_string(result.validation_errors) + " validation error(s)");
+  }
+  return cli::kExitOk;
+}
+
+}  // namespace siviflow
