@@ -8,6 +8,7 @@ packages=(
   glslang-tools spirv-tools
   libglm-dev libtinygltf-dev libopenexr-dev libpng-dev libjpeg62-turbo-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
+  libglfw3-dev libimgui-dev xvfb
 )
 missing=()
 for p in "${packages[@]}"; do
