@@ -470,6 +470,9 @@ const ParticleField& RendererInspector::particle_field(const Renderer& renderer)
 const FlowTextureLayout& RendererInspector::flow_texture_layout(const Renderer& renderer) {
   return renderer.impl_->simulation.layout();
 }
+const RiverFlowField& RendererInspector::flow_field(const Renderer& renderer) {
+  return renderer.impl_->river->flow.field();
+}
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 uint64_t Renderer::flow_solves() const { return impl_->river->flow.full_solves(); }
 

@@ -1,5 +1,6 @@
 // What our tools and tests read of a renderer's simulation, beyond the embedding interface (not
-// installed): the particles of the last simulated frame and the flow texture's layout.
+// installed): the particles of the last simulated frame, the flow texture's layout and the
+// river's flow per vertex.
 #pragma once
 
 #include "siviflow/renderer.h"
@@ -14,6 +15,8 @@ class RendererInspector {
   static const ParticleField& particle_field(const Renderer& renderer);
   // Where the flow texture's and the aux data's texels are (sizes, texel size in pixels).
   static const FlowTextureLayout& flow_texture_layout(const Renderer& renderer);
+  // The river's flow per vertex as the next update's particles read it (shared by its views).
+  static const RiverFlowField& flow_field(const Renderer& renderer);
 };
 
 inline const ParticleField& particle_field(const Renderer& renderer) {
@@ -21,6 +24,9 @@ inline const ParticleField& particle_field(const Renderer& renderer) {
 }
 inline const FlowTextureLayout& flow_texture_layout(const Renderer& renderer) {
   return RendererInspector::flow_texture_layout(renderer);
+}
+inline const RiverFlowField& flow_field(const Renderer& renderer) {
+  return RendererInspector::flow_field(renderer);
 }
 
 }  // namespace siviflow

@@ -27,8 +27,8 @@ void print_help() {
       "  --screenshot FILE   with --frames: the last presented image as PNG\n"
       "  --input-script FILE scripted mouse and key events per frame (for checks; see\n"
       "                      tools/view/input_script.h)\n"
-      "  --flow-report FILE  at exit, CSV of the obstacles and the first river's particles\n"
-      "                      with their flow\n");
+      "  --flow-report FILE  at exit, CSV of the obstacles, the first river's flow per vertex\n"
+      "                      and its particles with their flow\n");
 }
 
 Status parse_options(int argc, char** argv, view::ViewOptions* options, bool* help) {

@@ -11,6 +11,7 @@ namespace {
 
 // A click this much beyond an obstacle's outline still picks it: boulders stand above the water.
 constexpr float kPickSlack = 1.25f;
+constexpr float kProbeHeight = 1000.0f;  // a vertical ray from this high finds the water below
 
 // Distance along `ray` to triangle (a, b, c) (Moller-Trumbore), or a negative number.
 float ray_triangle(const Ray& ray, glm::vec3 a, glm::vec3 b, glm::vec3 c) {
@@ -108,14 +109,18 @@ glm::vec3 ObstacleControl::centre_at(const Entry& entry, double time_seconds) co
 }
 
 std::optional<size_t> ObstacleControl::entry_under(const Ray& ray, double time_seconds) const {
-  const std::optional<glm::vec3> hit = hit_water(ray);
-  if (!hit) return std::nullopt;
+  // The boulder stands on the water: the ray passes near its centre at the water's height.
   std::optional<size_t> best;
   float best_distance = std::numeric_limits<float>::infinity();
   for (size_t i = 0; i < entries_.size(); ++i) {
     if (!entries_[i].active) continue;
-    const glm::vec3 c = centre_at(entries_[i], time_seconds);
-    const float d = glm::length(glm::vec2(hit->x - c.x, hit->z - c.z));
+    glm::vec3 c = centre_at(entries_[i], time_seconds);
+    const std::optional<glm::vec3> below =
+        hit_water({c + glm::vec3(0.0f, kProbeHeight, 0.0f), glm::vec3(0.0f, -1.0f, 0.0f)});
+    if (below) c.y = below->y;
+    const float along = glm::dot(c - ray.origin, ray.direction);
+    if (along <= 0.0f) continue;
+    const float d = glm::length(ray.origin + along * ray.direction - c);
     if (d <= kPickSlack * outline_radius(entries_[i].obstacle) && d < best_distance) {
       best = i;
       best_distance = d;
@@ -146,11 +151,13 @@ Status ObstacleControl::drag_to(const Ray& ray) {
   const std::optional<glm::vec3> hit = hit_water(ray);
   if (!hit) return Status::success();  // off the water: it stays where it was
   Entry& entry = entries_[*dragged_];
+  // Across the water only: its boulder keeps the height it was modelled at.
+  const glm::vec3 centre(hit->x, entry.obstacle.centre.y, hit->z);
   for (size_t r = 0; r < renderers_.size(); ++r) {
-    SIVIFLOW_TRY(renderers_[r]->move_obstacle(entry.ids[r], *hit, entry.obstacle.rotation_rad));
+    SIVIFLOW_TRY(renderers_[r]->move_obstacle(entry.ids[r], centre, entry.obstacle.rotation_rad));
   }
-  entry.obstacle.centre = *hit;
-  return world_->place_boulder(entry.boulder, *hit);
+  entry.obstacle.centre = centre;
+  return world_->place_boulder(entry.boulder, centre);
 }
 
 Status ObstacleControl::add_at(const Ray& ray) {

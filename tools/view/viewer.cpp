@@ -658,13 +658,21 @@ Status Viewer::finish_screenshot(uint32_t slot) {
   return screenshot_.write_png(options_.screenshot, swapchain_.format());
 }
 
-// For scripted checks: where the obstacles stand and the flow each particle carries.
+// For scripted checks: where the obstacles stand, the river's flow per vertex (what the next
+// frame's particles read) and the flow each particle of this frame carries.
 Status Viewer::write_flow_report() const {
   std::string csv = "kind,x,y,z,a,b,c\n";
   char row[256];
   for (const ObstacleControl::Placed& p : obstacles_.placed(sim_time_)) {
     std::snprintf(row, sizeof(row), "obstacle,%.6g,%.6g,%.6g,%.6g,0,0\n", p.centre.x, p.centre.y,
                   p.centre.z, p.radius);
+    csv += row;
+  }
+  const RiverFlowField& field = flow_field(*renderer_list_.front());
+  for (size_t v = 0; v < field.positions.size(); ++v) {
+    const glm::vec3& p = field.positions[v];
+    std::snprintf(row, sizeof(row), "vertex,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", p.x, p.y, p.z,
+                  field.flow[v].x, field.flow[v].y, field.flow[v].z);
     csv += row;
   }
   for (const Particle& particle : particle_field(*renderer_list_.front()).particles()) {
