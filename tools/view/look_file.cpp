@@ -14,7 +14,8 @@ namespace siviflow::view {
 
 Status save_look_to_scene(const std::string& path, const WaterLook& look) {
   using Json = nlohmann::json;
-  Json root = Json::object();
+  // A new file: the procedural river holding the look (a scene needs a river).
+  Json root = {{"version", kSceneFileVersion}, {"river", {{"procedural", Json::object()}}}};
   std::error_code error;
   if (std::filesystem::exists(path, error)) {
     std::ifstream in(path, std::ios::binary);

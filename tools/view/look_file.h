@@ -9,7 +9,7 @@
 namespace siviflow::view {
 
 // Writes every field of `look` into the "look" object of the scene file at `path`, keeping its
-// other keys; a missing file becomes a scene file holding only the look. The file is replaced
+// other keys; a missing file becomes a scene file of the procedural river with the look. The file is replaced
 // atomically; a file that is not a JSON object is refused and left as it was.
 Status save_look_to_scene(const std::string& path, const WaterLook& look);
 
