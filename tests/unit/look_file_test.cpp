@@ -32,7 +32,7 @@ WaterLook tuned_look() {
 TEST(LookFile, SavedLookReadsBackAndKeepsTheScene) {
   const auto dir = testing::fresh_test_dir("look_file");
   const auto path = dir / "scene.json";
-  std::ofstream(path) << R"({"version": 1, "render": {"width": 320, "height": 180}, "look": {"fresnel_f0": 0.5}})";
+  std::ofstream(path) << R"({"version": 1, "river": {"procedural": {}}, "render": {"size": [320, 180]}, "look": {"fresnel_f0": 0.5}})";
   const Status saved = view::save_look_to_scene(path.string(), tuned_look());
   ASSERT_TRUE(saved.ok()) << saved.message();
   SceneFile scene;
