@@ -7,6 +7,8 @@
 namespace siviflow::view {
 namespace {
 
+constexpr float kLabelWidth = 150.0f;  // pixels, "reflection_distortion" in the default font
+
 // The slider range of each look field: the renderer's accepted range (water_look.h), or a
 // working range where that is unbounded.
 struct Range {
@@ -51,6 +53,7 @@ PanelActions draw_panel(const PanelStats& stats, PanelState* state) {
   }
   if (ImGui::CollapsingHeader("Water look", ImGuiTreeNodeFlags_DefaultOpen)) {
     WaterLook& look = state->look;
+    ImGui::PushItemWidth(-kLabelWidth);  // room for the longest field name beside its slider
     for (const LookVectorField& f : kLookVectorFields) {
       glm::vec3& v = look.*f.member;
       const std::string name = f.name;
@@ -71,6 +74,7 @@ PanelActions draw_panel(const PanelStats& stats, PanelState* state) {
       actions.look_changed = true;
     }
     ImGui::InputText("scene file", state->save_path, sizeof(state->save_path));
+    ImGui::PopItemWidth();
     actions.save_look = ImGui::Button("save look to scene file");
   }
   if (!state->message.empty()) ImGui::TextWrapped("%s", state->message.c_str());
