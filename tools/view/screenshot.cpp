@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "siviflow/image_files.h"
+#include "view/image_barrier.h"
 
 namespace siviflow::view {
 
@@ -34,21 +35,7 @@ Status Screenshot::record_copy(WindowDevice& device, VkCommandBuffer cmd, VkImag
     if (result != VK_SUCCESS) return vk_failure("vkMapMemory", result);
     extent_ = extent;
   }
-  VkImageMemoryBarrier2 to_source{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  to_source.srcStageMask = from.stage;
-  to_source.srcAccessMask = from.access;
-  to_source.dstStageMask = kCopySource.stage;
-  to_source.dstAccessMask = kCopySource.access;
-  to_source.oldLayout = from.layout;
-  to_source.newLayout = kCopySource.layout;
-  to_source.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_source.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_source.image = image;
-  to_source.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.imageMemoryBarrierCount = 1;
-  dependency.pImageMemoryBarriers = &to_source;
-  vkCmdPipelineBarrier2(cmd, &dependency);
+  image_barrier(cmd, image, from, kCopySource);
 
   VkBufferImageCopy region{};
   region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};

@@ -20,6 +20,7 @@
 #include "siviflow/world.h"
 #include "view/fly_camera.h"
 #include "view/frame_slots.h"
+#include "view/image_barrier.h"
 #include "view/input_script.h"
 #include "view/look_file.h"
 #include "view/obstacle_control.h"
@@ -58,25 +59,6 @@ const ImageState kDepthRead =
     state(VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
           VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT, VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL);
 
-void image_barrier(VkCommandBuffer cmd, VkImage image, const ImageState& from,
-                   const ImageState& to) {
-  VkImageMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  barrier.srcStageMask = from.stage;
-  barrier.srcAccessMask = from.access;
-  barrier.dstStageMask = to.stage;
-  barrier.dstAccessMask = to.access;
-  barrier.oldLayout = from.layout;
-  barrier.newLayout = to.layout;
-  barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.image = image;
-  barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dependency.imageMemoryBarrierCount = 1;
-  dependency.pImageMemoryBarriers = &barrier;
-  vkCmdPipelineBarrier2(cmd, &dependency);
-}
-
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -106,6 +88,8 @@ class Viewer {
   void on_button(int button, bool pressed);
   void on_key(int key);
   void on_wheel(double notches);
+  // Moves the dragged obstacle to the cursor, once for all the cursor events since the last call.
+  void apply_drag();
   static Viewer* self(GLFWwindow* window) {
     return static_cast<Viewer*>(glfwGetWindowUserPointer(window));
   }
@@ -137,6 +121,7 @@ class Viewer {
   double sim_time_ = 0.0;
   glm::vec2 cursor_{0.0f};
   bool looking_ = false;  // right button held over the scene
+  bool drag_moved_ = false;  // the cursor moved while dragging since the last frame
   std::chrono::steady_clock::time_point last_frame_;
   // The stages after the panel is built (panel, record, submit and present), shown a frame late.
   std::vector<std::pair<std::string, double>> late_cpu_ms_;
@@ -311,10 +296,14 @@ void Viewer::on_cursor(double x, double y) {
   const glm::vec2 now(static_cast<float>(x), static_cast<float>(y));
   if (looking_) fly_.turn(now - cursor_);
   cursor_ = now;
-  if (obstacles_.dragging()) {
-    const Status status = obstacles_.drag_to(pixel_ray(current_view(), cursor_));
-    if (!status.ok()) panel_.message = status.message();
-  }
+  drag_moved_ = obstacles_.dragging();  // re-solved once per frame, however many events came
+}
+
+void Viewer::apply_drag() {
+  if (!drag_moved_) return;
+  drag_moved_ = false;
+  const Status status = obstacles_.drag_to(pixel_ray(current_view(), cursor_));
+  if (!status.ok()) panel_.message = status.message();
 }
 
 void Viewer::on_button(int button, bool pressed) {
@@ -322,6 +311,7 @@ void Viewer::on_button(int button, bool pressed) {
   if (button == GLFW_MOUSE_BUTTON_RIGHT) looking_ = pressed && !over_panel;
   if (button != GLFW_MOUSE_BUTTON_LEFT) return;
   if (!pressed) {
+    apply_drag();  // where the button came up
     obstacles_.end_drag();
   } else if (!over_panel) {
     obstacles_.begin_drag(pixel_ray(current_view(), cursor_), sim_time_);
@@ -420,6 +410,7 @@ Status Viewer::frame(bool* presented) {
   const auto events_start = std::chrono::steady_clock::now();
   glfwPollEvents();
   apply_script_events();
+  apply_drag();
   int width = 0;
   int height = 0;
   glfwGetFramebufferSize(device_.window, &width, &height);

@@ -68,6 +68,7 @@ uint32_t WindowDevice::validation_error_count() const {
 }
 
 Status WindowDevice::create(const WindowDeviceOptions& options) {
+  validation = options.validation;
   SIVIFLOW_TRY(create_window(options));
   SIVIFLOW_TRY(create_instance());
   const VkResult result = glfwCreateWindowSurface(instance, window, nullptr, &surface);
@@ -99,7 +100,6 @@ Status WindowDevice::create_window(const WindowDeviceOptions& options) {
   window = glfwCreateWindow(static_cast<int>(options.width), static_cast<int>(options.height),
                             "SiViFlow", nullptr, nullptr);
   if (window == nullptr) return Status::error("cannot create the window: " + g_glfw_error);
-  validation = options.validation;
   return Status::success();
 }
 
