@@ -32,6 +32,7 @@ struct Renderer::Impl {
   FrameRing ring;
   std::vector<float> particle_heights;  // this frame's live particles' heights
   WaterLook look;                    // from the next update() on (set_look)
+  DebugView debug_view = DebugView::kNone;  // likewise (set_debug_view)
   // The river, its flow and its static GPU data, shared with the other views of it.
   std::shared_ptr<SharedRiver> river;
   RiverView simulation;  // this view's particles and flow textures, on the CPU

@@ -1,4 +1,5 @@
-// What a host changes on a running renderer: obstacles placed at runtime and the water's look.
+// What a host changes on a running renderer: obstacles placed at runtime, the water's look and
+// its debug view.
 #include <cmath>
 #include <string>
 
@@ -94,5 +95,24 @@ Status Renderer::Impl::set_look(const WaterLook& new_look) {
 }
 
 const WaterLook& Renderer::look() const { return impl_->look; }
+
+const char* debug_view_name(DebugView view) {
+  static constexpr const char* kNames[kDebugViewCount] = {"none", "flow", "particles", "tiles"};
+  const auto index = static_cast<uint32_t>(view);
+  return index < kDebugViewCount ? kNames[index] : "";
+}
+
+Status Renderer::set_debug_view(DebugView view) {
+  return guarded(impl_->info, [&] {
+    if (static_cast<uint32_t>(view) >= kDebugViewCount) {
+      return argument_error(text_format("set_debug_view: %u is not a DebugView",
+                                        static_cast<uint32_t>(view)));
+    }
+    impl_->debug_view = view;
+    return Status::success();
+  });
+}
+
+DebugView Renderer::debug_view() const { return impl_->debug_view; }
 
 }  // namespace siviflow

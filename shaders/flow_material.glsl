@@ -4,6 +4,7 @@
 #include "shared.h"
 #include "sky_common.glsl"
 #include "tiled_directional_flow.glsl"
+#include "water_debug_views.glsl"
 
 layout(push_constant) uniform Push { FlowConstants flow; };
 layout(set = 0, binding = 0) uniform usampler2D flow_texture;   // shared.h layout, texelFetch only
@@ -39,7 +40,8 @@ void main() {
   // particle, reads the aux texture's all-zero texel 0: no branch needed). Its flow reaches the
   // ripples through the tile table.
   vec2 pixel = gl_FragCoord.xy - flow.screen.xy;  // in the view's viewport
-  uint own = texelFetch(flow_texture, ivec2(pixel * (1.0 / flow.water.w)), 0).r;
+  uvec4 texel = texelFetch(flow_texture, ivec2(pixel * (1.0 / flow.water.w)), 0);
+  uint own = texel.r;
   float fade = texelFetch(particle_aux, ivec2(own % SIVIFLOW_AUX_WIDTH,
                                                own / SIVIFLOW_AUX_WIDTH), 0).a;
 
@@ -106,6 +108,11 @@ void main() {
                                      (4.0 * max(cos_theta, 0.1)));
   colour += glint * shore / max(alpha, 1e-3);
   out_color = vec4(colour, alpha);
+  int debug_view = int(look.surface.w);
+  if (debug_view != kDebugViewNone) {
+    out_color = debug_view_colour(debug_view, out_color, texel, fade, in_world, flow.water.z,
+                                  look.surface.y, tile_table);
+  }
 #ifdef SIVIFLOW_FLOW_AOVS
   out_mask = 1.0;
   out_normal = vec4(n, 1.0);

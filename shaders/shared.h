@@ -103,7 +103,8 @@ struct WaterLookConstants {
   vec4 deep_color;   // rgb linear colour of deep water, w opacity per metre of view path
   vec4 sun_color;    // rgb linear multiplier of the sunlit part, w ripple strength
   vec4 surface;      // x Fresnel reflectance at normal incidence, y normal-map repeat in tiles
-                     // (the ripples' size), z the sun glint's strength, w unused
+                     // (the ripples' size), z the sun glint's strength, w the debug view
+                     // (siviflow::DebugView as a float; 0 the water's look)
 };
 
 // Push constants of the flow pass (the water material).

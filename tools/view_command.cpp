@@ -1,6 +1,7 @@
 // `siviflow view`: the live viewer (tools/view/viewer.h) from the command line.
 #include <cstdio>
 #include <string>
+#include <string_view>
 
 #include "cli.h"
 #include "commands.h"
@@ -15,10 +16,12 @@ void print_help() {
   std::printf(
       "usage: siviflow view [SCENE.json] [--size WxH] [--frames N] [--no-vsync] [--validation]\n"
       "                     [--screenshot FILE.png] [--input-script FILE] [--flow-report FILE]\n"
+      "                     [--debug-view none|flow|particles|tiles]\n"
       "  A window with the scene (or the default scene) and its water, live. Controls: WASD\n"
       "  move, Q/E down/up, hold the right button to look, wheel for speed, shift fast; drag a\n"
       "  boulder with the left button, B adds one under the cursor, X removes the one under it;\n"
-      "  C follows the scene's camera path, space pauses; Esc or closing the window quits.\n"
+      "  C follows the scene's camera path, space pauses, V steps through the debug views;\n"
+      "  Esc or closing the window quits.\n"
       "  --size WxH          window size (default 1280x720)\n"
       "  --frames N          close after N presented frames (time then steps 1/60 s a frame)\n"
       "  --no-vsync          present with MAILBOX or IMMEDIATE where offered (default FIFO)\n"
@@ -28,7 +31,23 @@ void print_help() {
       "  --input-script FILE scripted mouse and key events per frame (for checks; see\n"
       "                      tools/view/input_script.h)\n"
       "  --flow-report FILE  at exit, CSV of the obstacles, the first river's flow per vertex\n"
-      "                      and its particles with their flow\n");
+      "                      and its particles with their flow\n"
+      "  --debug-view NAME   start with a debug view of the water: flow (direction as colour,\n"
+      "                      an arrow per ripple tile), particles (a colour each), tiles (the\n"
+      "                      ripple tiles outlined); none is the water's look\n");
+}
+
+Status parse_debug_view(std::string_view name, DebugView* view) {
+  std::string names;
+  for (uint32_t i = 0; i < kDebugViewCount; ++i) {
+    const auto candidate = static_cast<DebugView>(i);
+    if (name == debug_view_name(candidate)) {
+      *view = candidate;
+      return Status::success();
+    }
+    names += std::string(i == 0 ? "" : ", ") + debug_view_name(candidate);
+  }
+  return Status::error("--debug-view: '" + std::string(name) + "' is not one of " + names);
 }
 
 Status parse_options(int argc, char** argv, view::ViewOptions* options, bool* help) {
@@ -62,6 +81,9 @@ Status parse_options(int argc, char** argv, view::ViewOptions* options, bool* he
     } else if (arg == "--flow-report") {
       SIVIFLOW_TRY(args.value(arg, &value));
       options->flow_report = value;
+    } else if (arg == "--debug-view") {
+      SIVIFLOW_TRY(args.value(arg, &value));
+      SIVIFLOW_TRY(parse_debug_view(value, &options->debug_view));
     } else if (!arg.empty() && arg[0] != '-' && options->scene_path.empty()) {
       options->scene_path = arg;
     } else {

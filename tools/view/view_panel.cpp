@@ -77,6 +77,16 @@ PanelActions draw_panel(const PanelStats& stats, PanelState* state) {
     ImGui::PopItemWidth();
     actions.save_look = ImGui::Button("save look to scene file");
   }
+  if (ImGui::CollapsingHeader("Debug view (V)", ImGuiTreeNodeFlags_DefaultOpen)) {
+    static constexpr const char* kLabels[kDebugViewCount] = {
+        "the water's look", "flow direction (colour, arrow per tile)", "particles", "tile grid"};
+    for (uint32_t i = 0; i < kDebugViewCount; ++i) {
+      if (ImGui::RadioButton(kLabels[i], state->debug_view == static_cast<DebugView>(i))) {
+        state->debug_view = static_cast<DebugView>(i);
+        actions.debug_view_changed = true;
+      }
+    }
+  }
   if (!state->message.empty()) ImGui::TextWrapped("%s", state->message.c_str());
   ImGui::End();
   return actions;

@@ -1,5 +1,6 @@
 // The viewer's Dear ImGui panel: frame rate, GPU time per pass and CPU time per stage, the
-// particle count, the camera and time controls, the water's look live, and "save look".
+// particle count, the camera and time controls, the water's look live, "save look", and the
+// water's debug views.
 #pragma once
 
 #include <cstddef>
@@ -7,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "siviflow/renderer.h"
 #include "siviflow/water_look.h"
 
 namespace siviflow::view {
@@ -29,6 +31,7 @@ struct PanelState {
   double time_seconds = 0.0;
   float camera_speed = 0.0f;
   WaterLook look;
+  DebugView debug_view = DebugView::kNone;
   char save_path[512] = {};
   std::string message;  // the last action's outcome or error
 };
@@ -36,6 +39,7 @@ struct PanelState {
 struct PanelActions {
   bool look_changed = false;
   bool save_look = false;
+  bool debug_view_changed = false;
 };
 
 // Builds the panel for this frame (between ImGui::NewFrame and ImGui::Render).

@@ -90,6 +90,8 @@ class Viewer {
   void on_wheel(double notches);
   // Moves the dragged obstacle to the cursor, once for all the cursor events since the last call.
   void apply_drag();
+  // Hands the panel's debug view to every river's renderer.
+  void apply_debug_view();
   static Viewer* self(GLFWwindow* window) {
     return static_cast<Viewer*>(glfwGetWindowUserPointer(window));
   }
@@ -178,6 +180,8 @@ Status Viewer::init() {
   std::snprintf(panel_.save_path, sizeof(panel_.save_path), "%s",
                 options_.scene_path.empty() ? "look.json" : options_.scene_path.c_str());
   panel_.look = renderers_.front()->look();
+  panel_.debug_view = options_.debug_view;
+  apply_debug_view();
   last_frame_ = std::chrono::steady_clock::now();
   return Status::success();
 }
@@ -299,6 +303,13 @@ void Viewer::on_cursor(double x, double y) {
   drag_moved_ = obstacles_.dragging();  // re-solved once per frame, however many events came
 }
 
+void Viewer::apply_debug_view() {
+  for (Renderer* renderer : renderer_list_) {
+    const Status status = renderer->set_debug_view(panel_.debug_view);
+    if (!status.ok()) panel_.message = status.message();
+  }
+}
+
 void Viewer::apply_drag() {
   if (!drag_moved_) return;
   drag_moved_ = false;
@@ -326,6 +337,11 @@ void Viewer::on_key(int key) {
     case GLFW_KEY_ESCAPE: quit_ = true; break;
     case GLFW_KEY_C: panel_.follow_path = !panel_.follow_path; break;
     case GLFW_KEY_SPACE: panel_.paused = !panel_.paused; break;
+    case GLFW_KEY_V:
+      panel_.debug_view =
+          static_cast<DebugView>((static_cast<uint32_t>(panel_.debug_view) + 1) % kDebugViewCount);
+      apply_debug_view();
+      break;
     case GLFW_KEY_B: status = obstacles_.add_at(ray); break;
     case GLFW_KEY_X: {
       bool removed = false;
@@ -347,7 +363,7 @@ void Viewer::apply_script_events() {
   static const struct {
     const char* name;
     int key;
-  } kKeys[] = {{"b", GLFW_KEY_B}, {"x", GLFW_KEY_X}, {"c", GLFW_KEY_C},
+  } kKeys[] = {{"b", GLFW_KEY_B}, {"x", GLFW_KEY_X}, {"c", GLFW_KEY_C}, {"v", GLFW_KEY_V},
                {"space", GLFW_KEY_SPACE}, {"escape", GLFW_KEY_ESCAPE}};
   for (const InputEvent& e : script_) {
     if (e.frame != frame_index_) continue;
@@ -555,6 +571,7 @@ void Viewer::build_panel(uint32_t slot, const std::vector<std::pair<std::string,
       panel_.message = status.ok() ? "" : status.message();
     }
   }
+  if (actions.debug_view_changed) apply_debug_view();
   if (actions.save_look) {
     const Status status = save_look_to_scene(panel_.save_path, renderers_.front()->look());
     panel_.message = status.ok() ? std::string("look saved to ") + panel_.save_path

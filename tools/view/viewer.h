@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "siviflow/renderer.h"
 #include "sim/status.h"
 
 namespace siviflow::view {
@@ -21,6 +22,7 @@ struct ViewOptions {
   std::string screenshot;      // the last presented image as PNG
   std::string input_script;    // scripted input (input_script.h)
   std::string flow_report;     // CSV of the obstacles and the particles' flow at exit
+  DebugView debug_view = DebugView::kNone;  // the water's debug view at the start
 };
 
 struct ViewResult {

@@ -42,6 +42,14 @@ namespace siviflow {
 enum class LogLevel { kInfo, kWarning, kError };
 class Renderer;
 
+// What the water shows in place of its look, to see what the material reads (set_debug_view):
+// the flow as a colour per direction with an arrow per ripple tile, each particle's pixels in a
+// colour of its own, or the look with the ripple tiles outlined.
+enum class DebugView : uint32_t { kNone, kFlowDirection, kParticles, kTileGrid };
+inline constexpr uint32_t kDebugViewCount = 4;
+// "none", "flow", "particles", "tiles"; "" for a value out of range.
+const char* debug_view_name(DebugView view);
+
 // What a host's own reflection drawing needs: the scene mirrored about the water plane, seen from
 // the real camera, and the plane to clip below (keep dot(plane.xyz, p) + plane.w >= 0).
 struct ReflectionView {
@@ -258,6 +266,9 @@ class Renderer {
   // error naming it and its value, and the look stays as it was.
   Status set_look(const WaterLook& look);
   const WaterLook& look() const;
+  // The debug view from the next update() on; a value out of the enum is an error.
+  Status set_debug_view(DebugView view);
+  DebugView debug_view() const;
 
   // New view size. Call between frames (not between begin_frame and record); images that
   // frames in flight still use are freed once every slot has come round again.
