@@ -1,5 +1,6 @@
 #include "river_simulation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -98,6 +99,19 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   const size_t count = mesh_.positions.size();
   velocity_.resize(count);
   speed_.resize(count);
+  foam_.resize(count);
+  bank_distance_.resize(count);
+  section_.resize(count);
+  for (size_t v = 0; v < count; ++v) {
+    const RiverVertex vertex = flow_.surface().vertex(v);
+    bank_distance_[v] = std::min(vertex.d_left, vertex.d_right);
+    section_[v] = vertex.section;
+  }
+  auto bvh = std::make_shared<RiverBvh>();
+  SIVIFLOW_TRY(RiverBvh::build(mesh_.positions, mesh_.indices, bvh.get()));
+  bvh_ = std::move(bvh);
+  SIVIFLOW_TRY(FoamField::create(mesh_.positions, mesh_.indices, section_, bvh_.get(), FoamParams{},
+                                 &foam_field_));
   refresh_velocity();
   field_.positions = mesh_.positions;
   field_.indices = mesh_.indices;
@@ -105,9 +119,7 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   field_.speed = speed_;
   field_.depth = mesh_.depth;
   field_.slope = slope_;
-  auto bvh = std::make_shared<RiverBvh>();
-  SIVIFLOW_TRY(RiverBvh::build(field_.positions, field_.indices, bvh.get()));
-  bvh_ = std::move(bvh);
+  field_.foam = foam_;
   return Status::success();
 }
 
@@ -116,6 +128,7 @@ void RiverFlow::refresh_velocity() {
     velocity_[v] = flow_.velocity(v);
     speed_[v] = glm::length(velocity_[v]);
   }
+  foam_field_.compute(velocity_, bank_distance_, foam_);
 }
 
 Status RiverFlow::set_time(double time_seconds) {

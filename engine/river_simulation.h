@@ -15,6 +15,7 @@
 
 #include "siviflow/water_river.h"
 #include "sim/flow_textures.h"
+#include "sim/foam.h"
 #include "sim/particles.h"
 #include "sim/procedural_river.h"
 #include "sim/river_bvh.h"
@@ -74,6 +75,7 @@ class RiverFlow {
   uint64_t full_solves() const { return full_solves_; }  // 1: the one at create
 
  private:
+  // Re-reads the solved velocity per vertex and derives the foam from it.
   void refresh_velocity();
 
   RiverMesh mesh_;
@@ -81,6 +83,10 @@ class RiverFlow {
   std::vector<glm::vec3> velocity_;  // per vertex, m/s
   std::vector<float> speed_;
   std::vector<float> slope_;         // riverbed slope under the vertex (rise over run)
+  std::vector<float> bank_distance_;  // to the nearer margin along the section, metres
+  std::vector<uint32_t> section_;    // per vertex
+  std::vector<float> foam_;          // 0..1 per vertex (sim/foam.h)
+  FoamField foam_field_;
   bool has_keys_ = false;            // some obstacle moves: re-solve as time goes
   RiverFlowField field_;
   std::shared_ptr<const RiverBvh> bvh_;

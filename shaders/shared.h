@@ -68,7 +68,8 @@ struct SceneConstants {
 // Aux texture: VK_FORMAT_R32G32B32A32_SFLOAT, SIVIFLOW_AUX_WIDTH texels wide, as many rows as
 // the slots need; id s is texel (s % SIVIFLOW_AUX_WIDTH, s / SIVIFLOW_AUX_WIDTH); texel 0 and
 // unused slots are all zero:
-//   .r speed (m/s)   .g depth (m)   .b riverbed slope (as the river gives it)   .a fade (0..1)
+//   .r speed (m/s)   .g depth (m)   .b foam (0..1, sim/foam.h)   .a fade (0..1)
+// (The paper's aux also holds the riverbed slope; no pass reads it, so foam took its lane.)
 #define SIVIFLOW_FLOW_TEXEL_PX 4
 #define SIVIFLOW_PARTICLE_NONE 0u
 #define SIVIFLOW_AUX_WIDTH 256u
@@ -87,12 +88,12 @@ static_assert(offsetof(FlowTexel, flow_z) == 6);
 struct ParticleAux {
   float speed;
   float depth;
-  float slope;
+  float foam;
   float fade;
 };
 static_assert(sizeof(ParticleAux) == 16);
 static_assert(offsetof(ParticleAux, depth) == 4);
-static_assert(offsetof(ParticleAux, slope) == 8);
+static_assert(offsetof(ParticleAux, foam) == 8);
 static_assert(offsetof(ParticleAux, fade) == 12);
 #endif
 

@@ -270,7 +270,7 @@ Status FlowTextures::pack(std::span<const Particle> particles, float cover_radiu
   std::byte* aux = staging.data() + l.aux_offset;
   std::memset(aux, 0, l.aux_bytes);
   for (const Particle& p : particles) {
-    const gpu::ParticleAux a{p.speed, p.depth, p.slope, p.fade};
+    const gpu::ParticleAux a{p.speed, p.depth, p.foam, p.fade};
     std::memcpy(aux + size_t{p.slot} * sizeof(gpu::ParticleAux), &a, sizeof a);
   }
   return Status::success();

@@ -1,6 +1,6 @@
 // Flow Texture Mapper (paper §3.2, Algorithm 2 lines 10-11): packs the particles of a frame into
 // the flow texture (per texel: the id of the nearest particle and its flow vector) and the
-// auxiliary data addressed by that id (speed, depth, slope, fade), as plain bytes in a caller-
+// auxiliary data addressed by that id (speed, depth, foam, fade), as plain bytes in a caller-
 // provided block (the frame slot's staging block). shaders/shared.h documents every channel;
 // FlowTextureLayout says where each image's texels start, row-major, tightly packed (the
 // bufferRowLength = 0 of vkCmdCopyBufferToImage).

@@ -240,6 +240,7 @@ Status check_inputs(const RiverFlowField& river, const ParticleParams& params, f
   SIVIFLOW_TRY(check_scalars(river.speed, "speed"));
   SIVIFLOW_TRY(check_scalars(river.depth, "depth"));
   SIVIFLOW_TRY(check_scalars(river.slope, "slope"));
+  SIVIFLOW_TRY(check_scalars(river.foam, "foam"));
   for (size_t i = 0; i < n; ++i) {
     if (!finite(river.flow[i])) {
       return Status::error("particles: flow of vertex " + std::to_string(i) + " is not finite");
@@ -429,6 +430,8 @@ void ParticleField::refresh_attributes() {
     p.speed = river_.speed.empty() ? glm::length(p.flow) : river_.speed[v];
     p.depth = river_.depth.empty() ? 0.0f : river_.depth[v];
     p.slope = river_.slope.empty() ? 0.0f : river_.slope[v];
+  p.foam = river_.foam.empty() ? 0.0f : river_.foam[v];
+    p.foam = river_.foam.empty() ? 0.0f : river_.foam[v];
   }
 }
 
@@ -623,6 +626,7 @@ bool ParticleField::try_create(Frame& f, const glm::vec2& screen, uint32_t* inde
   p.speed = river_.speed.empty() ? glm::length(p.flow) : river_.speed[v];
   p.depth = river_.depth.empty() ? 0.0f : river_.depth[v];
   p.slope = river_.slope.empty() ? 0.0f : river_.slope[v];
+  p.foam = river_.foam.empty() ? 0.0f : river_.foam[v];
   *index = static_cast<uint32_t>(particles_.size());
   particles_.push_back(p);
   grid_insert(*index);

@@ -55,7 +55,7 @@ namespace siviflow {
 // The per-vertex river data the particles consume (the River Surface Generator's and the stream
 // function's output, or any mesh with the same data). Spans into caller-owned arrays: they must
 // outlive the ParticleField. Positions and indices must not change after create() (the BVH is
-// built on them); flow, speed, depth and slope may change between updates (they are re-read
+// built on them); flow, speed, depth, slope and foam may change between updates (they are re-read
 // every update, so a re-solved flow reaches the particles the next frame).
 struct RiverFlowField {
   std::span<const glm::vec3> positions;  // world space, metres, +Y up
@@ -64,6 +64,7 @@ struct RiverFlowField {
   std::span<const float> speed;          // m/s per vertex; empty: |flow|
   std::span<const float> depth;          // water depth per vertex, metres; empty: 0
   std::span<const float> slope;          // riverbed slope per vertex; empty: 0
+  std::span<const float> foam;           // foam per vertex, 0..1 (sim/foam.h); empty: 0
 };
 
 // What the particles see through: a world -> clip matrix in Vulkan conventions (clip depth 0..1,
@@ -105,11 +106,12 @@ struct Particle {
   float fade = 0.0f;         // 0..1: 0 invisible, 1 fully in
   glm::vec3 world{0.0f};     // on the river surface
   glm::vec2 screen{0.0f};    // this frame, pixels
-  uint32_t vertex = 0;       // nearest river vertex: flow, speed, depth and slope are its own
+  uint32_t vertex = 0;       // nearest river vertex: flow, speed, depth, slope, foam are its own
   glm::vec3 flow{0.0f};
   float speed = 0.0f;
   float depth = 0.0f;
   float slope = 0.0f;
+  float foam = 0.0f;
   // Live particles take part in the Poisson-disk test; fading-out ones do not.
   bool live() const { return state != ParticleState::kFadingOut; }
 };

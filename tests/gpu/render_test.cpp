@@ -217,7 +217,7 @@ TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
     ASSERT_TRUE(read_particle_aux(read_back, layout, p.slot, &aux).ok());
     EXPECT_FLOAT_EQ(aux.speed, p.speed);
     EXPECT_FLOAT_EQ(aux.depth, p.depth);
-    EXPECT_FLOAT_EQ(aux.slope, p.slope);
+    EXPECT_FLOAT_EQ(aux.foam, p.foam);
     EXPECT_FLOAT_EQ(aux.fade, p.fade);
     if (p.screen.x < 0 || p.screen.y < 0 || p.screen.x >= kWidth || p.screen.y >= kHeight) continue;
     ++on_screen;

@@ -16,7 +16,7 @@ namespace siviflow {
 namespace {
 
 Particle make_particle(uint32_t id, uint16_t slot, glm::vec2 screen, glm::vec3 flow, float speed,
-                       float depth, float slope, float fade, ParticleState state) {
+                       float depth, float foam, float fade, ParticleState state) {
   Particle p;
   p.id = id;
   p.slot = slot;
@@ -24,7 +24,7 @@ Particle make_particle(uint32_t id, uint16_t slot, glm::vec2 screen, glm::vec3 f
   p.flow = flow;
   p.speed = speed;
   p.depth = depth;
-  p.slope = slope;
+  p.foam = foam;
   p.fade = fade;
   p.state = state;
   return p;
@@ -112,11 +112,11 @@ TEST(FlowTextures, EachTexelTakesTheNearestParticleWithinTheCoverRadius) {
   ASSERT_TRUE(read_particle_aux(staging, l, 7, &aux).ok());
   EXPECT_EQ(aux.speed, 0.5f);
   EXPECT_EQ(aux.depth, 1.0f);
-  EXPECT_EQ(aux.slope, 0.02f);
+  EXPECT_EQ(aux.foam, 0.02f);
   EXPECT_EQ(aux.fade, 0.3f);
   for (uint32_t id : {0u, 1u, 4u, 10u}) {
     ASSERT_TRUE(read_particle_aux(staging, l, id, &aux).ok());
-    EXPECT_EQ(aux.speed + aux.depth + aux.slope + aux.fade, 0.0f) << "id " << id;
+    EXPECT_EQ(aux.speed + aux.depth + aux.foam + aux.fade, 0.0f) << "id " << id;
   }
   // Every byte of the block is written (padding included).
   for (size_t i = l.flow_bytes; i < l.aux_offset; ++i) ASSERT_EQ(staging[i], std::byte{0});
@@ -198,12 +198,12 @@ TEST(FlowTextures, PackingRoundTripsAFieldsParticles) {
       ASSERT_TRUE(read_particle_aux(staging, l, id, &aux).ok());
       const auto it = by_slot.find(static_cast<uint16_t>(id));
       if (it == by_slot.end()) {
-        ASSERT_EQ(aux.speed + aux.depth + aux.slope + aux.fade, 0.0f) << "unused id " << id;
+        ASSERT_EQ(aux.speed + aux.depth + aux.foam + aux.fade, 0.0f) << "unused id " << id;
         continue;
       }
       EXPECT_EQ(aux.speed, it->second->speed);
       EXPECT_EQ(aux.depth, it->second->depth);
-      EXPECT_EQ(aux.slope, it->second->slope);
+      EXPECT_EQ(aux.foam, it->second->foam);
       EXPECT_EQ(aux.fade, it->second->fade);
     }
   }

@@ -1,0 +1,78 @@
+// Foam on the river, per vertex, from its flow (issue "water that shows its flow").
+//
+// Which quantity, and why: foam is air the water took in where its flow was disturbed, and it
+// drifts with the current until it bursts. So
+//   - the sources: the flow's velocity gradient |grad u| (Frobenius norm of the 2x2 horizontal
+//     gradient, 1/s), large where the flow speeds up or turns sharply, i.e. at the shoulders of
+//     every obstacle and in tight bends, small in open water; the velocity deficit
+//     1 - speed / (its section's mean speed), large where the water piles up in front of an
+//     obstacle and in the still water in its lee (where a real rock's eddies churn: the
+//     stream function is irrotational and has no eddies of its own); and a line along the banks
+//     as fast as the section flows (the stream function slips at the banks, so the gradient
+//     alone would miss the shear a real bank makes);
+//   - the foam is then carried downstream along the flow, thinning as exp(-t / lifetime): the
+//     steady state of that transport, max(source, foam upstream one step earlier, decayed),
+//     makes the wake, strongest just behind an obstacle and fading with distance.
+// No Vulkan: the renderer hands the values to the GPU with the particles' data.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "sim/river_bvh.h"
+#include "sim/status.h"
+
+namespace siviflow {
+
+struct FoamParams {
+  float gradient_onset = 0.25f;  // 1/s: |grad u| where foam starts (open water stays below)
+  float gradient_full = 1.0f;    // 1/s: where it is full (a boulder's shoulders in 1 m/s water)
+  float deficit_onset = 0.5f;    // velocity deficit where foam starts (banks' own slow water
+                                 // stays below)
+  float deficit_full = 0.9f;     // where it is full (nearly still water)
+  float bank_width_m = 0.5f;     // the bank line's width (falls off as exp(-distance / width))
+  float bank_speed_full = 1.0f;  // m/s past the bank at which its line is full
+  float bank_strength = 0.6f;    // the bank line's foam at full speed
+  float lifetime_s = 8.0f;       // foam decays as exp(-t / lifetime) while carried
+  float step_s = 0.4f;           // transport step
+  uint32_t steps = 30;           // transport steps: the wake is followed for steps * step_s
+};
+
+class FoamField {
+ public:
+  // Adjacency and scratch for the mesh (indices: 3 per triangle; empty, every 3 positions are
+  // one). `section`: each vertex's cross-section (river_surface.h). `bvh` is built on the same
+  // positions and indices; it and the spans outlive this object.
+  static Status create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                       std::span<const uint32_t> section, const RiverBvh* bvh,
+                       const FoamParams& params, FoamField* out);
+
+  // Foam per vertex in [0, 1] for the flow `velocity` (m/s per vertex); `bank_distance`: each
+  // vertex's distance to the nearer margin along its section (metres). Writes `foam` (sized to
+  // the vertices).
+  void compute(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+               std::span<float> foam);
+
+  const FoamParams& params() const { return params_; }
+
+ private:
+  std::span<const glm::vec3> positions_;
+  std::span<const uint32_t> section_;
+  const RiverBvh* bvh_ = nullptr;
+  FoamParams params_;
+  std::vector<uint32_t> ring_start_;  // per vertex: first of its neighbours in ring_
+  std::vector<uint32_t> ring_;        // one-ring neighbours (by shared triangle)
+  // Per vertex: where the flow came from one step earlier (3 vertices and their weights; all 0
+  // weights when that point is off the river).
+  std::vector<uint32_t> upstream_vertex_;
+  std::vector<float> upstream_weight_;
+  std::vector<float> section_speed_;  // per section: its vertices' mean speed
+  std::vector<uint32_t> section_size_;
+  std::vector<float> source_;
+  std::vector<float> scratch_;
+};
+
+}  // namespace siviflow

@@ -1,0 +1,126 @@
+// Foam from the flow (sim/foam.h) in a straight channel with a boulder: none in open water, a
+// wake strongest just behind the boulder and thinning downstream, a line along the moving banks,
+// and a wake that follows the boulder when it moves.
+#include "sim/foam.h"
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "sim/stream_function.h"
+#include "unit/river_test_meshes.h"
+
+namespace siviflow {
+namespace {
+
+// 10 m wide, 60 m long, 0.5 m between vertices, 1 m/s; flow along +z.
+constexpr float kWidth = 10.0f, kLength = 60.0f, kQ = 10.0f, kRadius = 1.0f;
+constexpr uint32_t kSections = 121, kAcross = 21;
+
+class FoamTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mesh_ = test::symmetric_channel(kWidth, kLength, kSections, kAcross);
+    RiverSurface surface;
+    ASSERT_TRUE(RiverSurface::build(mesh_.positions, mesh_.indices, {}, &surface).ok());
+    ASSERT_TRUE(StreamFunction::create(std::move(surface), {kQ, 1.5f, 0.0f}, &flow_).ok());
+    ASSERT_TRUE(RiverBvh::build(mesh_.positions, mesh_.indices, &bvh_).ok());
+    for (size_t v = 0; v < mesh_.positions.size(); ++v) {
+      const RiverVertex vertex = flow_.surface().vertex(v);
+      bank_.push_back(std::min(vertex.d_left, vertex.d_right));
+      section_.push_back(vertex.section);
+    }
+    ASSERT_TRUE(FoamField::create(mesh_.positions, mesh_.indices, section_, &bvh_, FoamParams{},
+                                  &field_).ok());
+  }
+
+  // Foam per vertex for the flow as it is now.
+  std::vector<float> foam() {
+    std::vector<glm::vec3> velocity(mesh_.positions.size());
+    for (size_t v = 0; v < velocity.size(); ++v) velocity[v] = flow_.velocity(v);
+    std::vector<float> out(velocity.size());
+    field_.compute(velocity, bank_, out);
+    return out;
+  }
+
+  // The vertex at (x, z) (the channel's grid).
+  size_t at(float x, float z) const {
+    const auto j = static_cast<size_t>(std::lround((0.5f * kWidth - x) / kWidth * (kAcross - 1)));
+    const auto k = static_cast<size_t>(std::lround(z / kLength * (kSections - 1)));
+    return k * kAcross + j;
+  }
+
+  static Obstacle boulder(float z) {
+    Obstacle o;
+    o.centre = {0.0f, 0.0f, z};
+    o.radius = kRadius;
+    return o;
+  }
+
+  test::TestMesh mesh_;
+  StreamFunction flow_;
+  RiverBvh bvh_;
+  FoamField field_;
+  std::vector<float> bank_;
+  std::vector<uint32_t> section_;
+};
+
+TEST_F(FoamTest, OpenWaterHasFoamOnlyAlongTheBanks) {
+  const std::vector<float> f = foam();
+  for (float z : {10.0f, 30.0f, 50.0f}) {
+    for (float x : {-2.0f, -1.0f, 0.0f, 1.0f, 2.0f}) {
+      EXPECT_LT(f[at(x, z)], 0.05f) << "open water at x " << x << " z " << z;
+    }
+    // The shear of the flow's profile near the banks starts the bank line a little early.
+    EXPECT_LT(f[at(-3.0f, z)], 0.15f);
+    EXPECT_LT(f[at(3.0f, z)], 0.15f);
+    EXPECT_GT(f[at(-5.0f, z)], 0.4f) << "right bank at z " << z;
+    EXPECT_GT(f[at(5.0f, z)], 0.4f) << "left bank at z " << z;
+    EXPECT_LT(f[at(-4.0f, z)], f[at(-5.0f, z)]) << "the bank line thins away from the bank";
+  }
+}
+
+TEST_F(FoamTest, ABoulderLeavesAWakeThatThinsDownstream) {
+  ASSERT_TRUE(flow_.set_obstacles({boulder(20.0f)}).ok());
+  const std::vector<float> f = foam();
+  EXPECT_LT(f[at(0.0f, 12.0f)], 0.05f) << "upstream of the boulder";
+  EXPECT_LT(f[at(2.5f, 28.0f)] + f[at(-2.5f, 28.0f)], 0.6f) << "beside the wake";
+  const float behind = f[at(0.0f, 21.5f)];
+  EXPECT_GT(behind, 0.6f);
+  float last = behind;
+  std::printf("wake on the centreline:");
+  for (float z : {24.0f, 28.0f, 32.0f, 36.0f}) {
+    const float here = f[at(0.0f, z)];
+    std::printf(" z %.0f: %.3f", double(z), double(here));
+    EXPECT_LT(here, last + 1e-4f) << "thinning at z " << z;
+    last = here;
+  }
+  std::printf("\n");
+  EXPECT_GT(f[at(0.0f, 28.0f)], 0.2f) << "still foamy a few metres on";
+  EXPECT_LT(f[at(0.0f, 36.0f)], 0.6f * behind) << "thinner far behind";
+}
+
+TEST_F(FoamTest, TheWakeFollowsAMovedBoulder) {
+  ASSERT_TRUE(flow_.set_obstacles({boulder(20.0f)}).ok());
+  const std::vector<float> before = foam();
+  ASSERT_TRUE(flow_.move_obstacle(0, {0.0f, 0.0f, 40.0f}).ok());
+  const std::vector<float> after = foam();
+  EXPECT_GT(before[at(0.0f, 23.0f)], 0.4f);
+  EXPECT_LT(after[at(0.0f, 23.0f)], 0.05f) << "the old wake is gone";
+  EXPECT_GT(after[at(0.0f, 43.0f)], 0.4f) << "behind the boulder's new place";
+}
+
+TEST(FoamParamsTest, BadParametersAreRefused) {
+  FoamParams params;
+  params.lifetime_s = 0.0f;
+  FoamField field;
+  RiverBvh bvh;
+  const Status status = FoamField::create({}, {}, {}, &bvh, params, &field);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("FoamParams"), std::string::npos) << status.message();
+}
+
+}  // namespace
+}  // namespace siviflow
