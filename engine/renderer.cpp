@@ -291,6 +291,7 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   water_frame.look.water_color = glm::vec4(look.water_color, look.absorption_per_metre);
   water_frame.look.deep_color = glm::vec4(look.deep_color, look.opacity_per_metre);
   water_frame.look.sun_color = glm::vec4(look.sun_color, look.ripple_strength);
+  water_frame.look.foam = glm::vec4(look.foam_color, look.foam_amount);
   water_frame.look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, look.sun_glint,
                                          static_cast<float>(debug_view));
   tile_lattice.place(river->water_lo, river->water_hi, look.tile_size_m, view.camera_position,

@@ -28,6 +28,7 @@ std::string water_look_error(const WaterLook& look, std::string* problem) {
       {"reflection_distortion", look.reflection_distortion, 0.0f, 0.5f},
       {"fresnel_f0", look.fresnel_f0, 0.0f, 1.0f},
       {"sun_glint", look.sun_glint, 0.0f, 10.0f},
+      {"foam_amount", look.foam_amount, 0.0f, 4.0f},
   };
   for (const auto& s : scalars) {
     if (!in_range(s.value, s.lo, s.hi)) {
@@ -41,7 +42,8 @@ std::string water_look_error(const WaterLook& look, std::string* problem) {
     float hi;
   } colors[] = {{"water_color", look.water_color, 1.0f},
                 {"deep_color", look.deep_color, 1.0f},
-                {"sun_color", look.sun_color, 100.0f}};
+                {"sun_color", look.sun_color, 100.0f},
+                {"foam_color", look.foam_color, 1.0f}};
   for (const auto& c : colors) {
     for (int i = 0; i < 3; ++i) {
       if (!in_range(c.value[i], 0.0f, c.hi)) {

@@ -34,6 +34,15 @@ const float kMaxRoughness = 0.45;
 const float kSunIntensity = 8.0;  // at WaterLook::sun_glint 1
 const float kPi = 3.14159265;
 const float kMaxWaterPath = 1.0e4;       // metres: the host's far plane or sky behind the water
+const float kFoamEdge = 0.25;            // ripple-height band over which foam patches fade in
+
+// How much of the water foam covers: where the ripple height through the tiles (moving with the
+// flow) rises above 1 - the foam there, so thin foam is scattered patches on the crests and full
+// foam covers all.
+float foam_coverage(float foam, float pattern) {
+  float density = clamp(foam, 0.0, 1.0);
+  return smoothstep(1.0 - density, 1.0 - density + kFoamEdge, pattern) * min(4.0 * density, 1.0);
+}
 
 void main() {
   // The particle covering this pixel, and by its slot its speed, depth, slope, fade (slot 0, no
@@ -87,6 +96,11 @@ void main() {
   vec3 colour = mix(body, reflection, fresnel);
   float alpha = clamp(mix(opacity, 1.0, fresnel), 0.0, 1.0) * shore;
 
+  // Foam: opaque, diffusely lit, over the water's colour (thinning out with the shore's water).
+  float foam = foam_coverage(tdf.foam * look.foam.w, tdf.foam_pattern) * shore;
+  colour = mix(colour, look.foam.rgb * light, foam);
+  alpha = mix(alpha, shore, foam);
+
   // Sunlight: the sun's specular glint on the rippled surface (GGX distribution, Schlick Fresnel,
   // no shadowing), as broad as the applied ripples make the water rough: sharp glints on calm
   // water, a broad sheen on rough. It is light the surface adds, whatever shows through it:
@@ -106,7 +120,7 @@ void main() {
   float lit = step(0.0, dot(n, sun)) * step(0.0, sun.y);
   vec3 glint = look.sun_color.rgb * (kSunIntensity * look.surface.z * distribution * sun_fresnel * lit /
                                      (4.0 * max(cos_theta, 0.1)));
-  colour += glint * shore / max(alpha, 1e-3);
+  colour += glint * (shore * (1.0 - foam)) / max(alpha, 1e-3);  // foam is rough: no glint
   out_color = vec4(colour, alpha);
   int debug_view = int(look.surface.w);
   if (debug_view != kDebugViewNone) {

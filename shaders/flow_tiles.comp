@@ -2,14 +2,15 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared.h"
 #include "tdf_tile_table.glsl"
-// The tile table of this frame (shared.h): per lattice point near the camera, the flow at the
-// tile centre and what the water material derives from it (tdf_encode_tile). One invocation
+// The tile table of this frame (shared.h): per lattice point near the camera, the flow and foam
+// at the tile centre and what the water material derives from them (tdf_encode_tile). One invocation
 // per table texel.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant) uniform Push { FlowTileConstants tiles; };
 layout(set = 0, binding = 0) uniform usampler2D flow_texture;   // shared.h layout, texelFetch only
 layout(set = 0, binding = 1) uniform sampler2D water_heights;   // R32_SFLOAT, texelFetch only
 layout(set = 0, binding = 2, rgba32ui) uniform writeonly uimage2D tile_table;
+layout(set = 0, binding = 3) uniform sampler2D particle_aux;    // shared.h layout, texelFetch only
 
 // Nearest first: the point itself, then its axis neighbours, then the diagonal ones.
 const ivec2 kSearch[9] = ivec2[9](ivec2(0, 0), ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
@@ -45,9 +46,12 @@ void main() {
     if (found.r == SIVIFLOW_PARTICLE_NONE && inside) found = t;
   }
   vec3 flow = found.r == SIVIFLOW_PARTICLE_NONE ? vec3(0.0) : tdf_texel_flow(found);
+  // (Slot 0, no particle, reads the aux texture's all-zero texel 0: no foam.)
+  float foam = texelFetch(particle_aux, ivec2(found.r % SIVIFLOW_AUX_WIDTH,
+                                              found.r / SIVIFLOW_AUX_WIDTH), 0).b;
   float cycles_per_mps =
       kTdfAdvection * SIVIFLOW_TDF_TIME_PERIOD / (tiles.heights.w * tiles.ripples.x);
   imageStore(tile_table, texel,
-             tdf_encode_tile(lattice, flow, tiles.screen.w / SIVIFLOW_TDF_TIME_PERIOD, cycles_per_mps,
+             tdf_encode_tile(lattice, flow, foam, tiles.screen.w / SIVIFLOW_TDF_TIME_PERIOD, cycles_per_mps,
                              tiles.ripples.x));
 }

@@ -106,6 +106,7 @@ struct WaterLookConstants {
   vec4 surface;      // x Fresnel reflectance at normal incidence, y normal-map repeat in tiles
                      // (the ripples' size), z the sun glint's strength, w the debug view
                      // (siviflow::DebugView as a float; 0 the water's look)
+  vec4 foam;         // rgb linear colour of foam, w foam amount
 };
 
 // Push constants of the flow pass (the water material).
@@ -130,7 +131,9 @@ struct FlowConstants {
 //   .r  .g  float bits of (a, b): the tile's map transform M = mat2(a, -b, b, a), its rotation
 //           by the flow direction times the map repeats per tile (its length also gives the
 //           roughness, tdf_back_rotation)
-//   .b  .a  float bits of the map offset at the tile centre: hashed offset minus the scroll
+//   .b      the map offset at the tile centre (hashed offset minus the scroll, mod 1) as two
+//           16-bit unorms (packUnorm2x16)
+//   .a      float bits of the foam at the tile centre (0..1, the particle's, sim/foam.h)
 #define SIVIFLOW_TILE_TABLE_MAX 512u
 // Water heights (R32_SFLOAT, world-aligned samples, see FlowTileConstants.heights) are this or
 // more where no water is near: the lattice points there are no tile of any water fragment.
@@ -156,7 +159,7 @@ struct FlowTileConstants {
 #ifdef __cplusplus
 static_assert(sizeof(FlowConstants) == 128);
 static_assert(sizeof(FlowTileConstants) == 128);
-static_assert(sizeof(WaterLookConstants) == 64);
+static_assert(sizeof(WaterLookConstants) == 80);
 static_assert(offsetof(FlowTileConstants, lattice) == 64);
 static_assert(offsetof(FlowTileConstants, heights) == 80);
 static_assert(offsetof(FlowTileConstants, screen) == 96);

@@ -32,10 +32,10 @@ vec2 tdf_tile_offset(ivec2 cell, int grid) {
 }
 
 // The tile table texel (shared.h) of the tile centred on lattice point `lattice`, whose flow is
-// `flow` (world m/s; zero for still water).
+// `flow` (world m/s; zero for still water) and foam `foam` (0..1).
 //   cycles_per_mps: scroll cycles per period per m/s of scaled speed; periods: time / period;
 //   repeat_tiles: tiles per normal-map repeat at scale 1 (the ripples' size).
-uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float periods, float cycles_per_mps,
+uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float foam, float periods, float cycles_per_mps,
                       float repeat_tiles) {
   // Lattice (2c + 1, .) is grid A's tile c, (2c, .) the grid offset by half a tile, per axis.
   int grid = int((lattice.x & 1) == 0) + 2 * int((lattice.y & 1) == 0);
@@ -50,8 +50,9 @@ uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float periods, float cycles_per_
   float cycles = round(speed * scale * cycles_per_mps * kTdfGridSpeed[grid]);
   float phase = fract(cycles * periods + kTdfGridPhase[grid]);
   // Subtracting the phase after M moves the pattern along +dir, i.e. downstream.
-  vec2 offset = tdf_tile_offset(cell, grid) - vec2(phase, 0.0);
-  return uvec4(floatBitsToUint(ab), floatBitsToUint(offset));
+  // The map tiles, so the offset keeps only its fraction: 16 bits each resolve 1/65536 of it.
+  vec2 offset = fract(tdf_tile_offset(cell, grid) - vec2(phase, 0.0));
+  return uvec4(floatBitsToUint(ab), packUnorm2x16(offset), floatBitsToUint(foam));
 }
 
 // R(+angle) scaled by the roughness, which turns a tile's sampled tilt back into world x/z: both

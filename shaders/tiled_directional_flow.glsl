@@ -45,19 +45,24 @@ struct TdfResult {
   vec3 normal;  // final water normal, world space, unit length (the `normal` AOV)
   vec2 tilt;    // blended, rescaled, strength-scaled N.xy along world x and z (|tilt| <= 0.95):
                 // the natural input of a screen-space reflection offset
+  float foam;          // the tiles' foam (0..1), blended as the ripples are
+  float foam_pattern;  // the ripples' height (normal map A, 0..1, mean 0.5) through the same
+                       // tiles, contrast restored: foam drawn from it moves with the ripples
 };
 
-// One tile of one grid: its normal-map sample, as a tangent tilt along world x/z.
+// One tile of one grid: its normal-map sample, as a tangent tilt along world x/z (xy), the
+// tile's foam (z) and the ripple height there (w).
 //   u: the fragment in tile units; lattice: the tile centre's lattice point.
-vec2 tdf_tile_sample(vec2 u, ivec2 lattice, vec2 du_dx, vec2 du_dy, float repeat_tiles,
+vec4 tdf_tile_sample(vec2 u, ivec2 lattice, vec2 du_dx, vec2 du_dy, float repeat_tiles,
                      usampler2D tile_table, sampler2D normal_map) {
   uvec4 tile = texelFetch(tile_table, lattice & (textureSize(tile_table, 0) - 1), 0);
   vec2 ab = uintBitsToFloat(tile.rg);
   vec2 back = tdf_back_rotation(ab, repeat_tiles);
   mat2 m = mat2(ab.x, -ab.y, ab.y, ab.x);
-  vec2 s = m * (u - 0.5 * vec2(lattice)) + uintBitsToFloat(tile.ba);
-  vec2 n = textureGrad(normal_map, s, m * du_dx, m * du_dy).rg * 2.0 - 1.0;
-  return mat2(back.x, back.y, -back.y, back.x) * n;
+  vec2 s = m * (u - 0.5 * vec2(lattice)) + unpackUnorm2x16(tile.b);
+  vec4 texel = textureGrad(normal_map, s, m * du_dx, m * du_dy);
+  vec2 n = texel.rg * 2.0 - 1.0;
+  return vec4(mat2(back.x, back.y, -back.y, back.x) * n, uintBitsToFloat(tile.a), texel.a);
 }
 
 // The Tiled Directional Flow normal of a water fragment.
@@ -75,7 +80,7 @@ TdfResult tdf_normal(vec3 world, vec3 surface_normal, float strength, float tile
   // 2 cell + 1 - 2 offset_k.
   const vec2 kOffsets[4] = vec2[4](vec2(0.0), vec2(0.5, 0.0), vec2(0.0, 0.5), vec2(0.5));
   const ivec2 kCentres[4] = ivec2[4](ivec2(1), ivec2(0, 1), ivec2(1, 0), ivec2(0));
-  vec2 n[4];
+  vec4 n[4];
   for (int k = 0; k < 4; ++k) {
     ivec2 lattice = 2 * ivec2(floor(u + kOffsets[k])) + kCentres[k];
     n[k] = tdf_tile_sample(u, lattice, du_dx, du_dy, repeat_tiles, tile_table, normal_map);
@@ -83,13 +88,14 @@ TdfResult tdf_normal(vec3 world, vec3 surface_normal, float strength, float tile
   // van Hoesel's weights: ff = 1 at the centre of grid A's tile, 0 at its edges (per axis).
   vec2 g = abs(2.0 * fract(u) - 1.0) - 0.5;
   vec2 ff = 0.5 - 4.0 * g * g * g;
-  vec2 n_ab = ff.x * n[0] + (1.0 - ff.x) * n[1];
-  vec2 n_cd = ff.x * n[2] + (1.0 - ff.x) * n[3];
-  vec2 tilt = ff.y * n_ab + (1.0 - ff.y) * n_cd;
+  vec4 n_ab = ff.x * n[0] + (1.0 - ff.x) * n[1];
+  vec4 n_cd = ff.x * n[2] + (1.0 - ff.x) * n[3];
+  vec4 blended = ff.y * n_ab + (1.0 - ff.y) * n_cd;
   // Restore the contrast the blend of uncorrelated samples took away: per axis
   // sqrt(ff^2 + (1 - ff)^2), both axes under one root. 0.5: van Hoesel's N is rg - 0.5.
   vec2 ff_sq = ff * ff + (1.0 - ff) * (1.0 - ff);
-  tilt *= 0.5 * strength * inversesqrt(ff_sq.x * ff_sq.y);
+  float contrast = inversesqrt(ff_sq.x * ff_sq.y);
+  vec2 tilt = blended.xy * (0.5 * strength * contrast);
   float len_sq = dot(tilt, tilt);
   if (len_sq > kTdfMaxTilt * kTdfMaxTilt) {
     tilt *= kTdfMaxTilt * inversesqrt(len_sq);
@@ -104,6 +110,8 @@ TdfResult tdf_normal(vec3 world, vec3 surface_normal, float strength, float tile
   TdfResult result;
   result.normal = tx * tilt.x + tz * tilt.y + up * z;
   result.tilt = tilt;
+  result.foam = blended.z;
+  result.foam_pattern = clamp(0.5 + (blended.w - 0.5) * contrast, 0.0, 1.0);
   return result;
 }
 

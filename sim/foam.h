@@ -28,8 +28,8 @@
 namespace siviflow {
 
 struct FoamParams {
-  float gradient_onset = 0.25f;  // 1/s: |grad u| where foam starts (open water stays below)
-  float gradient_full = 1.0f;    // 1/s: where it is full (a boulder's shoulders in 1 m/s water)
+  float gradient_onset = 0.35f;  // 1/s: |grad u| where foam starts (open water stays below)
+  float gradient_full = 1.2f;    // 1/s: where it is full (a boulder's shoulders in 1 m/s water)
   float deficit_onset = 0.5f;    // velocity deficit where foam starts (banks' own slow water
                                  // stays below)
   float deficit_full = 0.9f;     // where it is full (nearly still water)

@@ -25,10 +25,10 @@ constexpr std::array<VkDescriptorType, kBindingCount> kMaterialBindings = {
 // the specification allows, so no device query is needed.
 constexpr VkDeviceSize kLookStride = 256;
 static_assert(sizeof(gpu::WaterLookConstants) <= kLookStride);
-// Bindings of shaders/flow_tiles.comp: flow texture, water heights, tile table.
-constexpr std::array<VkDescriptorType, 3> kTileBindings = {
+// Bindings of shaders/flow_tiles.comp: flow texture, water heights, tile table, particle aux.
+constexpr std::array<VkDescriptorType, 4> kTileBindings = {
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+    VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
 constexpr uint32_t kTileGroupSide = 8;  // flow_tiles.comp's local size
 
 }  // namespace
@@ -132,7 +132,8 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   const std::array<VkDescriptorImageInfo, kTileBindings.size()> tiles{
       {{nearest_, textures.flow, read},
        {nearest_, textures.water_heights, read},
-       {VK_NULL_HANDLE, textures.tile_table, VK_IMAGE_LAYOUT_GENERAL}}};
+       {VK_NULL_HANDLE, textures.tile_table, VK_IMAGE_LAYOUT_GENERAL},
+       {nearest_, textures.aux, read}}};
   std::vector<VkWriteDescriptorSet> writes;
   const auto write = [&writes](VkDescriptorSet set, std::span<const VkDescriptorType> types,
                                std::span<const VkDescriptorImageInfo> images) {
@@ -210,6 +211,7 @@ void FlowPass::declare_tiles(FrameGraph& graph, Handles* handles) {
   handles->tile_table = pass.storage_write(handles->tile_table);  // every texel written
   pass.sampled(handles->flow, ShaderStage::Compute);
   pass.sampled(handles->water_heights, ShaderStage::Compute);
+  pass.sampled(handles->aux, ShaderStage::Compute);
   const ImageHandle table = handles->tile_table;
   const DataHandle<Frame> frame = frame_data_;
   pass.record([this, table, frame](const PassContext& ctx) {

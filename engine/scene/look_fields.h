@@ -19,7 +19,7 @@ struct LookVectorField {
   glm::vec3 WaterLook::*member;
 };
 
-inline constexpr std::array<LookScalarField, 8> kLookScalarFields{{
+inline constexpr std::array<LookScalarField, 9> kLookScalarFields{{
     {"absorption_per_metre", &WaterLook::absorption_per_metre},
     {"opacity_per_metre", &WaterLook::opacity_per_metre},
     {"ripple_strength", &WaterLook::ripple_strength},
@@ -28,12 +28,14 @@ inline constexpr std::array<LookScalarField, 8> kLookScalarFields{{
     {"reflection_distortion", &WaterLook::reflection_distortion},
     {"fresnel_f0", &WaterLook::fresnel_f0},
     {"sun_glint", &WaterLook::sun_glint},
+    {"foam_amount", &WaterLook::foam_amount},
 }};
-inline constexpr std::array<LookVectorField, 4> kLookVectorFields{{
+inline constexpr std::array<LookVectorField, 5> kLookVectorFields{{
     {"water_color", &WaterLook::water_color},
     {"deep_color", &WaterLook::deep_color},
     {"sun_direction", &WaterLook::sun_direction},
     {"sun_color", &WaterLook::sun_color},
+    {"foam_color", &WaterLook::foam_color},
 }};
 
 }  // namespace siviflow

@@ -18,7 +18,7 @@ struct Range {
 Range scalar_range(const char* name) {
   const std::string n = name;
   if (n == "absorption_per_metre" || n == "opacity_per_metre") return {0.0f, 20.0f};
-  if (n == "ripple_strength") return {0.0f, 4.0f};
+  if (n == "ripple_strength" || n == "foam_amount") return {0.0f, 4.0f};
   if (n == "ripple_scale") return {0.25f, 4.0f};
   if (n == "tile_size_m") return {kMinTileSizeM, kMaxTileSizeM};
   if (n == "reflection_distortion") return {0.0f, 0.5f};

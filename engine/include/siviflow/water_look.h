@@ -25,6 +25,10 @@ struct WaterLook {
   glm::vec3 sun_direction{0.45f, 0.62f, 0.35f};  // towards the sun, finite, any non-zero length
   glm::vec3 sun_color{1.0f, 1.0f, 1.0f};  // linear multiplier of sunlit water, each in [0, 100]
   float sun_glint = 1.0f;  // strength of the sun's specular glint on the water, in [0, 10]
+  // Foam where the flow is disturbed (wakes, banks, fast turns; sim/foam.h gives where), in
+  // [0, 4]: 0 none, 1 as the flow makes it, more spreads it further.
+  float foam_amount = 1.0f;
+  glm::vec3 foam_color{0.80f, 0.82f, 0.82f};  // linear RGB of foam in full light, each in [0, 1]
 };
 
 // Range limits of the tile size: the renderer sizes its water heights for the largest.
