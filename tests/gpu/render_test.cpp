@@ -235,8 +235,9 @@ TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
   EXPECT_GE(own_texel * 100, on_screen * 95);
 }
 
-// Each tile of the water's Tiled Directional Flow takes the flow of the particle under its centre:
-// the tile table turns the map along that flow and scales it with its speed. Checked where that
+// Each tile of the water's Tiled Directional Flow takes the flow and foam of the particle under
+// its centre: the tile table turns the map along that flow and scales it with its speed, and
+// carries the foam as it is. Checked where that
 // particle lies within a tile of the centre: tiles farther from water are no water pixel's.
 TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
   const std::vector<Frame> frames = render(0, 2);
@@ -247,6 +248,7 @@ TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
   const FlowTextureLayout& layout = flow_texture_layout(*renderer_);
   std::vector<std::byte> staging(layout.total_bytes);
   std::memcpy(staging.data() + layout.flow_offset, frame.flow_texture.data(), layout.flow_bytes);
+  std::memcpy(staging.data() + layout.aux_offset, frame.particle_aux.data(), layout.aux_bytes);
   const glm::mat4 view_proj = view_proj_of(world_->scene_camera(1.0 / 30.0), kWidth, kHeight);
   const float water_level = particle_field(*renderer_).particles().front().world.y;  // level river
   const glm::vec2 texels = glm::vec2(kWidth, kHeight) / float(layout.texel_px);
@@ -256,6 +258,7 @@ TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
   for (const Particle& p : particle_field(*renderer_).particles()) particle_at[p.slot] = p.world;
   size_t checked = 0;
   size_t agreeing = 0;
+  size_t foamy = 0;
   for (int y = 0; y < size.y; ++y) {
     for (int x = 0; x < size.x; ++x) {
       const glm::ivec2 lattice = corner + ((glm::ivec2(x, y) - corner) & (size - 1));
@@ -284,16 +287,24 @@ TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
       // Map repeats per tile: 1 / 3.5 in still water, 1.5 / 3.5 from 1.5 m/s.
       const float scale = glm::mix(1.0f, 1.5f, std::clamp(speed / 1.5f, 0.0f, 1.0f)) / 3.5f;
       const float cos_angle = glm::dot(ab, glm::vec2(flow.x, flow.z)) / (glm::length(ab) * speed);
-      if (cos_angle > std::cos(glm::radians(0.5f)) && std::abs(glm::length(ab) - scale) < 1e-4f) {
+      gpu::ParticleAux aux{};
+      ASSERT_TRUE(read_particle_aux(staging, layout, texel.id, &aux).ok());
+      float foam = 0.0f;
+      std::memcpy(&foam, tile + 3, sizeof(foam));
+      if (foam > 0.0f) ++foamy;
+      if (cos_angle > std::cos(glm::radians(0.5f)) && std::abs(glm::length(ab) - scale) < 1e-4f &&
+          foam == aux.foam) {
         ++agreeing;
       } else {
         ADD_FAILURE() << "lattice point (" << lattice.x << ", " << lattice.y << "): flow ("
-                      << flow.x << ", " << flow.z << "), table (" << ab.x << ", " << ab.y << ")";
+                      << flow.x << ", " << flow.z << "), table (" << ab.x << ", " << ab.y
+                      << "), foam " << foam << " against the particle's " << aux.foam;
       }
     }
   }
   EXPECT_GT(checked, 100u);
   EXPECT_EQ(agreeing, checked);
+  EXPECT_GT(foamy, 0u) << "some tiles near the banks carry foam";
 }
 
 // On a river longer than the tile table reaches (1.6 km against 768 m), the table's window lies

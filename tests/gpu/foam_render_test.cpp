@@ -1,0 +1,86 @@
+// The water draws its foam where the flow made it: the pixels that foam whitens are those whose
+// particles carry foam (sim/foam.h, through the aux texture and the tile table), open water stays
+// clear, and foam_amount 0 draws none.
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "render_frames.h"
+#include "shaders/shared.h"
+#include "renderer_inspect.h"
+#include "sim/flow_textures.h"
+
+namespace siviflow::testing {
+namespace {
+
+class FoamRenderTest : public RenderTest {
+ protected:
+  // Frame 3 of the default scene with the default look but `foam_amount`.
+  Frame frame_with_foam(float foam_amount) {
+    renderer_.reset();
+    world_.reset();
+    Status status = create_renderer(make_create_info(kWidth, kHeight));
+    EXPECT_TRUE(status.ok()) << status.message();
+    WaterLook look;
+    look.foam_amount = foam_amount;
+    status = renderer_->set_look(look);
+    EXPECT_TRUE(status.ok()) << status.message();
+    std::vector<Frame> frames = render(0, 4);
+    return frames.empty() ? Frame{} : frames.back();
+  }
+};
+
+double luminance(const float* rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+
+TEST_F(FoamRenderTest, FoamWhitensTheWaterWhoseParticlesCarryFoam) {
+  const Frame clear = frame_with_foam(0.0f);
+  const Frame foamy = frame_with_foam(1.0f);
+  ASSERT_FALSE(clear.rgba.empty());
+  ASSERT_FALSE(foamy.rgba.empty());
+  EXPECT_EQ(clear.flow_texture, foamy.flow_texture) << "the look does not move the particles";
+  const FlowTextureLayout& layout = flow_texture_layout(*renderer_);
+  std::vector<std::byte> staging(layout.total_bytes);
+  std::memcpy(staging.data() + layout.flow_offset, foamy.flow_texture.data(), layout.flow_bytes);
+  std::memcpy(staging.data() + layout.aux_offset, foamy.particle_aux.data(), layout.aux_bytes);
+  // Foam shows as patches where the ripples rise above 1 - foam: the more foam a particle
+  // carries, the more of its pixels are white; none where it carries none.
+  size_t whitened[2] = {}, pixels[2] = {};  // [0] particles with no foam, [1] with foam > 0.5
+  size_t water = 0, darkened = 0, whitened_all = 0;
+  for (uint32_t y = 0; y < kHeight; ++y) {
+    for (uint32_t x = 0; x < kWidth; ++x) {
+      if (foamy.water_mask[size_t{y} * kWidth + x] != 1.0f) continue;
+      ++water;
+      gpu::FlowTexel texel{};
+      ASSERT_TRUE(read_flow_texel(staging, layout, x / layout.texel_px, y / layout.texel_px,
+                                  &texel).ok());
+      if (texel.id == SIVIFLOW_PARTICLE_NONE) continue;
+      gpu::ParticleAux aux{};
+      ASSERT_TRUE(read_particle_aux(staging, layout, texel.id, &aux).ok());
+      const double change = luminance(foamy.pixel(x, y)) - luminance(clear.pixel(x, y));
+      whitened_all += change > 0.05 ? 1 : 0;
+      darkened += change < -0.05 ? 1 : 0;  // foam hides a glint
+      const int bin = aux.foam < 0.02f ? 0 : aux.foam > 0.5f ? 1 : -1;
+      if (bin < 0) continue;
+      ++pixels[bin];
+      whitened[bin] += change > 0.05 ? 1 : 0;
+    }
+  }
+  ASSERT_GT(water, 2000u);
+  ASSERT_GT(pixels[0], water / 10);
+  ASSERT_GT(pixels[1], water / 100);
+  const double share[2] = {double(whitened[0]) / pixels[0], double(whitened[1]) / pixels[1]};
+  std::printf("foam: %zu of %zu water pixels whitened, %zu darker; whitened share where the "
+              "particle has no foam %.3f (%zu px), foam > 0.5 %.3f (%zu px)\n", whitened_all,
+              water, darkened, share[0], pixels[0], share[1], pixels[1]);
+  EXPECT_GT(whitened_all, water / 100) << "foam shows";
+  EXPECT_LT(whitened_all, water / 2) << "most of the river is open water";
+  // Foam from a neighbouring tile may reach into a clear particle's pixels (tiles blend).
+  EXPECT_LT(share[0], 0.05) << "open water stays clear";
+  EXPECT_GT(share[1], 0.15) << "foamy water shows foam";
+  EXPECT_LT(darkened, water / 50);
+}
+
+}  // namespace
+}  // namespace siviflow::testing
