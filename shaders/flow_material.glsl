@@ -45,9 +45,9 @@ float foam_coverage(float foam, float pattern) {
 }
 
 void main() {
-  // The particle covering this pixel, and by its slot its speed, depth, slope, fade (slot 0, no
-  // particle, reads the aux texture's all-zero texel 0: no branch needed). Its flow reaches the
-  // ripples through the tile table.
+  // The particle covering this pixel, and by its slot its fade (slot 0, no particle, reads the
+  // aux texture's all-zero texel 0: no branch needed). Its flow and foam reach the ripples
+  // through the tile table.
   vec2 pixel = gl_FragCoord.xy - flow.screen.xy;  // in the view's viewport
   uvec4 texel = texelFetch(flow_texture, ivec2(pixel * (1.0 / flow.water.w)), 0);
   uint own = texel.r;
