@@ -390,7 +390,7 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
   // The AOV attachments are the view's size: they cannot sit at an offset in the host's images.
   if ((info.readback_images & kAovReadbackImages) != 0 &&
       (viewport.offset.x != 0 || viewport.offset.y != 0)) {
-    return argument_error("with the water mask, normal or reflection read back, View::viewport "
+    return argument_error("with the water mask, normal, reflection or foam read back, View::viewport "
                           "must start at the images' origin");
   }
   SIVIFLOW_TRY(check(inputs.color, "color", info.color_format,

@@ -92,6 +92,7 @@ Status Renderer::Impl::declare_graph() {
     water.normal = frame_image(graph.create_image({"water normal", FlowPass::kNormalFormat, extent, transparent}));
     water.reflection_sample = frame_image(
         graph.create_image({"reflection sample", FlowPass::kReflectionFormat, extent, transparent}));
+    water.foam = frame_image(graph.create_image({"foam", FlowPass::kFoamFormat, extent, transparent}));
   }
   water.water_heights = river_assets.images[SharedRiver::kWaterHeights];
   water.tile_table = frame_image(graph.create_image(
@@ -113,7 +114,8 @@ Status Renderer::Impl::declare_graph() {
                                                      frame_uploads.images[1].destination,
                                                      water.normal,
                                                      water.reflection_sample,
-                                                     water.tile_table};
+                                                     water.tile_table,
+                                                     water.foam};
     readbacks.clear();
     readback_kinds.clear();
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
@@ -244,6 +246,7 @@ VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
       return pixels * texel_bytes(impl_->info.color_format);
     case ReadbackImage::kDepth:
     case ReadbackImage::kWaterMask:
+    case ReadbackImage::kFoam:
       return pixels * sizeof(float);
     case ReadbackImage::kFlowTexture:
       return impl_->simulation.layout().flow_bytes;
@@ -277,6 +280,8 @@ const char* readback_image_name(ReadbackImage image) {
       return "readback reflection sample";
     case ReadbackImage::kTileTable:
       return "readback tile table";
+    case ReadbackImage::kFoam:
+      return "readback foam";
   }
   return "readback";
 }

@@ -1,5 +1,5 @@
 // The water material of Algorithm 3, shared by flow.frag (beauty only) and flow_aovs.frag
-// (beauty plus the water mask, normal and reflection AOVs, with SIVIFLOW_FLOW_AOVS defined).
+// (beauty plus the water mask, normal, reflection and foam AOVs, with SIVIFLOW_FLOW_AOVS defined).
 #extension GL_GOOGLE_include_directive : require
 #include "shared.h"
 #include "sky_common.glsl"
@@ -21,6 +21,7 @@ layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_mask;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_reflection;
+layout(location = 4) out float out_foam;
 #endif
 
 // Tunables of the material that are not the artist's look (that comes in `look`).
@@ -131,5 +132,6 @@ void main() {
   out_mask = 1.0;
   out_normal = vec4(n, 1.0);
   out_reflection = vec4(reflection, 1.0);
+  out_foam = foam;
 #endif
 }

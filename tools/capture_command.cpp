@@ -57,6 +57,7 @@ struct CaptureOptions {
   bool particles_aov = false;  // particle.id and frame_NNNNN.particles.csv
   bool normal_aov = false;     // normal.X/Y/Z
   bool reflection_aov = false; // reflection.R/G/B
+  bool foam_aov = false;       // foam.Y
 };
 
 void print_help() {
@@ -82,6 +83,7 @@ void print_help() {
       "                 normal     normal.X/Y/Z: the final water normal in world space (0 off water)\n"
       "                 reflection reflection.R/G/B: the reflection sample of the water before\n"
       "                            blending (0 off water)\n"
+      "                 foam       foam.Y: how much of the water foam covers, 0 none to 1 full\n"
       "  --preview      also write DIR/frame_NNNNN.png (sRGB, clamped)\n"
       "  --validation   run with the Khronos validation layer; any error fails the capture\n");
 }
@@ -132,9 +134,11 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
           options->normal_aov = true;
         } else if (aov == "reflection") {
           options->reflection_aov = true;
+        } else if (aov == "foam") {
+          options->foam_aov = true;
         } else {
           return Status::error("--aov: unknown AOV '" + aov +
-                               "' (available: depth, flow, particles, normal, reflection)");
+                               "' (available: depth, flow, particles, normal, reflection, foam)");
         }
       }
     } else if (arg == "--preview") {
@@ -195,6 +199,7 @@ struct FinishedFrame {
   std::vector<std::byte> flow_texture;  // as uploaded: shaders/shared.h FlowTexel per texel
   std::vector<float> normal;            // RGBA per pixel
   std::vector<float> reflection;        // RGBA per pixel
+  std::vector<float> foam;
   std::vector<Particle> particles;
 };
 
@@ -236,8 +241,8 @@ class Capture {
 Status Capture::run() {
   const size_t river_count = scene_.has_value() ? scene_->rivers.size() : 1;
   if (river_count > 1 && (options_.flow_aov || options_.particles_aov || options_.normal_aov ||
-                          options_.reflection_aov)) {
-    return Status::error("--aov flow, particles, normal and reflection are of one river; the scene has " +
+                          options_.reflection_aov || options_.foam_aov)) {
+    return Status::error("--aov flow, particles, normal, reflection and foam are of one river; the scene has " +
                          std::to_string(river_count) + " (depth works with any number)");
   }
   HeadlessContextOptions context_options;
@@ -359,6 +364,7 @@ uint32_t Capture::readback_images() const {
   }
   if (options_.normal_aov) images |= readback_bit(ReadbackImage::kNormal);
   if (options_.reflection_aov) images |= readback_bit(ReadbackImage::kReflection);
+  if (options_.foam_aov) images |= readback_bit(ReadbackImage::kFoam);
   return images;
 }
 
@@ -380,6 +386,7 @@ void Capture::copy_out(const SlotTargets& slot) {
        &finished_.flow_texture);
   copy(ReadbackImage::kNormal, pixels * 4, &finished_.normal);
   copy(ReadbackImage::kReflection, pixels * 4, &finished_.reflection);
+  copy(ReadbackImage::kFoam, pixels, &finished_.foam);
   finished_.particles = slot.particles;
 }
 
@@ -454,6 +461,7 @@ Status Capture::write_frame() {
     static const char* const kNames[3] = {"reflection.R", "reflection.G", "reflection.B"};
     add_planes(finished_.reflection, reflection_, kNames);
   }
+  if (options_.foam_aov) frame.channels.push_back({"foam.Y", finished_.foam.data()});
   frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
   frame.metadata.frame = static_cast<int>(finished_.frame);
   frame.metadata.time_seconds = static_cast<float>(finished_.frame / options_.fps);

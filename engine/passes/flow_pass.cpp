@@ -53,7 +53,7 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
   desc.fragment_shader = with_aovs ? "flow_aovs.frag" : "flow.frag";
   desc.layout = layout_;
   desc.color_format = color_format;
-  if (with_aovs) desc.extra_color_formats = {kMaskFormat, kNormalFormat, kReflectionFormat};
+  if (with_aovs) desc.extra_color_formats = {kMaskFormat, kNormalFormat, kReflectionFormat, kFoamFormat};
   desc.depth_format = depth_format;
   desc.depth_write = false;
   desc.dynamic_depth_compare = true;  // the host's depth convention, per frame
@@ -188,6 +188,7 @@ void FlowPass::declare(FrameGraph& graph, uint32_t index_count, Handles* handles
     handles->mask = pass.color_write(handles->mask, LoadOp::Clear);
     handles->normal = pass.color_write(handles->normal, LoadOp::Clear);
     handles->reflection_sample = pass.color_write(handles->reflection_sample, LoadOp::Clear);
+    handles->foam = pass.color_write(handles->foam, LoadOp::Clear);
   }
   pass.depth_read(handles->depth);
   pass.sampled_fragment(handles->depth);

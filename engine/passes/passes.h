@@ -64,12 +64,13 @@ DataHandle<ReflectionView> add_reflection_pass(FrameGraph& graph, ImageHandle* c
 // Flow tile centre near the camera; then per fragment the particle (flow texture, aux data by
 // slot), the Tiled Directional Flow normal from the table, the reflection sampled with that
 // normal, depth colour and shore fade, blended over the scene's colour. With AOVs it also writes
-// the water mask, the normal and the reflection sample, unblended.
+// the water mask, the normal, the reflection sample and the foam coverage, unblended.
 class FlowPass {
  public:
   static constexpr VkFormat kMaskFormat = VK_FORMAT_R32_SFLOAT;
   static constexpr VkFormat kNormalFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
   static constexpr VkFormat kReflectionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+  static constexpr VkFormat kFoamFormat = VK_FORMAT_R32_SFLOAT;
 
   static constexpr VkFormat kTileTableFormat = VK_FORMAT_R32G32B32A32_UINT;  // shaders/shared.h
   static constexpr VkFormat kWaterHeightsFormat = VK_FORMAT_R32_SFLOAT;
@@ -126,6 +127,7 @@ class FlowPass {
     ImageHandle mask;        // AOVs, written when created with_aovs
     ImageHandle normal;
     ImageHandle reflection_sample;
+    ImageHandle foam;
   };
   // The tile table of this frame (shaders/flow_tiles.comp), before declare; the new version of
   // handles->tile_table goes back into `handles`.

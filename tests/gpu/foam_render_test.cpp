@@ -1,6 +1,7 @@
 // The water draws its foam where the flow made it: the pixels that foam whitens are those whose
 // particles carry foam (sim/foam.h, through the aux texture and the tile table), open water stays
-// clear, and foam_amount 0 draws none.
+// clear, and foam_amount 0 draws none; behind a boulder the foam AOV shows its wake, which
+// follows the boulder in the very next frame when it moves.
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -8,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "render_frames.h"
+#include "straight_channel.h"
 #include "shaders/shared.h"
 #include "renderer_inspect.h"
 #include "sim/flow_textures.h"
@@ -80,6 +82,65 @@ TEST_F(FoamRenderTest, FoamWhitensTheWaterWhoseParticlesCarryFoam) {
   EXPECT_LT(share[0], 0.05) << "open water stays clear";
   EXPECT_GT(share[1], 0.15) << "foamy water shows foam";
   EXPECT_LT(darkened, water / 50);
+}
+
+class FoamWakeTest : public StraightChannelTest {
+ protected:
+  struct Wake {
+    double downstream = 0.0;  // mean foam.Y within four radii downstream of the boulder
+    double upstream = 0.0;    // and the same upstream
+    double foamy_share = 0.0; // of the water with foam.Y above 0.1
+  };
+
+  // The water pixels within four radii of the boulder's edge at `centre`, more than a radius
+  // downstream (or upstream) of its centre and within two radii of its line.
+  static Wake wake(const Frame& frame, const glm::vec3& centre) {
+    double sum[2] = {}, count[2] = {};
+    size_t water = 0, foamy = 0;
+    for (uint32_t y = 0; y < kHeight; ++y) {
+      for (uint32_t x = 0; x < kWidth; ++x) {
+        const size_t i = size_t{y} * kWidth + x;
+        if (frame.water_mask[i] != 1.0f) continue;
+        ++water;
+        foamy += frame.foam[i] > 0.1f ? 1 : 0;
+        const glm::vec2 offset = water_point(x, y) - glm::vec2(centre.x, centre.z);
+        if (std::abs(offset.x) > 2.0f * kBoulderRadius || std::abs(offset.y) < kBoulderRadius ||
+            std::abs(offset.y) > 5.0f * kBoulderRadius) {
+          continue;
+        }
+        const int side = offset.y > 0.0f ? 0 : 1;  // the river flows along +Z
+        sum[side] += frame.foam[i];
+        count[side] += 1.0;
+      }
+    }
+    EXPECT_GT(count[0], 300.0);
+    EXPECT_GT(count[1], 300.0);
+    return {sum[0] / std::max(count[0], 1.0), sum[1] / std::max(count[1], 1.0),
+            double(foamy) / std::max<size_t>(water, 1)};
+  }
+};
+
+TEST_F(FoamWakeTest, FoamTrailsTheBoulderAndFollowsItWhenItMoves) {
+  const glm::vec3 left{-2.8f, 0.0f, 0.0f}, right{2.8f, 0.0f, 0.0f};
+  Status status = create_channel(make_create_info(kWidth, kHeight), left);
+  ASSERT_TRUE(status.ok()) << status.message();
+  const std::vector<Frame> before = render_still(0, 3);
+  ASSERT_TRUE(move_boulder(right).ok());
+  const std::vector<Frame> after = render_still(3, 4);
+  ASSERT_EQ(before.size(), 3u);
+  ASSERT_EQ(after.size(), 1u);
+  const Wake still = wake(before.back(), left);
+  const Wake moved = wake(after[0], right);
+  const Wake left_behind = wake(after[0], left);
+  std::printf("foam.Y behind the boulder %.3f, before it %.3f (ratio %.1f), foamy water %.2f; "
+              "moved: behind its new place %.3f, before it %.3f, behind its old place %.3f\n",
+              still.downstream, still.upstream, still.downstream / std::max(still.upstream, 1e-6),
+              still.foamy_share, moved.downstream, moved.upstream, left_behind.downstream);
+  EXPECT_GT(still.downstream, 0.05) << "the boulder has a wake";
+  EXPECT_GE(still.downstream, 3.0 * still.upstream) << "the wake lies downstream";
+  EXPECT_LT(still.foamy_share, 1.0 / 3.0) << "most of the river is open water";
+  EXPECT_GE(moved.downstream, 3.0 * moved.upstream) << "the next frame's wake trails the new place";
+  EXPECT_GE(moved.downstream, 3.0 * left_behind.downstream) << "and has left the old one";
 }
 
 }  // namespace

@@ -26,6 +26,7 @@ struct Frame {
   std::vector<float> normal;  // RGBA per pixel: xyz the water normal, 0 off water
   std::vector<float> reflection;  // RGBA per pixel: the reflection sample, 0 off water
   std::vector<uint32_t> tile_table;  // RGBA32UI texels (shaders/shared.h)
+  std::vector<float> foam;  // the foam's coverage, 0 none to 1 full, 0 off water
 
   const float* pixel(uint32_t x, uint32_t y) const { return &rgba[(size_t{y} * width + x) * 4]; }
 };
@@ -90,6 +91,8 @@ class RenderTest : public GpuTest {
       const auto* tiles = static_cast<const uint32_t*>(slot.readback[7].data);
       out.tile_table.assign(
           tiles, tiles + renderer_->readback_bytes(ReadbackImage::kTileTable) / sizeof(uint32_t));
+      const auto* foam = static_cast<const float*>(slot.readback[8].data);
+      out.foam.assign(foam, foam + size_t{width} * height);
       frames.push_back(std::move(out));
       slot.pending = false;
     };

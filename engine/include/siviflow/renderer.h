@@ -182,15 +182,17 @@ enum class ReadbackImage : uint32_t {
   kNormal,       // RGBA32F: the final water normal in world space (xyz) on water, 0 elsewhere
   kReflection,   // RGBA32F: the reflection sample of the water material before blending
   kTileTable,    // RGBA32UI: the water's tile table (shaders/shared.h), tile_table_layout()
+  kFoam,         // 32-bit float: how much of the water foam covers, 0 none to 1 full, 0 off water
 };
-inline constexpr uint32_t kReadbackImageCount = 8;
+inline constexpr uint32_t kReadbackImageCount = 9;
 constexpr uint32_t readback_bit(ReadbackImage image) { return 1u << static_cast<uint32_t>(image); }
 inline constexpr uint32_t kAllReadbackImages = (1u << kReadbackImageCount) - 1;
-// The water mask, normal and reflection sample come from extra attachments of the water pass,
-// added only when one of them is read back.
+// The water mask, normal, reflection sample and foam come from extra attachments of the water
+// pass, added only when one of them is read back.
 inline constexpr uint32_t kAovReadbackImages = readback_bit(ReadbackImage::kWaterMask) |
                                                readback_bit(ReadbackImage::kNormal) |
-                                               readback_bit(ReadbackImage::kReflection);
+                                               readback_bit(ReadbackImage::kReflection) |
+                                               readback_bit(ReadbackImage::kFoam);
 
 // The tile table of the water material (shaders/shared.h): its size and which lattice points
 // the last updated frame put in it (the corner moves with the camera on rivers larger than the

@@ -1,0 +1,99 @@
+// The view the tests of the flow's marks on the water measure: a still camera looking down on a
+// straight channel, flowing along +Z, with a boulder in mid-stream that the host can move (a
+// runtime obstacle of the renderer, drawn by the world's boulder of the same place).
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "render_frames.h"
+#include "siviflow/scene_file.h"
+#include "siviflow/scene_river.h"
+
+namespace siviflow::testing {
+
+class StraightChannelTest : public RenderTest {
+ protected:
+  static constexpr float kBoulderRadius = 1.2f;
+  static constexpr float kChannelWidth = 12.0f;
+
+  static SceneFile channel_scene(const glm::vec3& boulder) {
+    SceneFile scene;
+    scene.path = "straight-channel.json";
+    ProceduralRiverParams& river = scene.rivers[0].procedural;
+    river.length = 120.0f;
+    river.meander_amplitude = 0.0f;
+    river.width = kChannelWidth;
+    river.width_variation = 0.0f;
+    Obstacle obstacle;
+    obstacle.centre = boulder;
+    obstacle.radius = kBoulderRadius;
+    scene.obstacles.push_back(obstacle);
+    return scene;
+  }
+
+  // The world of the channel with its boulder at `boulder`, and the water of the channel with
+  // the boulder as a runtime obstacle (so that move_boulder can move it).
+  Status create_channel(CreateInfo info, const glm::vec3& boulder, const WaterLook& look = {}) {
+    renderer_.reset();
+    world_.reset();
+    scene_ = channel_scene(boulder);
+    scene_.look = look;
+    WorldCreateInfo world_info = context_->world_create_info(info.color_format, info.depth_format);
+    world_info.frames_in_flight = info.frames_in_flight;
+    world_info.scene = &scene_;
+    SIVIFLOW_TRY(World::create(world_info, &world_));
+    SceneRiverData river;
+    SIVIFLOW_TRY(scene_river_data(&scene_, 0, &river));
+    river.obstacles.clear();
+    const WaterRiver water = river.river();
+    info.river = &water;
+    info.look = &scene_.look;
+    info.reflection = &World::draw_reflection;
+    info.reflection_user = world_.get();
+    SIVIFLOW_TRY(Renderer::create(info, &renderer_));
+    WaterObstacle obstacle;
+    obstacle.centre = boulder;
+    obstacle.radius = kBoulderRadius;
+    return renderer_->add_obstacle(obstacle, &obstacle_id_);
+  }
+
+  Status move_boulder(const glm::vec3& centre) {
+    SIVIFLOW_TRY(renderer_->move_obstacle(obstacle_id_, centre));
+    return world_->place_boulder(0, centre);
+  }
+
+  static Camera camera() {
+    Camera camera;
+    camera.position = {0.0f, 15.0f, -7.0f};
+    camera.target = {0.0f, 0.0f, 4.0f};
+    return camera;
+  }
+
+  std::vector<Frame> render_still(uint32_t first, uint32_t end) {
+    return render_views(first, end, kWidth, kHeight,
+                        [](double) { return camera_view(camera(), {kWidth, kHeight}); });
+  }
+
+  // Where the centre of pixel (x, y) sees the water's level plane (y = 0), in x and z.
+  static glm::vec2 water_point(uint32_t x, uint32_t y) {
+    const View view = camera_view(camera(), {kWidth, kHeight});
+    const glm::mat4 to_world = glm::inverse(view.projection * view.view);
+    const glm::vec2 ndc{(x + 0.5f) / kWidth * 2.0f - 1.0f, (y + 0.5f) / kHeight * 2.0f - 1.0f};
+    const glm::vec4 near = to_world * glm::vec4(ndc, 0.0f, 1.0f);
+    const glm::vec4 far = to_world * glm::vec4(ndc, 1.0f, 1.0f);
+    const glm::vec3 a = glm::vec3(near) / near.w, b = glm::vec3(far) / far.w;
+    const float t = a.y / (a.y - b.y);
+    const glm::vec3 p = a + t * (b - a);
+    return {p.x, p.z};
+  }
+
+  SceneFile scene_;
+  uint32_t obstacle_id_ = 0;
+};
+
+}  // namespace siviflow::testing
