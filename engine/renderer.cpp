@@ -294,6 +294,8 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   water_frame.look.foam = glm::vec4(look.foam_color, look.foam_amount);
   water_frame.look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, look.sun_glint,
                                          static_cast<float>(debug_view));
+  const float wrapped_time = static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD));
+  water_frame.look.material = glm::vec4(static_cast<float>(look.material), wrapped_time, 0.0f, 0.0f);
   tile_lattice.place(river->water_lo, river->water_hi, look.tile_size_m, view.camera_position,
                      view.forward);
   const TileTableLayout& tiles = tile_lattice.layout();
@@ -306,7 +308,7 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   water_frame.tiles.lattice = glm::vec4(tiles.corner_x, tiles.corner_z, tiles.width, tiles.height);
   water_frame.tiles.screen =
       glm::vec4(info.extent.width, info.extent.height, static_cast<float>(layout.texel_px),
-                static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD)));
+                wrapped_time);
   last_time = time_seconds;
   return Status::success();
 }

@@ -15,7 +15,32 @@ std::string range_problem(float value, float lo, float hi) {
 
 }  // namespace
 
+const char* water_material_name(WaterMaterial material) {
+  switch (material) {
+    case WaterMaterial::kTiledDirectionalFlow:
+      return "tiled_directional_flow";
+    case WaterMaterial::kFlowMap:
+      return "flowmap";
+  }
+  return "unknown";
+}
+
+bool water_material_from_name(std::string_view name, WaterMaterial* material) {
+  for (uint32_t i = 0; i < kWaterMaterialCount; ++i) {
+    const auto candidate = static_cast<WaterMaterial>(i);
+    if (name == water_material_name(candidate)) {
+      *material = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
 std::string water_look_error(const WaterLook& look, std::string* problem) {
+  if (static_cast<uint32_t>(look.material) >= kWaterMaterialCount) {
+    *problem = text_format("%u is not a WaterMaterial", static_cast<unsigned>(look.material));
+    return "material";
+  }
   const struct {
     const char* name;
     float value, lo, hi;

@@ -1,9 +1,11 @@
-// The water material of Algorithm 3, shared by flow.frag (beauty only) and flow_aovs.frag
+// The water material of Algorithm 3 (its ripples by Tiled Directional Flow, or by the flow-map
+// baseline when the look asks for it), shared by flow.frag (beauty only) and flow_aovs.frag
 // (beauty plus the water mask, normal, reflection and foam AOVs, with SIVIFLOW_FLOW_AOVS defined).
 #extension GL_GOOGLE_include_directive : require
 #include "shared.h"
 #include "sky_common.glsl"
 #include "tiled_directional_flow.glsl"
+#include "flow_map.glsl"
 #include "water_debug_views.glsl"
 
 layout(push_constant) uniform Push { FlowConstants flow; };
@@ -36,6 +38,7 @@ const float kSunIntensity = 8.0;  // at WaterLook::sun_glint 1
 const float kPi = 3.14159265;
 const float kMaxWaterPath = 1.0e4;       // metres: the host's far plane or sky behind the water
 const float kFoamEdge = 0.25;            // ripple-height band over which foam patches fade in
+const int kMaterialFlowMap = 1;          // siviflow::WaterMaterial::kFlowMap
 
 // How much of the water foam covers: where the ripple height through the tiles (moving with the
 // flow) rises above 1 - the foam there, so thin foam is scattered patches on the crests and full
@@ -69,14 +72,21 @@ void main() {
   // ripples part of the way: a full fade would print the particles' cells on the water.
   float shore = smoothstep(0.0, kShoreFadeMetres, below);
   float transparency = shore * mix(1.0 - kFadeInfluence, 1.0, fade);
-  TdfResult tdf = tdf_normal(in_world, vec3(0.0, 1.0, 0.0),
-                             look.sun_color.w * transparency * transparency, flow.water.z,
-                             look.surface.y, tile_table, normal_map);
-  vec3 n = tdf.normal;
+  float strength = look.sun_color.w * transparency * transparency;
+  TdfResult ripples;
+  if (int(look.material.x) == kMaterialFlowMap) {  // uniform: the look is the draw's
+    FlowMapSample here = flow_map_at(pixel, flow.water.w, flow_texture, particle_aux);
+    ripples = flow_map_normal(in_world, strength, flow.water.z * look.surface.y / kTdfScaleFast,
+                              look.material.y, here, normal_map);
+  } else {
+    ripples = tdf_normal(in_world, vec3(0.0, 1.0, 0.0), strength, flow.water.z, look.surface.y,
+                         tile_table, normal_map);
+  }
+  vec3 n = ripples.normal;
 
   // Reflection: the mirrored scene at this pixel, offset by the normal's tilt (paper §4.3); the
   // sky seen along the reflected ray where the host's reflection drew nothing.
-  vec2 uv = pixel * flow.screen.zw + tdf.tilt * flow.water.y;
+  vec2 uv = pixel * flow.screen.zw + ripples.tilt * flow.water.y;
   vec4 mirrored = texture(reflection_map, clamp(uv, vec2(0.0), vec2(1.0)));
   vec3 reflected_ray = reflect(-to_eye, n);
   reflected_ray.y = abs(reflected_ray.y);  // a ray tilted under the horizon sees the sky's edge
@@ -98,7 +108,7 @@ void main() {
   float alpha = clamp(mix(opacity, 1.0, fresnel), 0.0, 1.0) * shore;
 
   // Foam: opaque, diffusely lit, over the water's colour (thinning out with the shore's water).
-  float foam = foam_coverage(tdf.foam * look.foam.w, tdf.foam_pattern) * shore;
+  float foam = foam_coverage(ripples.foam * look.foam.w, ripples.foam_pattern) * shore;
   colour = mix(colour, look.foam.rgb * light, foam);
   alpha = mix(alpha, shore, foam);
 

@@ -107,6 +107,8 @@ struct WaterLookConstants {
                      // (the ripples' size), z the sun glint's strength, w the debug view
                      // (siviflow::DebugView as a float; 0 the water's look)
   vec4 foam;         // rgb linear colour of foam, w foam amount
+  vec4 material;     // x the material (siviflow::WaterMaterial as a float), y scene time wrapped
+                     // to SIVIFLOW_TDF_TIME_PERIOD (s): the flow map's phases; zw unused
 };
 
 // Push constants of the flow pass (the water material).
@@ -159,7 +161,7 @@ struct FlowTileConstants {
 #ifdef __cplusplus
 static_assert(sizeof(FlowConstants) == 128);
 static_assert(sizeof(FlowTileConstants) == 128);
-static_assert(sizeof(WaterLookConstants) == 80);
+static_assert(sizeof(WaterLookConstants) == 96);
 static_assert(offsetof(FlowTileConstants, lattice) == 64);
 static_assert(offsetof(FlowTileConstants, heights) == 80);
 static_assert(offsetof(FlowTileConstants, screen) == 96);

@@ -294,11 +294,20 @@ Status parse_river(const Reader& r, const Json& v, const std::string& path,
 // the renderer accepts (so a file the parser takes is one the renderer takes).
 Status parse_look(const Reader& r, const Json& v, WaterLook* out) {
   SIVIFLOW_TRY(r.object(v, "look"));
-  std::vector<std::string_view> allowed;
+  std::vector<std::string_view> allowed{"material"};
   for (const auto& s : kLookScalarFields) allowed.push_back(s.name);
   for (const auto& s : kLookVectorFields) allowed.push_back(s.name);
   SIVIFLOW_TRY(r.keys(v, "look", allowed));
   WaterLook look;
+  if (const Json* x = find(v, "material")) {
+    std::string name;
+    SIVIFLOW_TRY(r.string(*x, "look.material", &name));
+    if (!water_material_from_name(name, &look.material)) {
+      return r.fail("look.material", "'" + name + "' is not a material (" +
+                                         water_material_name(WaterMaterial::kTiledDirectionalFlow) +
+                                         " or " + water_material_name(WaterMaterial::kFlowMap) + ")");
+    }
+  }
   for (const auto& s : kLookScalarFields) {
     if (const Json* x = find(v, s.name)) SIVIFLOW_TRY(r.real(*x, join("look", s.name), &(look.*s.member)));
   }

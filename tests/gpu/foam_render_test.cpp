@@ -94,7 +94,7 @@ class FoamWakeTest : public StraightChannelTest {
 
   // The water pixels within four radii of the boulder's edge at `centre`, more than a radius
   // downstream (or upstream) of its centre and within two radii of its line.
-  static Wake wake(const Frame& frame, const glm::vec3& centre) {
+  Wake wake(const Frame& frame, const glm::vec3& centre) const {
     double sum[2] = {}, count[2] = {};
     size_t water = 0, foamy = 0;
     for (uint32_t y = 0; y < kHeight; ++y) {

@@ -241,6 +241,9 @@ TEST_F(RuntimeControlTest, BadObstaclesAndLooksAreRefusedByNameAndChangeNothing)
   bad.fresnel_f0 = 1.5f;
   refused(renderer_->set_look(bad), {"set_look", "WaterLook::fresnel_f0", "1.5 is outside [0, 1]"});
   bad = WaterLook{};
+  bad.material = static_cast<WaterMaterial>(7);
+  refused(renderer_->set_look(bad), {"set_look", "WaterLook::material", "7 is not a WaterMaterial"});
+  bad = WaterLook{};
   bad.tile_size_m = NAN;
   refused(renderer_->set_look(bad), {"tile_size_m", "nan"});
   bad = WaterLook{};

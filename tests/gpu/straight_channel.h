@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/matrix.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
@@ -67,23 +68,24 @@ class StraightChannelTest : public RenderTest {
     return world_->place_boulder(0, centre);
   }
 
-  static Camera camera() {
-    Camera camera;
-    camera.position = {0.0f, 15.0f, -7.0f};
-    camera.target = {0.0f, 0.0f, 4.0f};
-    return camera;
+  // Places the still camera (by default it looks down the channel at the boulder from behind
+  // and above) and sizes the view.
+  void set_camera(const glm::vec3& position, const glm::vec3& target, VkExtent2D extent) {
+    camera_.position = position;
+    camera_.target = target;
+    extent_ = extent;
   }
+  View view() const { return camera_view(camera_, extent_); }
 
   std::vector<Frame> render_still(uint32_t first, uint32_t end) {
-    return render_views(first, end, kWidth, kHeight,
-                        [](double) { return camera_view(camera(), {kWidth, kHeight}); });
+    return render_views(first, end, extent_.width, extent_.height, [this](double) { return view(); });
   }
 
   // Where the centre of pixel (x, y) sees the water's level plane (y = 0), in x and z.
-  static glm::vec2 water_point(uint32_t x, uint32_t y) {
-    const View view = camera_view(camera(), {kWidth, kHeight});
-    const glm::mat4 to_world = glm::inverse(view.projection * view.view);
-    const glm::vec2 ndc{(x + 0.5f) / kWidth * 2.0f - 1.0f, (y + 0.5f) / kHeight * 2.0f - 1.0f};
+  glm::vec2 water_point(double x, double y) const {
+    const View v = view();
+    const glm::mat4 to_world = glm::inverse(v.projection * v.view);
+    const glm::vec2 ndc{(x + 0.5) / extent_.width * 2.0 - 1.0, (y + 0.5) / extent_.height * 2.0 - 1.0};
     const glm::vec4 near = to_world * glm::vec4(ndc, 0.0f, 1.0f);
     const glm::vec4 far = to_world * glm::vec4(ndc, 1.0f, 1.0f);
     const glm::vec3 a = glm::vec3(near) / near.w, b = glm::vec3(far) / far.w;
@@ -92,8 +94,18 @@ class StraightChannelTest : public RenderTest {
     return {p.x, p.z};
   }
 
+  // The pixel (x right, y down) where world point `p` is seen.
+  glm::dvec2 pixel_of(const glm::vec3& p) const {
+    const View v = view();
+    const glm::vec4 clip = v.projection * v.view * glm::vec4(p, 1.0f);
+    return {(clip.x / clip.w + 1.0) * 0.5 * extent_.width - 0.5,
+            (clip.y / clip.w + 1.0) * 0.5 * extent_.height - 0.5};
+  }
+
   SceneFile scene_;
   uint32_t obstacle_id_ = 0;
+  Camera camera_{{0.0f, 15.0f, -7.0f}, {0.0f, 0.0f, 4.0f}};
+  VkExtent2D extent_{kWidth, kHeight};
 };
 
 }  // namespace siviflow::testing

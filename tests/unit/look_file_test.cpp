@@ -26,6 +26,7 @@ WaterLook tuned_look() {
   look.ripple_strength = 1.25f;
   look.tile_size_m = 5.0f;
   look.sun_glint = 3.0f;
+  look.material = WaterMaterial::kFlowMap;
   return look;
 }
 
@@ -42,6 +43,7 @@ TEST(LookFile, SavedLookReadsBackAndKeepsTheScene) {
   EXPECT_FLOAT_EQ(scene.look.ripple_strength, 1.25f);
   EXPECT_FLOAT_EQ(scene.look.tile_size_m, 5.0f);
   EXPECT_FLOAT_EQ(scene.look.sun_glint, 3.0f);
+  EXPECT_EQ(scene.look.material, WaterMaterial::kFlowMap);
   EXPECT_FLOAT_EQ(scene.look.water_color.g, 0.3f);
   EXPECT_FLOAT_EQ(scene.look.fresnel_f0, WaterLook{}.fresnel_f0) << "every field is written";
 }

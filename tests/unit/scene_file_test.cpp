@@ -520,7 +520,7 @@ TEST(SceneFile, BadRiverListsAreNamed) {
 TEST(SceneFileSchema, LookKeysDefaultsAndRangesMatchWaterLook) {
   const Json schema = load_schema();
   const Json& look = schema["properties"]["look"]["properties"];
-  EXPECT_EQ(look.size(), 14u) << "WaterLook has 14 fields";
+  EXPECT_EQ(look.size(), 15u) << "WaterLook has 15 fields";
   // All the schema's defaults, written out, give WaterLook's defaults.
   Json defaults = Json::object();
   for (const auto& item : look.items()) defaults[item.key()] = item.value()["default"];
@@ -529,6 +529,7 @@ TEST(SceneFileSchema, LookKeysDefaultsAndRangesMatchWaterLook) {
   ASSERT_TRUE(status.ok()) << status.message();
   const WaterLook d;
   const WaterLook& l = scene.look;
+  EXPECT_EQ(l.material, d.material);
   EXPECT_EQ(l.water_color, d.water_color);
   EXPECT_EQ(l.deep_color, d.deep_color);
   EXPECT_EQ(l.absorption_per_metre, d.absorption_per_metre);
@@ -567,6 +568,20 @@ TEST(SceneFile, LookKeysReachTheLookAndBadOnesAreNamed) {
   expect_error(with({{"look", {{"sun_direction", {0, 0, 0}}}}}),
                {"look.sun_direction", "non-zero"});
   expect_error(with({{"look", {{"gloss", 1}}}}), {"look.gloss: unknown key", "fresnel_f0"});
+}
+
+TEST(SceneFile, LookMaterialIsNamedAndAnUnknownOneRefused) {
+  SceneFile scene;
+  ASSERT_TRUE(parse(with({{"look", {{"material", "flowmap"}}}}), &scene).ok());
+  EXPECT_EQ(scene.look.material, WaterMaterial::kFlowMap);
+  ASSERT_TRUE(parse(with({{"look", {{"material", "tiled_directional_flow"}}}}), &scene).ok());
+  EXPECT_EQ(scene.look.material, WaterMaterial::kTiledDirectionalFlow);
+  const Json schema = load_schema();
+  EXPECT_EQ(schema["properties"]["look"]["properties"]["material"]["enum"],
+            Json({"tiled_directional_flow", "flowmap"}));
+  expect_error(with({{"look", {{"material", "wavy"}}}}),
+               {"look.material", "'wavy' is not a material", "tiled_directional_flow or flowmap"});
+  expect_error(with({{"look", {{"material", 1}}}}), {"look.material", "must be a string"});
 }
 
 TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {

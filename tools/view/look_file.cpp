@@ -27,7 +27,7 @@ Status save_look_to_scene(const std::string& path, const WaterLook& look) {
       return Status::error(path + ": not a scene file (not a JSON object); the look was not saved");
     }
   }
-  Json fields = Json::object();
+  Json fields = {{"material", water_material_name(look.material)}};
   for (const LookScalarField& f : kLookScalarFields) fields[f.name] = look.*f.member;
   for (const LookVectorField& f : kLookVectorFields) {
     const glm::vec3& v = look.*f.member;

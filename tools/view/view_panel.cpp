@@ -53,6 +53,15 @@ PanelActions draw_panel(const PanelStats& stats, PanelState* state) {
   }
   if (ImGui::CollapsingHeader("Water look", ImGuiTreeNodeFlags_DefaultOpen)) {
     WaterLook& look = state->look;
+    static constexpr const char* kMaterials[kWaterMaterialCount] = {
+        "Tiled Directional Flow", "flow map (two-phase baseline)"};
+    for (uint32_t i = 0; i < kWaterMaterialCount; ++i) {
+      if (i > 0) ImGui::SameLine();
+      if (ImGui::RadioButton(kMaterials[i], look.material == static_cast<WaterMaterial>(i))) {
+        look.material = static_cast<WaterMaterial>(i);
+        actions.look_changed = true;
+      }
+    }
     ImGui::PushItemWidth(-kLabelWidth);  // room for the longest field name beside its slider
     for (const LookVectorField& f : kLookVectorFields) {
       glm::vec3& v = look.*f.member;

@@ -3,13 +3,30 @@
 // are the look SiViFlow ships with.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <string_view>
 
 #include <glm/vec3.hpp>
 
 namespace siviflow {
 
+// How the ripples follow the flow.
+enum class WaterMaterial : uint32_t {
+  // SiViFlow's: world-anchored tiles, each with its own flow direction (van Hoesel 2010).
+  kTiledDirectionalFlow,
+  // The classic baseline most engines ship (Vlachos 2010): one normal map in two phases
+  // scrolled along the flow and cross-faded, which pulses once per cycle; for comparison.
+  kFlowMap,
+};
+inline constexpr uint32_t kWaterMaterialCount = 2;
+// "tiled_directional_flow" or "flowmap": the scene file's names.
+const char* water_material_name(WaterMaterial material);
+// The material of that name; false when there is none.
+bool water_material_from_name(std::string_view name, WaterMaterial* material);
+
 struct WaterLook {
+  WaterMaterial material = WaterMaterial::kTiledDirectionalFlow;
   glm::vec3 water_color{0.10f, 0.22f, 0.20f};  // linear RGB of shallow water, each in [0, 1]
   glm::vec3 deep_color{0.015f, 0.05f, 0.07f};  // linear RGB of deep water, each in [0, 1]
   // Per metre of view path through the water, in [0, 100]: how fast shallow turns deep, and

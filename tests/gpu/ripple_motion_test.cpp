@@ -1,0 +1,170 @@
+// The ripples move with the flow: under a still camera over a straight channel with a boulder,
+// the water's normal pattern (the `normal` AOV) is tracked between frames a few frames apart by
+// phase correlation in a small window around each particle, and its motion compared with the
+// particle's flow projected to the screen, for both materials: Tiled Directional Flow and the
+// two-phase flow-map baseline.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <vector>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "phase_correlation.h"
+#include "renderer_inspect.h"
+#include "shaders/shared.h"
+#include "sim/flow_textures.h"
+#include "straight_channel.h"
+
+namespace siviflow::testing {
+namespace {
+
+constexpr VkExtent2D kView{640, 360};
+constexpr size_t kWindow = 32;     // pixels a side
+constexpr uint32_t kFirst = 12;    // frames: the particles have faded in
+constexpr uint32_t kApart = 4;     // frames between the two images compared
+constexpr double kFps = 30.0;
+constexpr double kMinShift = 1.5;  // pixels: slower water is too still to measure a direction
+
+struct Motion {
+  glm::dvec2 measured;  // pixels over kApart frames
+  glm::dvec2 expected;  // the particle's flow over the same time, projected
+  double boulder_distance;  // metres from the boulder's centre
+};
+
+struct Summary {
+  size_t windows = 0;
+  double angle_deg = 0.0;   // median angular error
+  double speed_ratio = 0.0; // median |measured| / |expected|
+  size_t near_windows = 0;
+  double near_angle_deg = 0.0;  // the same where the flow turns round the boulder
+};
+
+double median(std::vector<double> values) {
+  if (values.empty()) return NAN;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+class RippleMotionTest : public StraightChannelTest {
+ protected:
+  static constexpr glm::vec3 kBoulder{0.0f, 0.0f, 0.0f};
+
+  // The normal's x and z (world tilt) of the window of `frame` whose top-left is `corner`;
+  // false when it leaves the image or holds anything but water.
+  bool window(const Frame& frame, glm::ivec2 corner, Window* out) const {
+    if (corner.x < 0 || corner.y < 0 || corner.x + int(kWindow) > int(kView.width) ||
+        corner.y + int(kWindow) > int(kView.height)) {
+      return false;
+    }
+    out->size = kWindow;
+    out->channels.assign(2, std::vector<double>(kWindow * kWindow));
+    for (size_t y = 0; y < kWindow; ++y) {
+      for (size_t x = 0; x < kWindow; ++x) {
+        const size_t i = size_t(corner.y + y) * kView.width + size_t(corner.x + x);
+        if (frame.water_mask[i] != 1.0f) return false;
+        out->channels[0][y * kWindow + x] = frame.normal[i * 4 + 0];
+        out->channels[1][y * kWindow + x] = frame.normal[i * 4 + 2];
+      }
+    }
+    return true;
+  }
+
+  // The pattern's shift from `a` to `b` in the window centred on `centre`: measured once, then
+  // again with b's window moved by the whole pixels of the first estimate (phase_correlation.h).
+  bool track(const Frame& a, const Frame& b, glm::dvec2 centre, glm::dvec2* shift) const {
+    const glm::ivec2 corner = glm::ivec2(glm::round(centre)) - glm::ivec2(kWindow / 2);
+    Window first, second;
+    if (!window(a, corner, &first) || !window(b, corner, &second)) return false;
+    const glm::ivec2 moved = glm::ivec2(glm::round(phase_correlation_shift(first, second)));
+    if (!window(b, corner + moved, &second)) return false;
+    *shift = glm::dvec2(moved) + phase_correlation_shift(first, second);
+    return true;
+  }
+
+  // Every particle of frame `a` whose window is all water, its motion to frame `b`.
+  std::vector<Motion> motions(const Frame& a, const Frame& b) const {
+    const FlowTextureLayout& layout = flow_texture_layout(*renderer_);
+    struct Cells {
+      glm::dvec2 sum{0.0};
+      size_t count = 0;
+      glm::vec3 flow{0.0f};
+    };
+    std::map<uint32_t, Cells> particles;
+    for (uint32_t ty = 0; ty < layout.flow_extent.y; ++ty) {
+      for (uint32_t tx = 0; tx < layout.flow_extent.x; ++tx) {
+        gpu::FlowTexel texel{};
+        std::memcpy(&texel, a.flow_texture.data() + (size_t{ty} * layout.flow_extent.x + tx) * sizeof(texel),
+                    sizeof(texel));
+        if (texel.id == SIVIFLOW_PARTICLE_NONE) continue;
+        Cells& cells = particles[texel.id];
+        cells.sum += (glm::dvec2(tx, ty) + 0.5) * double(layout.texel_px) - 0.5;
+        ++cells.count;
+        cells.flow = decode_flow(texel);
+      }
+    }
+    std::vector<Motion> out;
+    const double seconds = kApart / kFps;
+    for (const auto& [id, cells] : particles) {
+      const glm::dvec2 centre = cells.sum / double(cells.count);
+      const glm::vec2 xz = water_point(centre.x, centre.y);
+      const glm::vec3 p(xz.x, 0.0f, xz.y);
+      Motion motion;
+      motion.expected = pixel_of(p + cells.flow * float(seconds)) - pixel_of(p);
+      motion.boulder_distance = glm::distance(xz, glm::vec2(kBoulder.x, kBoulder.z));
+      if (glm::length(motion.expected) < kMinShift) continue;
+      if (!track(a, b, centre, &motion.measured)) continue;
+      out.push_back(motion);
+    }
+    return out;
+  }
+
+  Summary measure(WaterMaterial material) {
+    WaterLook look;
+    look.material = material;
+    set_camera({0.0f, 9.0f, -4.5f}, {0.0f, 0.0f, 2.5f}, kView);
+    const Status status = create_channel(make_create_info(kView.width, kView.height), kBoulder, look);
+    EXPECT_TRUE(status.ok()) << status.message();
+    const std::vector<Frame> frames = render_still(0, kFirst + 2 * kApart + 1);
+    EXPECT_EQ(frames.size(), kFirst + 2 * kApart + 1);
+    if (frames.size() != kFirst + 2 * kApart + 1) return {};
+    std::vector<Motion> all = motions(frames[kFirst], frames[kFirst + kApart]);
+    const std::vector<Motion> later = motions(frames[kFirst + kApart], frames[kFirst + 2 * kApart]);
+    all.insert(all.end(), later.begin(), later.end());
+    std::vector<double> angles, ratios, near;
+    for (const Motion& m : all) {
+      const double cosine = glm::dot(m.measured, m.expected) /
+                            std::max(glm::length(m.measured) * glm::length(m.expected), 1e-9);
+      const double angle = glm::degrees(std::acos(std::clamp(cosine, -1.0, 1.0)));
+      angles.push_back(angle);
+      ratios.push_back(glm::length(m.measured) / glm::length(m.expected));
+      if (m.boulder_distance < 2.5 * kBoulderRadius) near.push_back(angle);
+    }
+    return {angles.size(), median(angles), median(ratios), near.size(), median(near)};
+  }
+};
+
+void expect_moves_with_the_flow(const char* material, const Summary& s) {
+  std::printf("%s: %zu windows, median angular error %.1f deg, median speed ratio %.2f; "
+              "%zu windows round the boulder, median angular error %.1f deg\n",
+              material, s.windows, s.angle_deg, s.speed_ratio, s.near_windows, s.near_angle_deg);
+  EXPECT_GT(s.windows, 100u) << material;
+  EXPECT_GT(s.near_windows, 10u) << material;
+  EXPECT_LE(s.angle_deg, 10.0) << material;
+  EXPECT_NEAR(s.speed_ratio, 1.0, 0.2) << material;
+  EXPECT_LE(s.near_angle_deg, 15.0) << material;
+}
+
+TEST_F(RippleMotionTest, TiledDirectionalFlowRipplesMoveWithTheFlow) {
+  expect_moves_with_the_flow("tiled directional flow", measure(WaterMaterial::kTiledDirectionalFlow));
+}
+
+TEST_F(RippleMotionTest, FlowMapRipplesMoveWithTheFlow) {
+  expect_moves_with_the_flow("flow map", measure(WaterMaterial::kFlowMap));
+}
+
+}  // namespace
+}  // namespace siviflow::testing
