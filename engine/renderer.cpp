@@ -289,13 +289,15 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
                                    static_cast<float>(layout.texel_px));
   const float repeat_tiles = kTdfRepeatTiles * look.ripple_scale;
   water_frame.look.water_color = glm::vec4(look.water_color, look.absorption_per_metre);
-  water_frame.look.deep_color = glm::vec4(look.deep_color, look.opacity_per_metre);
+  water_frame.look.deep_color = glm::vec4(look.deep_color, 0.0f);
   water_frame.look.sun_color = glm::vec4(look.sun_color, look.ripple_strength);
   water_frame.look.foam = glm::vec4(look.foam_color, look.foam_amount);
   water_frame.look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, look.sun_glint,
                                          static_cast<float>(debug_view));
   const float wrapped_time = static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD));
   water_frame.look.material = glm::vec4(static_cast<float>(look.material), wrapped_time, 0.0f, 0.0f);
+  water_frame.look.refraction =
+      glm::vec4(look.opacity_per_metre * look.opacity_tint, look.refraction_distortion);
   tile_lattice.place(river->water_lo, river->water_hi, look.tile_size_m, view.camera_position,
                      view.forward);
   const TileTableLayout& tiles = tile_lattice.layout();
@@ -396,7 +398,8 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
                           "must start at the images' origin");
   }
   SIVIFLOW_TRY(check(inputs.color, "color", info.color_format,
-                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, ReadbackImage::kColor));
+                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                     ReadbackImage::kColor));
   SIVIFLOW_TRY(check(inputs.depth, "depth", info.depth_format,
                      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
                      ReadbackImage::kDepth));

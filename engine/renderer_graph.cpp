@@ -77,6 +77,11 @@ Status Renderer::Impl::declare_graph() {
   host_depth = graph.import_image({"host depth", info.depth_format, extent, {}}, ResourceState{},
                                   state_of(Access::DepthAttachmentRead));
 
+  // refraction copy: what the host drew, for the water to see through.
+  ImageHandle refraction =
+      frame_image(graph.create_image({"refraction copy", info.color_format, extent, {}}));
+  refraction_data = add_refraction_copy_pass(graph, host_color, &refraction);
+
   // flow: the water material over the host's colour.
   FlowPass::Handles water;
   water.color = host_color;
@@ -95,6 +100,7 @@ Status Renderer::Impl::declare_graph() {
     water.foam = frame_image(graph.create_image({"foam", FlowPass::kFoamFormat, extent, transparent}));
   }
   water.water_heights = river_assets.images[SharedRiver::kWaterHeights];
+  water.refraction = refraction;
   water.tile_table = frame_image(graph.create_image(
       {"tile table", FlowPass::kTileTableFormat,
        {tile_lattice.layout().width, tile_lattice.layout().height}, {}}));
@@ -138,6 +144,7 @@ Status Renderer::Impl::declare_graph() {
   textures.normal_map = river->assets.image(SharedRiver::kNormalMap).view;
   textures.tile_table = find_frame_image(water.tile_table)->view;
   textures.water_heights = river->assets.image(SharedRiver::kWaterHeights).view;
+  textures.refraction = find_frame_image(refraction)->view;
   return flow_pass.bind_textures(gpu, textures, [this](VkDescriptorPool pool) {
     ring.defer_deletion_until_all_slots([gpu_context = gpu, pool] {
       gpu_context.table->vkDestroyDescriptorPool(gpu_context.table->device, pool,
@@ -235,6 +242,7 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   b.bind_data(flow_pass.frame_data(), &water_frame);
   b.bind_data(uploads_data, &frame_uploads);
   b.bind_data(reflection_data, &reflection_view);
+  b.bind_data(refraction_data, &viewport.offset);
   if (readbacks_data.valid()) b.bind_data(readbacks_data, &readbacks);
   return Status::success();
 }

@@ -59,10 +59,12 @@ struct Renderer::Impl {
   std::vector<ReadbackImage> readback_kinds;  // which image each of them copies
   FrameBindings bindings;
   FlowPass::Frame water_frame;  // of the frame being prepared: push constants, look, host depth
-  // Where the graph's passes read this frame's upload list, readback copies and reflection view.
+  // Where the graph's passes read this frame's upload list, readback copies, reflection view and
+  // the viewport's offset in the host's images (the refraction copy's source).
   DataHandle<UploadList> uploads_data;
   DataHandle<std::vector<ReadbackCopy>> readbacks_data;
   DataHandle<ReflectionView> reflection_data;
+  DataHandle<VkOffset2D> refraction_data;
   ViewMath view;        // of the frame being prepared
   VkRect2D viewport{};  // in the host's images
   ReflectionView reflection_view{};

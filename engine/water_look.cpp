@@ -51,6 +51,7 @@ std::string water_look_error(const WaterLook& look, std::string* problem) {
       {"ripple_scale", look.ripple_scale, 0.25f, 4.0f},
       {"tile_size_m", look.tile_size_m, kMinTileSizeM, kMaxTileSizeM},
       {"reflection_distortion", look.reflection_distortion, 0.0f, 0.5f},
+      {"refraction_distortion", look.refraction_distortion, 0.0f, 0.5f},
       {"fresnel_f0", look.fresnel_f0, 0.0f, 1.0f},
       {"sun_glint", look.sun_glint, 0.0f, 10.0f},
       {"foam_amount", look.foam_amount, 0.0f, 4.0f},
@@ -68,7 +69,8 @@ std::string water_look_error(const WaterLook& look, std::string* problem) {
   } colors[] = {{"water_color", look.water_color, 1.0f},
                 {"deep_color", look.deep_color, 1.0f},
                 {"sun_color", look.sun_color, 100.0f},
-                {"foam_color", look.foam_color, 1.0f}};
+                {"foam_color", look.foam_color, 1.0f},
+                {"opacity_tint", look.opacity_tint, 4.0f}};
   for (const auto& c : colors) {
     for (int i = 0; i < 3; ++i) {
       if (!in_range(c.value[i], 0.0f, c.hi)) {

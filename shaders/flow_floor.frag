@@ -5,7 +5,8 @@
 // The flow pass's floor, for `siviflow bench`: drawn with the water's geometry, depth test and
 // blending into the same colour format (flow.vert), so over the same pixels and written the same
 // way, the same texture reads as the water material (1 flow texel fetch, 1 aux fetch, 4 tile
-// table fetches, 1 host depth fetch, 1 reflection and 4 normal-map reads with gradients) and next to no arithmetic,
+// table fetches, 2 host depth fetches, 1 reflection, 1 refraction and 4 normal-map reads with
+// gradients) and next to no arithmetic,
 // so flow / floor tells what the material's own maths costs.
 layout(push_constant) uniform Push { FlowConstants flow; };
 layout(set = 0, binding = 0) uniform usampler2D flow_texture;
@@ -15,6 +16,7 @@ layout(set = 0, binding = 3) uniform sampler2D normal_map;
 layout(set = 0, binding = 4) uniform usampler2D tile_table;
 layout(set = 0, binding = 5) uniform sampler2D host_depth;
 layout(set = 0, binding = 6) uniform Look { WaterLookConstants look; };
+layout(set = 0, binding = 7) uniform sampler2D refraction_map;
 layout(location = 0) in vec3 in_world;
 layout(location = 0) out vec4 out_value;
 
@@ -27,7 +29,9 @@ void main() {
   for (int i = 0; i < 4; ++i) slots += texelFetch(tile_table, (lattice + ivec2(i & 1, i >> 1)) & wrap, 0).r;
   vec4 aux = texelFetch(particle_aux, ivec2(int(slots % SIVIFLOW_AUX_WIDTH), 0), 0);
   vec2 uv = pixel * flow.screen.zw;
-  vec3 sum = texture(reflection_map, uv).rgb + texelFetch(host_depth, ivec2(gl_FragCoord.xy), 0).r;
+  vec3 sum = texture(reflection_map, uv).rgb + texture(refraction_map, uv).rgb +
+             texelFetch(host_depth, ivec2(gl_FragCoord.xy), 0).r +
+             texelFetch(host_depth, ivec2(gl_FragCoord.xy) + 1, 0).r;
   // Normal-map coordinates at the material's map scale (its mid-speed scale), with the world
   // position's gradients, so the reads come from the same mip levels as the material's.
   vec2 tile = in_world.xz * (0.5 * (kTdfScaleStill + kTdfScaleFast) / (look.surface.y * flow.water.z));

@@ -16,6 +16,7 @@ layout(set = 0, binding = 3) uniform sampler2D normal_map;      // tileable ripp
 layout(set = 0, binding = 4) uniform usampler2D tile_table;     // this frame's, flow_tiles.comp
 layout(set = 0, binding = 5) uniform sampler2D host_depth;      // what the host drew, texelFetch
 layout(set = 0, binding = 6) uniform Look { WaterLookConstants look; };  // siviflow/water_look.h
+layout(set = 0, binding = 7) uniform sampler2D refraction_map;  // the host's colour before the water
 
 layout(location = 0) in vec3 in_world;
 layout(location = 0) out vec4 out_color;
@@ -98,19 +99,37 @@ void main() {
   float f0 = look.surface.x;
   float fresnel = f0 + (1.0 - f0) * grazing_sq * grazing_sq * grazing;
 
-  // Colour and absorption by the water the light crosses: clear in the shallows, dark and
-  // opaque in the deep.
+  // Refraction: what lies under the water (the host's colour before it), seen through the
+  // surface bent by the normal, the more the more water lies under it (up to a metre). Where the
+  // bent view lands on something in front of the water, the pixel's own straight view is taken:
+  // the refraction never shows what is in front.
+  vec2 viewport_size = 1.0 / flow.screen.zw;
+  vec2 bend = ripples.tilt * (look.refraction.w * min(below, 1.0)) * viewport_size;  // pixels
+  // The texel whose depth is checked is the one sampled: a filtered sample could blend in a
+  // neighbour in front of the water.
+  vec2 bent = floor(clamp(pixel + bend, vec2(0.0), viewport_size - 1.0)) + 0.5;
+  float bent_behind = texelFetch(host_depth, ivec2(flow.screen.xy + bent), 0).r;
+  float bent_path = eye_distance * ((gl_FragCoord.z - k) / (bent_behind - k) - 1.0);
+  if (!(bent_path > 0.0)) {
+    bent = pixel;
+    bent_path = path;
+  }
+  vec3 seen = texture(refraction_map, bent * flow.screen.zw).rgb;
+
+  // The water's own colour, and what lies behind absorbed per colour channel by the water the
+  // light crosses (Beer-Lambert), the water's colour scattered in for what it takes: clear in
+  // the shallows, dark in the deep.
   vec3 light = 0.35 + 0.65 * look.sun_color.rgb * max(dot(n, flow.sun_direction.xyz), 0.0);
   vec3 body = mix(look.water_color.rgb, look.deep_color.rgb,
                   1.0 - exp(-look.water_color.w * path)) * light;
-  float opacity = 1.0 - exp(-look.deep_color.w * path);
-  vec3 colour = mix(body, reflection, fresnel);
-  float alpha = clamp(mix(opacity, 1.0, fresnel), 0.0, 1.0) * shore;
+  vec3 transmittance = exp(-look.refraction.rgb * clamp(bent_path, 0.0, kMaxWaterPath));
+  vec3 under = seen * transmittance + body * (1.0 - transmittance);
+  vec3 colour = mix(under, reflection, fresnel);
+  float alpha = shore;  // the water holds what lies behind it; only the thinnest shore blends
 
   // Foam: opaque, diffusely lit, over the water's colour (thinning out with the shore's water).
   float foam = foam_coverage(ripples.foam * look.foam.w, ripples.foam_pattern) * shore;
   colour = mix(colour, look.foam.rgb * light, foam);
-  alpha = mix(alpha, shore, foam);
 
   // Sunlight: the sun's specular glint on the rippled surface (GGX distribution, Schlick Fresnel,
   // no shadowing), as broad as the applied ripples make the water rough: sharp glints on calm

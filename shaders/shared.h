@@ -101,7 +101,7 @@ static_assert(offsetof(ParticleAux, fade) == 12);
 // per frame slot.
 struct WaterLookConstants {
   vec4 water_color;  // rgb linear colour of shallow water, w absorption per metre of view path
-  vec4 deep_color;   // rgb linear colour of deep water, w opacity per metre of view path
+  vec4 deep_color;   // rgb linear colour of deep water, w unused
   vec4 sun_color;    // rgb linear multiplier of the sunlit part, w ripple strength
   vec4 surface;      // x Fresnel reflectance at normal incidence, y normal-map repeat in tiles
                      // (the ripples' size), z the sun glint's strength, w the debug view
@@ -109,6 +109,8 @@ struct WaterLookConstants {
   vec4 foam;         // rgb linear colour of foam, w foam amount
   vec4 material;     // x the material (siviflow::WaterMaterial as a float), y scene time wrapped
                      // to SIVIFLOW_TDF_TIME_PERIOD (s): the flow map's phases; zw unused
+  vec4 refraction;   // rgb opacity per metre of view path per colour channel, w refraction
+                     // distortion (uv per unit tilt per metre of water below, up to one)
 };
 
 // Push constants of the flow pass (the water material).
@@ -161,7 +163,7 @@ struct FlowTileConstants {
 #ifdef __cplusplus
 static_assert(sizeof(FlowConstants) == 128);
 static_assert(sizeof(FlowTileConstants) == 128);
-static_assert(sizeof(WaterLookConstants) == 96);
+static_assert(sizeof(WaterLookConstants) == 112);
 static_assert(offsetof(FlowTileConstants, lattice) == 64);
 static_assert(offsetof(FlowTileConstants, heights) == 80);
 static_assert(offsetof(FlowTileConstants, screen) == 96);

@@ -11,16 +11,17 @@
 namespace siviflow {
 namespace {
 
-// Bindings 0..6 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
-// normal map, tile table, host depth, the look's uniform buffer.
-constexpr uint32_t kBindingCount = 7;
+// Bindings 0..7 as in shaders/flow_material.glsl: flow texture, particle aux, reflection,
+// normal map, tile table, host depth, the look's uniform buffer, the refraction copy.
+constexpr uint32_t kBindingCount = 8;
 constexpr uint32_t kHostDepthBinding = 5;
 constexpr uint32_t kLookBinding = 6;
+constexpr uint32_t kRefractionBinding = 7;
 constexpr std::array<VkDescriptorType, kBindingCount> kMaterialBindings = {
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
     VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-    VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER};
+    VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
 // Each slot's look block starts at a multiple of this: the largest minUniformBufferOffsetAlignment
 // the specification allows, so no device query is needed.
 constexpr VkDeviceSize kLookStride = 256;
@@ -148,6 +149,16 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
     }
   };
   for (VkDescriptorSet set : sets_) write(set, kMaterialBindings, material);
+  const VkDescriptorImageInfo refraction{linear_clamp_, textures.refraction, read};
+  for (VkDescriptorSet set : sets_) {
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = set;
+    w.dstBinding = kRefractionBinding;
+    w.descriptorCount = 1;
+    w.descriptorType = kMaterialBindings[kRefractionBinding];
+    w.pImageInfo = &refraction;
+    writes.push_back(w);
+  }
   write(tiles_set_, kTileBindings, tiles);
   std::vector<VkDescriptorBufferInfo> looks(slot_count_);
   for (uint32_t slot = 0; slot < slot_count_; ++slot) {
@@ -197,6 +208,7 @@ void FlowPass::declare(FrameGraph& graph, uint32_t index_count, Handles* handles
   pass.sampled_fragment(handles->reflection);
   pass.sampled_fragment(handles->normal_map);
   pass.sampled_fragment(handles->tile_table);
+  pass.sampled_fragment(handles->refraction);
   pass.vertex_read(handles->vertices);
   pass.index_read(handles->indices);
   const Handles h = *handles;
@@ -241,6 +253,7 @@ void FlowPass::declare_floor(FrameGraph& graph, uint32_t index_count, const Hand
   pass.sampled_fragment(inputs.reflection);
   pass.sampled_fragment(inputs.normal_map);
   pass.sampled_fragment(inputs.tile_table);
+  pass.sampled_fragment(inputs.refraction);
   pass.vertex_read(inputs.vertices);
   pass.index_read(inputs.indices);
   pass.side_effect();

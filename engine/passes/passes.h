@@ -58,12 +58,22 @@ DataHandle<ReflectionView> add_reflection_pass(FrameGraph& graph, ImageHandle* c
                                                ImageHandle* depth, ReflectionCallback callback,
                                                void* user);
 
+// ---- refraction copy: what the host drew, before the water, for the water to see through ----
+
+// Declares the copy of the view's viewport of the host's `color` into `copy` (the view's size,
+// the colour's format; its handle is replaced by the written version), which the water samples
+// where it refracts: an image cannot be sampled while it is drawn to. Each execute binds the
+// viewport's offset in the host's image to the returned handle.
+DataHandle<VkOffset2D> add_refraction_copy_pass(FrameGraph& graph, ImageHandle color,
+                                                ImageHandle* copy);
+
 // ---- flow: the water material of Algorithm 3, drawn over the scene ----
 
 // Draws the river surface: first (compute) the tile table, the flow at every Tiled Directional
 // Flow tile centre near the camera; then per fragment the particle (flow texture, aux data by
 // slot), the Tiled Directional Flow normal from the table, the reflection sampled with that
-// normal, depth colour and shore fade, blended over the scene's colour. With AOVs it also writes
+// normal, what lies under the water (the refraction copy) sampled with it and absorbed per
+// colour channel, depth colour and shore fade, over the scene's colour. With AOVs it also writes
 // the water mask, the normal, the reflection sample and the foam coverage, unblended.
 class FlowPass {
  public:
@@ -89,6 +99,7 @@ class FlowPass {
     VkImageView normal_map = VK_NULL_HANDLE;  // tileable, mipmapped
     VkImageView tile_table = VK_NULL_HANDLE;  // kTileTableFormat
     VkImageView water_heights = VK_NULL_HANDLE;  // kWaterHeightsFormat, sim/water_heights.h
+    VkImageView refraction = VK_NULL_HANDLE;  // the host's colour before the water, view-sized
   };
   // Points a fresh descriptor set at the textures of this configuration. The previous pool is
   // handed to `retire`, to be destroyed once no frame in flight uses it.
@@ -122,6 +133,7 @@ class FlowPass {
     ImageHandle normal_map;
     ImageHandle tile_table;     // written by declare_tiles (compute), read by the material
     ImageHandle water_heights;  // read by declare_tiles
+    ImageHandle refraction;     // the host's colour before the water (add_refraction_copy_pass)
     BufferHandle vertices;   // river surface positions (vec3)
     BufferHandle indices;
     ImageHandle mask;        // AOVs, written when created with_aovs

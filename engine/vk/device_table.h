@@ -62,6 +62,7 @@ namespace siviflow {
   X(vkCmdDrawIndexed)                  \
   X(vkCmdCopyBuffer)                   \
   X(vkCmdCopyBufferToImage)            \
+  X(vkCmdCopyImage)                    \
   X(vkCmdCopyImageToBuffer)            \
   X(vkCreateQueryPool)                 \
   X(vkDestroyQueryPool)                \

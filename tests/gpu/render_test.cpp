@@ -604,6 +604,9 @@ TEST_F(RenderTest, BadHostImagesAndViewsAreRefusedByName) {
   inputs.depth = targets.depth;
   inputs.depth.usage &= ~VkImageUsageFlags{VK_IMAGE_USAGE_SAMPLED_BIT};  // the water reads it
   refused(inputs, "FrameInputs::depth.usage 0x21 lacks 0x4");
+  inputs.depth = targets.depth;
+  inputs.color.usage &= ~VkImageUsageFlags{VK_IMAGE_USAGE_TRANSFER_SRC_BIT};  // the refraction copy
+  refused(inputs, "lacks 0x1");
   ASSERT_TRUE(context_->end_slot_and_submit(0).ok());  // an empty command buffer is fine
   ASSERT_TRUE(context_->wait_slot(0).ok());
 }

@@ -37,13 +37,16 @@ class StraightChannelTest : public RenderTest {
     return scene;
   }
 
-  // The world of the channel with its boulder at `boulder`, and the water of the channel with
-  // the boulder as a runtime obstacle (so that move_boulder can move it).
-  Status create_channel(CreateInfo info, const glm::vec3& boulder, const WaterLook& look = {}) {
+  // The world of the channel with its boulder at `boulder` and `objects`, and the water of the
+  // channel with the boulder as a runtime obstacle (so that move_boulder can move it), which
+  // reflects the world unless `info` names a reflection of its own.
+  Status create_channel(CreateInfo info, const glm::vec3& boulder, const WaterLook& look = {},
+                        const std::vector<SceneObject>& objects = {}) {
     renderer_.reset();
     world_.reset();
     scene_ = channel_scene(boulder);
     scene_.look = look;
+    scene_.objects = objects;
     WorldCreateInfo world_info = context_->world_create_info(info.color_format, info.depth_format);
     world_info.frames_in_flight = info.frames_in_flight;
     world_info.scene = &scene_;
@@ -54,8 +57,10 @@ class StraightChannelTest : public RenderTest {
     const WaterRiver water = river.river();
     info.river = &water;
     info.look = &scene_.look;
-    info.reflection = &World::draw_reflection;
-    info.reflection_user = world_.get();
+    if (info.reflection == nullptr) {
+      info.reflection = &World::draw_reflection;
+      info.reflection_user = world_.get();
+    }
     SIVIFLOW_TRY(Renderer::create(info, &renderer_));
     WaterObstacle obstacle;
     obstacle.centre = boulder;

@@ -520,7 +520,7 @@ TEST(SceneFile, BadRiverListsAreNamed) {
 TEST(SceneFileSchema, LookKeysDefaultsAndRangesMatchWaterLook) {
   const Json schema = load_schema();
   const Json& look = schema["properties"]["look"]["properties"];
-  EXPECT_EQ(look.size(), 15u) << "WaterLook has 15 fields";
+  EXPECT_EQ(look.size(), 17u) << "WaterLook has 17 fields";
   // All the schema's defaults, written out, give WaterLook's defaults.
   Json defaults = Json::object();
   for (const auto& item : look.items()) defaults[item.key()] = item.value()["default"];
@@ -544,6 +544,8 @@ TEST(SceneFileSchema, LookKeysDefaultsAndRangesMatchWaterLook) {
   EXPECT_EQ(l.sun_glint, d.sun_glint);
   EXPECT_EQ(l.foam_amount, d.foam_amount);
   EXPECT_EQ(l.foam_color, d.foam_color);
+  EXPECT_EQ(l.opacity_tint, d.opacity_tint);
+  EXPECT_EQ(l.refraction_distortion, d.refraction_distortion);
   // Each scalar's schema maximum is accepted, and just past it refused by name and value.
   for (const auto& item : look.items()) {
     if (!item.value().contains("maximum")) continue;

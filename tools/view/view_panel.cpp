@@ -21,7 +21,7 @@ Range scalar_range(const char* name) {
   if (n == "ripple_strength" || n == "foam_amount") return {0.0f, 4.0f};
   if (n == "ripple_scale") return {0.25f, 4.0f};
   if (n == "tile_size_m") return {kMinTileSizeM, kMaxTileSizeM};
-  if (n == "reflection_distortion") return {0.0f, 0.5f};
+  if (n == "reflection_distortion" || n == "refraction_distortion") return {0.0f, 0.5f};
   if (n == "sun_glint") return {0.0f, 10.0f};
   return {0.0f, 1.0f};  // fresnel_f0
 }
@@ -68,7 +68,7 @@ PanelActions draw_panel(const PanelStats& stats, PanelState* state) {
       const std::string name = f.name;
       if (name == "sun_direction") {
         actions.look_changed |= ImGui::SliderFloat3(f.name, &v.x, -1.0f, 1.0f);
-      } else if (name == "sun_color") {
+      } else if (name == "sun_color" || name == "opacity_tint") {
         actions.look_changed |= ImGui::SliderFloat3(f.name, &v.x, 0.0f, 4.0f);
       } else {
         actions.look_changed |= ImGui::ColorEdit3(f.name, &v.x, ImGuiColorEditFlags_Float);

@@ -166,8 +166,9 @@ struct ExternalImage {
   VkExtent2D extent = {0, 0};
   ImageState current;
   ImageState final;
-  // The usage it was created with. Colour: COLOR_ATTACHMENT; depth: DEPTH_STENCIL_ATTACHMENT and
-  // SAMPLED; either: TRANSFER_SRC when CreateInfo::readback_images copies it.
+  // The usage it was created with. Colour: COLOR_ATTACHMENT and TRANSFER_SRC (the water copies
+  // what it sees through); depth: DEPTH_STENCIL_ATTACHMENT and SAMPLED, and TRANSFER_SRC when
+  // CreateInfo::readback_images copies it.
   VkImageUsageFlags usage = 0;
 };
 
@@ -213,8 +214,8 @@ struct ReadbackTargets {
 };
 
 struct FrameInputs {
-  // The host's colour image, with its world drawn: the water is blended over it (colour
-  // attachment usage; transfer source with readback).
+  // The host's colour image, with its world drawn: the water is drawn over it, and sees
+  // through to a copy of it taken first (colour attachment and transfer source usages).
   ExternalImage color;
   // The host's depth image of the same frame: the water is depth-tested against it and reads it
   // for the depth of water behind each pixel (depth attachment and sampled usages; transfer

@@ -33,6 +33,13 @@ struct WaterLook {
   // how fast what lies behind the water disappears.
   float absorption_per_metre = 1.4f;
   float opacity_per_metre = 2.2f;
+  // Per colour channel, in [0, 4]: how much faster than opacity_per_metre red, green and blue
+  // of what lies behind are absorbed (Beer-Lambert); water takes red first, so the shallows
+  // show the bed nearly as it is and the deep turns it blue-green.
+  glm::vec3 opacity_tint{1.35f, 0.95f, 0.70f};
+  // Screen uv offset of what is seen through the water per unit of normal tilt, per metre of
+  // water under the surface up to one, in [0, 0.5]: the bed wavers under the ripples.
+  float refraction_distortion = 0.03f;
   float ripple_strength = 0.55f;  // tilt of the ripples, in [0, 4]: 0 is a flat mirror
   float ripple_scale = 1.0f;      // size of the ripples relative to the default, in [0.25, 4]
   // Side of a Tiled Directional Flow tile (one flow direction each), in [1, 8] metres.
