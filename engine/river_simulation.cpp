@@ -170,6 +170,7 @@ Status RiverView::create(const RiverFlow& river, uint64_t seed, glm::uvec2 viewp
   params.viewport = viewport;
   SIVIFLOW_TRY(ParticleField::create(river.field(), river.bvh(), params, &particles_));
   SIVIFLOW_TRY(FlowTextures::create(particles_, kDefaultFlowTexelPx, &flow_textures_));
+  river_ = &river;
   viewport_ = viewport;
   return Status::success();
 }
@@ -187,8 +188,19 @@ Status RiverView::resize(glm::uvec2 viewport) {
   return Status::success();
 }
 
+void RiverFlow::dry_footprints(std::vector<DryFootprint>* out) const {
+  out->clear();
+  const std::span<const Obstacle> obstacles = flow_.obstacles();
+  for (size_t i = 0; i < obstacles.size(); ++i) {
+    const glm::vec3 centre = flow_.obstacle_centre(i);
+    out->push_back({&obstacles[i], glm::dvec2(centre.x, centre.z)});
+  }
+}
+
 Status RiverView::simulate(const glm::mat4& view_proj, float dt_seconds) {
-  return particles_.update(ScreenCamera{view_proj, viewport_}, particles_.next_frame(), dt_seconds);
+  river_->dry_footprints(&dry_);
+  return particles_.update(ScreenCamera{view_proj, viewport_}, particles_.next_frame(), dt_seconds,
+                           dry_);
 }
 
 Status RiverView::pack(std::span<std::byte> staging) {

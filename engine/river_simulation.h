@@ -60,6 +60,9 @@ class RiverFlow {
   Status set_time(double time_seconds);
   glm::vec3 obstacle_centre(size_t index) const { return flow_.obstacle_centre(index); }
   size_t obstacle_count() const { return flow_.obstacles().size(); }
+  // Every obstacle's footprint where it stands now (pointers into this object, valid until the
+  // obstacles next change): where particles are not made.
+  void dry_footprints(std::vector<DryFootprint>* out) const;
 
   // Obstacles placed at runtime, by their index in the flow's list (add appends): each re-solves
   // the flow only around the old and new footprint.
@@ -113,9 +116,11 @@ class RiverView {
   const ParticleField& particle_field() const { return particles_; }
 
  private:
+  const RiverFlow* river_ = nullptr;
   ParticleField particles_;
   FlowTextures flow_textures_;
   glm::uvec2 viewport_{0u};
+  std::vector<DryFootprint> dry_;  // scratch: the river's footprints this frame
 };
 
 }  // namespace siviflow

@@ -12,9 +12,17 @@ layout(set = 0, binding = 1) uniform sampler2D water_heights;   // R32_SFLOAT, t
 layout(set = 0, binding = 2, rgba32ui) uniform writeonly uimage2D tile_table;
 layout(set = 0, binding = 3) uniform sampler2D particle_aux;    // shared.h layout, texelFetch only
 
-// Nearest first: the point itself, then its axis neighbours, then the diagonal ones.
+// The point itself, then its axis neighbours, then the diagonal ones, and what each weighs when
+// the point itself has no particle (nearer counts more).
 const ivec2 kSearch[9] = ivec2[9](ivec2(0, 0), ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
                                   ivec2(1, 1), ivec2(-1, 1), ivec2(1, -1), ivec2(-1, -1));
+const float kNeighbourWeight[9] = float[9](1.0, 1.0, 1.0, 1.0, 1.0, 0.5, 0.5, 0.5, 0.5);
+
+// The foam of a flow texel's particle (slot 0, no particle, reads the aux texture's all-zero
+// texel 0: no foam).
+float texel_foam(uint slot) {
+  return texelFetch(particle_aux, ivec2(slot % SIVIFLOW_AUX_WIDTH, slot / SIVIFLOW_AUX_WIDTH), 0).b;
+}
 
 void main() {
   // The lattice point of this texel: the one congruent to it (mod the table size) in the window.
@@ -35,7 +43,12 @@ void main() {
   vec4 origin = tiles.view_proj * vec4(centre.x, height, centre.y, 1.0);
   vec4 per_x = tiles.view_proj[0] * half_tile;
   vec4 per_z = tiles.view_proj[2] * half_tile;
-  uvec4 found = uvec4(SIVIFLOW_PARTICLE_NONE);
+  // The particle under the point gives its flow and foam. Where there is none (off screen, on
+  // land, hidden, on an obstacle's dry ground) the neighbours that have one give their weighted
+  // mean: around an obstacle they flow round both sides, and their mean is the water's way past
+  // it, not one side's turn. None at all: still water.
+  vec4 sum = vec4(0.0);  // flow xyz and foam, weighted
+  float weight = 0.0;
   // Far from water no fragment reads this point: no search (whole blocks of texels skip it).
   int candidates = height < SIVIFLOW_FAR_FROM_WATER ? 9 : 0;
   for (int i = 0; i < candidates; ++i) {
@@ -43,12 +56,14 @@ void main() {
     vec2 at = (clip.xy / clip.w * 0.5 + 0.5) * texels;
     bool inside = clip.w > 1e-6 && all(greaterThanEqual(at, vec2(0.0))) && all(lessThan(at, texels));
     uvec4 t = texelFetch(flow_texture, clamp(ivec2(at), ivec2(0), size - 1), 0);
-    if (found.r == SIVIFLOW_PARTICLE_NONE && inside) found = t;
+    if (!inside || t.r == SIVIFLOW_PARTICLE_NONE) continue;
+    sum += kNeighbourWeight[i] * vec4(tdf_texel_flow(t), texel_foam(t.r));
+    weight += kNeighbourWeight[i];
+    if (i == 0) break;
   }
-  vec3 flow = found.r == SIVIFLOW_PARTICLE_NONE ? vec3(0.0) : tdf_texel_flow(found);
-  // (Slot 0, no particle, reads the aux texture's all-zero texel 0: no foam.)
-  float foam = texelFetch(particle_aux, ivec2(found.r % SIVIFLOW_AUX_WIDTH,
-                                              found.r / SIVIFLOW_AUX_WIDTH), 0).b;
+  if (weight > 0.0) sum /= weight;
+  vec3 flow = sum.xyz;
+  float foam = sum.w;
   float cycles_per_mps =
       kTdfAdvection * SIVIFLOW_TDF_TIME_PERIOD / (tiles.heights.w * tiles.ripples.x);
   imageStore(tile_table, texel,

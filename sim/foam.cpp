@@ -10,6 +10,7 @@ namespace {
 
 constexpr float kRayHeight = 100.0f;  // metres above a point to cast down from (the river is a
                                       // height field seen from above)
+constexpr float kMinDirectionSpeed = 0.05f;  // m/s below which the flow has no direction
 
 float smoothstep(float edge0, float edge1, float x) {
   const float t = std::clamp((x - edge0) / (edge1 - edge0), 0.0f, 1.0f);
@@ -37,9 +38,12 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   if (bvh == nullptr) return Status::error("FoamField: no ray-cast structure");
   if (section.size() != positions.size()) return Status::error("FoamField: a section per vertex");
   if (!(params.gradient_full > params.gradient_onset) || !(params.lifetime_s > 0.0f) ||
-      !(params.deficit_full > params.deficit_onset) || !(params.step_s > 0.0f) || !(params.bank_width_m > 0.0f) || !(params.bank_speed_full > 0.0f)) {
-    return Status::error("FoamParams: full above onset, and positive lifetime, step, bank width "
-                         "and bank speed expected");
+      !(params.deficit_full > params.deficit_onset) || !(params.step_s > 0.0f) ||
+      !(params.bank_width_m > 0.0f) || !(params.bank_speed_full > 0.0f) ||
+      !(params.front_share >= 0.0f && params.front_share <= 1.0f) ||
+      !(params.lee_acceleration > 0.0f)) {
+    return Status::error("FoamParams: full above onset, positive lifetime, step, bank width, bank "
+                         "speed and lee acceleration, and a front share in [0, 1] expected");
   }
   FoamField field;
   field.positions_ = positions;
@@ -107,20 +111,31 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
       bzz += duz * dz;
     }
     const float det = axx * azz - axz * axz;
-    float gradient = 0.0f;
+    float g00 = 0.0f, g01 = 0.0f, g10 = 0.0f, g11 = 0.0f;  // d(u_x, u_z) / d(x, z)
     if (det > 1e-12f) {
       const float ixx = azz / det, ixz = -axz / det, izz = axx / det;
-      const float g00 = bxx * ixx + bxz * ixz, g01 = bxx * ixz + bxz * izz;
-      const float g10 = bzx * ixx + bzz * ixz, g11 = bzx * ixz + bzz * izz;
-      gradient = std::sqrt(g00 * g00 + g01 * g01 + g10 * g10 + g11 * g11);
+      g00 = bxx * ixx + bxz * ixz;
+      g01 = bxx * ixz + bxz * izz;
+      g10 = bzx * ixx + bzz * ixz;
+      g11 = bzx * ixz + bzz * izz;
     }
+    const float gradient = std::sqrt(g00 * g00 + g01 * g01 + g10 * g10 + g11 * g11);
     const float speed = std::hypot(velocity[v].x, velocity[v].z);
     const float section_speed = section_speed_[section_[v]];
     const float deficit = section_speed > 0.0f ? 1.0f - speed / section_speed : 0.0f;
+    // How the speed changes along the flow (1/s): negative where the water slows towards an
+    // obstacle, positive where it gathers speed again in the lee.
+    float along = 0.0f;
+    if (speed > kMinDirectionSpeed) {
+      const float ux = velocity[v].x / speed, uz = velocity[v].z / speed;
+      along = ux * (g00 * ux + g01 * uz) + uz * (g10 * ux + g11 * uz);
+    }
+    const float lee = p.front_share + (1.0f - p.front_share) *
+                                          smoothstep(-p.lee_acceleration, p.lee_acceleration, along);
     const float bank = p.bank_strength * std::exp(-bank_distance[v] / p.bank_width_m) *
                        std::min(section_speed / p.bank_speed_full, 1.0f);
     source_[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, gradient),
-                           smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
+                           lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
 
     // Where this vertex's water was one step ago: cast down onto the surface there.
     const glm::vec3 back = positions_[v] - p.step_s * glm::vec3(velocity[v].x, 0.0f, velocity[v].z);

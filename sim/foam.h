@@ -5,9 +5,10 @@
 //   - the sources: the flow's velocity gradient |grad u| (Frobenius norm of the 2x2 horizontal
 //     gradient, 1/s), large where the flow speeds up or turns sharply, i.e. at the shoulders of
 //     every obstacle and in tight bends, small in open water; the velocity deficit
-//     1 - speed / (its section's mean speed), large where the water piles up in front of an
-//     obstacle and in the still water in its lee (where a real rock's eddies churn: the
-//     stream function is irrotational and has no eddies of its own); and a line along the banks
+//     1 - speed / (its section's mean speed), large in the still water in an obstacle's lee
+//     (where a real rock's eddies churn: the stream function is irrotational and has no eddies
+//     of its own, and is as slow in front of the rock as behind it, so the deficit counts a
+//     quarter where the water slows along the flow, before the rock); and a line along the banks
 //     as fast as the section flows (the stream function slips at the banks, so the gradient
 //     alone would miss the shear a real bank makes);
 //   - the foam is then carried downstream along the flow, thinning as exp(-t / lifetime): the
@@ -33,6 +34,10 @@ struct FoamParams {
   float deficit_onset = 0.5f;    // velocity deficit where foam starts (banks' own slow water
                                  // stays below)
   float deficit_full = 0.9f;     // where it is full (nearly still water)
+  // The deficit's foam where the water slows towards an obstacle, as a share of that in its lee
+  // (where it gathers speed again): the cushion a rock pushes up is smoother than its eddies.
+  float front_share = 0.25f;
+  float lee_acceleration = 0.1f;  // 1/s of speed change along the flow that tells front from lee
   float bank_width_m = 0.5f;     // the bank line's width (falls off as exp(-distance / width))
   float bank_speed_full = 1.0f;  // m/s past the bank at which its line is full
   float bank_strength = 0.6f;    // the bank line's foam at full speed

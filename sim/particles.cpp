@@ -381,7 +381,55 @@ void ParticleField::clear_state() {
   next_frame_ = 0;
   camera_epoch_ = 0;
   epoch_view_proj_ = glm::mat4(0.0f);
+  dry_.clear();
   stats_ = {};
+}
+
+bool ParticleField::take_dry(std::span<const DryFootprint> dry) {
+  dry_changed_.clear();
+  for (size_t i = dry.size(); i < dry_.size(); ++i) dry_changed_.push_back({dry_[i].lo, dry_[i].hi});
+  const size_t before = dry_.size();
+  dry_.resize(dry.size());
+  for (size_t i = 0; i < dry.size(); ++i) {
+    PlacedFootprint& placed = dry_[i];
+    const Obstacle& o = *dry[i].obstacle;
+    if (i < before && placed.centre_xz == dry[i].centre_xz && placed.obstacle.radius == o.radius &&
+        placed.obstacle.polygon == o.polygon) {
+      continue;
+    }
+    if (i < before) dry_changed_.push_back({placed.lo, placed.hi});
+    placed.obstacle.radius = o.radius;
+    placed.obstacle.polygon = o.polygon;
+    placed.centre_xz = dry[i].centre_xz;
+    footprint_bounds(placed.obstacle, placed.centre_xz, &placed.lo, &placed.hi);
+    dry_changed_.push_back({placed.lo, placed.hi});
+  }
+  return !dry_changed_.empty();
+}
+
+void ParticleField::recheck_around_changed_footprints() {
+  for (Particle& p : particles_) {
+    if (p.slot == 0) continue;
+    const glm::dvec2 xz(p.world.x, p.world.z);
+    for (const auto& [lo, hi] : dry_changed_) {
+      // As far again as the footprint is wide: the particles whose fill circles reach over it.
+      const glm::dvec2 margin = glm::max(hi - lo, glm::dvec2(kDryRecheckMarginM));
+      if (glm::all(glm::greaterThanEqual(xz, lo - margin)) && glm::all(glm::lessThanEqual(xz, hi + margin))) {
+        slots_[p.slot].dry_mask = 0;
+        slots_[p.slot].dirty = true;
+        break;
+      }
+    }
+  }
+}
+
+bool ParticleField::on_dry_ground(const glm::vec3& p) const {
+  const glm::dvec2 xz(p.x, p.z);
+  for (const PlacedFootprint& d : dry_) {
+    if (xz.x < d.lo.x || xz.y < d.lo.y || xz.x > d.hi.x || xz.y > d.hi.y) continue;
+    if (footprint_distance(d.obstacle, d.centre_xz, xz) < 0.0) return true;
+  }
+  return false;
 }
 
 void ParticleField::reset() { clear_state(); }
@@ -423,16 +471,17 @@ void ParticleField::convert(Particle& p, const RayHit& hit) const {
   p.vertex = bvh_->nearest_vertex(hit.position, params_.vertex_search_radius, hit.triangle);
 }
 
-void ParticleField::refresh_attributes() {
-  for (Particle& p : particles_) {
-    const uint32_t v = p.vertex;
-    p.flow = river_.flow[v];
-    p.speed = river_.speed.empty() ? glm::length(p.flow) : river_.speed[v];
-    p.depth = river_.depth.empty() ? 0.0f : river_.depth[v];
-    p.slope = river_.slope.empty() ? 0.0f : river_.slope[v];
+void ParticleField::take_vertex_attributes(Particle& p) const {
+  const uint32_t v = p.vertex;
+  p.flow = river_.flow[v];
+  p.speed = river_.speed.empty() ? glm::length(p.flow) : river_.speed[v];
+  p.depth = river_.depth.empty() ? 0.0f : river_.depth[v];
+  p.slope = river_.slope.empty() ? 0.0f : river_.slope[v];
   p.foam = river_.foam.empty() ? 0.0f : river_.foam[v];
-    p.foam = river_.foam.empty() ? 0.0f : river_.foam[v];
-  }
+}
+
+void ParticleField::refresh_attributes() {
+  for (Particle& p : particles_) take_vertex_attributes(p);
 }
 
 void ParticleField::advance_fades(float dt) {
@@ -484,13 +533,15 @@ void ParticleField::project_and_cull(Frame& f) {
   for (Particle& p : particles_) {
     if (p.slot == 0) continue;
     glm::vec2 s;
-    if (project(f.vp, f.size, p.world, &s) && f.cull.contains(s)) {
+    const bool in_view = project(f.vp, f.size, p.world, &s) && f.cull.contains(s);
+    const bool dry = in_view && on_dry_ground(p.world);
+    if (in_view && !dry) {
       p.screen = s;
       continue;
     }
     release_slot(p.slot);
     p.slot = 0;
-    stats_.culled++;
+    (dry ? stats_.dry : stats_.culled)++;
   }
 }
 
@@ -602,6 +653,10 @@ bool ParticleField::try_create(Frame& f, const glm::vec2& screen, uint32_t* inde
     stats_.ray_misses++;
     return false;
   }
+  if (on_dry_ground(hit.position)) {  // as a miss: no water to be seen there
+    stats_.dry_hits++;
+    return false;
+  }
   // Distances are checked at the re-projected hit, the position every later frame will use.
   glm::vec2 s;
   if (!project(f.vp, f.size, hit.position, &s) || !f.fill.contains(s) ||
@@ -621,12 +676,7 @@ bool ParticleField::try_create(Frame& f, const glm::vec2& screen, uint32_t* inde
   p.fade = fades ? 0.0f : 1.0f;
   p.screen = s;
   convert(p, hit);
-  const uint32_t v = p.vertex;
-  p.flow = river_.flow[v];
-  p.speed = river_.speed.empty() ? glm::length(p.flow) : river_.speed[v];
-  p.depth = river_.depth.empty() ? 0.0f : river_.depth[v];
-  p.slope = river_.slope.empty() ? 0.0f : river_.slope[v];
-  p.foam = river_.foam.empty() ? 0.0f : river_.foam[v];
+  take_vertex_attributes(p);
   *index = static_cast<uint32_t>(particles_.size());
   particles_.push_back(p);
   grid_insert(*index);
@@ -803,7 +853,8 @@ void ParticleField::seed(Frame& f) {
   }
 }
 
-Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, float dt_seconds) {
+Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, float dt_seconds,
+                             std::span<const DryFootprint> dry) {
   if (grid_head_.empty()) return Status::error("particles: update on a field create() did not make");
   if (camera.viewport != params_.viewport) {
     return Status::error("particles: camera viewport " + std::to_string(camera.viewport.x) + "x" +
@@ -818,6 +869,13 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
   }
   if (!std::isfinite(dt_seconds) || dt_seconds < 0.0f) {
     return Status::error("particles: dt must be finite and >= 0");
+  }
+  for (size_t i = 0; i < dry.size(); ++i) {
+    if (dry[i].obstacle == nullptr || !std::isfinite(dry[i].centre_xz.x) ||
+        !std::isfinite(dry[i].centre_xz.y)) {
+      return Status::error("particles: dry footprint " + std::to_string(i) +
+                           " has no obstacle or a centre that is not finite");
+    }
   }
   Frame f;
   f.vp = camera.view_proj;
@@ -841,11 +899,13 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
   f.cull = {-cm, -cm, f.size.x + cm, f.size.y + cm};
 
   stats_ = {};
-  // Advection moves the particles on screen just as a camera move does.
-  // Compared with the camera the epoch began with, not last frame's, so a drift within the
-  // tolerance cannot add up; exact equality would call a recomputed matrix's rounding a move.
+  // Advection moves the particles on screen just as a camera move does, and moved footprints
+  // change where the water is seen. Compared with the camera the epoch began with, not last
+  // frame's, so a drift within the tolerance cannot add up; exact equality would call a
+  // recomputed matrix's rounding a move.
+  const bool dry_changed = take_dry(dry);
   f.camera_changed = next_frame_ == 0 || !same_camera(f.vp, epoch_view_proj_) ||
-                     (params_.advect && dt_seconds > 0.0f);
+                     (params_.advect && dt_seconds > 0.0f) || dry_changed;
   if (f.camera_changed) {
     ++camera_epoch_;
     epoch_view_proj_ = f.vp;
@@ -856,6 +916,7 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
   uint32_t live_before = 0;
   for (const Particle& p : particles_) live_before += p.slot != 0 && p.live();
   project_and_cull(f);
+  if (dry_changed) recheck_around_changed_footprints();
   uint32_t live_after = 0;
   for (const Particle& p : particles_) live_after += p.slot != 0 && p.live();
   remove_dead();

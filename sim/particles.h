@@ -17,7 +17,9 @@
 //      while it moves, only those wider than kMovingCoverFactor x it, so the fillers have room
 //      to survive the motion instead of being thinned again the next frame (churn). "Still":
 //      the matrix equals the one the camera last settled on up to rounding (kStillCameraEpsilon);
-//   6. conversion: a new particle's pixel ray is cast into the river (BVH); a miss makes none.
+//   6. conversion: a new particle's pixel ray is cast into the river (BVH); a miss makes none,
+//      and so does a hit inside an obstacle's dry footprint (the water there is not seen and
+//      its flow is the still water of a wall); a particle a footprint comes to cover goes.
 // Fill method: Dunbar & Humphreys boundary sampling, not Bridson's dart throwing. It only works
 // at the boundary of the covered region (cost scales with the gap, not the screen), it yields
 // a maximal set (no point of the water is left farther than the spacing from a particle, which
@@ -46,6 +48,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "sim/obstacle.h"
 #include "sim/particle_tuning.h"
 #include "sim/river_bvh.h"
 #include "sim/status.h"
@@ -95,6 +98,12 @@ struct ParticleParams {
   float advection_scale = 1.0f;
 };
 
+// An obstacle's footprint where it stands this frame: dry ground in the river.
+struct DryFootprint {
+  const Obstacle* obstacle = nullptr;  // read during the update only
+  glm::dvec2 centre_xz{0.0};
+};
+
 enum class ParticleState : uint8_t { kActive, kFadingIn, kFadingOut };
 // "active", "fading_in", "fading_out" (the `state` column of the particle dumps).
 const char* to_string(ParticleState state);
@@ -127,6 +136,8 @@ struct ParticleStats {
   uint32_t revived = 0;   // fading out, spot free again: fading back in
   uint32_t evicted = 0;   // fading out, slot taken early because the slots ran out
   uint32_t left_river = 0;  // advection carried it off the water
+  uint32_t dry = 0;       // a footprint came to cover it (removed at once, as a culled one)
+  uint32_t dry_hits = 0;  // pixel rays that met the river inside a footprint (no particle)
   uint32_t rays = 0;      // pixel rays cast (conversion and seeding)
   uint32_t ray_misses = 0;
   uint32_t arc_checks = 0;  // particles whose fill circle was recomputed
@@ -147,9 +158,11 @@ class ParticleField {
                        const ParticleParams& params, ParticleField* out);
 
   // Advances one frame (Algorithm 2). `camera.viewport` must equal params.viewport and
-  // `frame_index` must be next_frame(); dt_seconds >= 0 drives the fades and the advection.
-  // On failure nothing changes.
-  Status update(const ScreenCamera& camera, uint64_t frame_index, float dt_seconds);
+  // `frame_index` must be next_frame(); dt_seconds >= 0 drives the fades and the advection;
+  // `dry`: the obstacles' footprints where they stand this frame (a change re-examines the
+  // cover as a camera move does). On failure nothing changes.
+  Status update(const ScreenCamera& camera, uint64_t frame_index, float dt_seconds,
+                std::span<const DryFootprint> dry = {});
   // Back to the state before frame 0 (ids restart at 1).
   void reset();
 
@@ -192,6 +205,13 @@ class ParticleField {
   static Neighbour neighbour(const glm::vec2& c, const glm::vec2& q);
 
   void clear_state();
+  // Takes this frame's footprints (with bounds); true when they differ from the last frame's.
+  bool take_dry(std::span<const DryFootprint> dry);
+  bool on_dry_ground(const glm::vec3& p) const;
+  // The particles next to where a footprint was or now is look at their fill circles again:
+  // water a footprint left is covered at once, even under a still camera.
+  void recheck_around_changed_footprints();
+  void take_vertex_attributes(Particle& p) const;
   void advance_fades(float dt);
   void advect(float dt);
   void project_and_cull(Frame& f);
@@ -244,6 +264,13 @@ class ParticleField {
   uint64_t next_frame_ = 0;
   uint32_t camera_epoch_ = 0;  // bumps whenever the camera changes (moves beyond float noise)
   glm::mat4 epoch_view_proj_{0.0f};  // the camera the current epoch began with
+  struct PlacedFootprint {
+    Obstacle obstacle;  // a copy: the caller's may change in place between frames
+    glm::dvec2 centre_xz{0.0};
+    glm::dvec2 lo{0.0}, hi{0.0};
+  };
+  std::vector<PlacedFootprint> dry_;  // this frame's
+  std::vector<std::pair<glm::dvec2, glm::dvec2>> dry_changed_;  // bounds where they changed
   ParticleStats stats_;
 };
 

@@ -25,9 +25,10 @@ namespace {
 constexpr VkExtent2D kView{640, 360};
 constexpr size_t kWindow = 32;     // pixels a side
 constexpr uint32_t kFirst = 12;    // frames: the particles have faded in
-constexpr uint32_t kApart = 4;     // frames between the two images compared
+constexpr uint32_t kApart = 3;     // frames between the two images compared: at most 6 px of
+                                   // motion at the boulder's shoulders, which the windows track
 constexpr double kFps = 30.0;
-constexpr double kMinShift = 1.5;  // pixels: slower water is too still to measure a direction
+constexpr double kMinShift = 1.0;  // pixels: slower water is too still to measure a direction
 
 struct Motion {
   glm::dvec2 measured;  // pixels over kApart frames

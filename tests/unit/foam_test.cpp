@@ -89,6 +89,7 @@ TEST_F(FoamTest, ABoulderLeavesAWakeThatThinsDownstream) {
   EXPECT_LT(f[at(2.5f, 28.0f)] + f[at(-2.5f, 28.0f)], 0.6f) << "beside the wake";
   const float behind = f[at(0.0f, 21.5f)];
   EXPECT_GT(behind, 0.6f);
+  EXPECT_LT(f[at(0.0f, 18.5f)], 0.5f * behind) << "the water slowing in front foams less";
   float last = behind;
   std::printf("wake on the centreline:");
   for (float z : {24.0f, 28.0f, 32.0f, 36.0f}) {
@@ -113,13 +114,17 @@ TEST_F(FoamTest, TheWakeFollowsAMovedBoulder) {
 }
 
 TEST(FoamParamsTest, BadParametersAreRefused) {
-  FoamParams params;
-  params.lifetime_s = 0.0f;
-  FoamField field;
-  RiverBvh bvh;
-  const Status status = FoamField::create({}, {}, {}, &bvh, params, &field);
-  EXPECT_FALSE(status.ok());
-  EXPECT_NE(status.message().find("FoamParams"), std::string::npos) << status.message();
+  FoamParams lifeless, no_lee, too_much_front;
+  lifeless.lifetime_s = 0.0f;
+  no_lee.lee_acceleration = 0.0f;
+  too_much_front.front_share = 1.5f;
+  for (const FoamParams& params : {lifeless, no_lee, too_much_front}) {
+    FoamField field;
+    RiverBvh bvh;
+    const Status status = FoamField::create({}, {}, {}, &bvh, params, &field);
+    EXPECT_FALSE(status.ok());
+    EXPECT_NE(status.message().find("FoamParams"), std::string::npos) << status.message();
+  }
 }
 
 }  // namespace

@@ -263,6 +263,74 @@ TEST(Particles, FillCoversTheVisibleWater) {
   expect_min_distance(field);
 }
 
+// The largest screen distance from a water pixel inside `region` (x, z bounds on the water
+// plane) to the nearest live particle.
+float worst_gap_in(const ParticleField& field, const ScreenCamera& camera, glm::vec2 lo, glm::vec2 hi) {
+  const test::PixelRays rays(camera);
+  float worst = 0.0f;
+  for (float y = 0.5f; y < kSmall.y; y += 2.0f) {
+    for (float x = 0.5f; x < kSmall.x; x += 2.0f) {
+      glm::vec3 at;
+      if (!test::hit_plane_y(rays({x, y}), 0.0f, &at) || at.x < lo.x || at.x > hi.x ||
+          at.z < lo.y || at.z > hi.y) {
+        continue;
+      }
+      float nearest = std::numeric_limits<float>::infinity();
+      for (const Particle& p : field.particles()) {
+        if (p.live()) nearest = std::min(nearest, glm::length(p.screen - glm::vec2(x, y)));
+      }
+      worst = std::max(worst, nearest);
+    }
+  }
+  return worst;
+}
+
+TEST(Particles, NoneInsideAnObstaclesFootprintAndTheWaterItLeavesIsCoveredAtOnce) {
+  const GridRiver r = test::straight_channel(30.0f, 200.0f, 31, 201);
+  ParticleField field = make_field(r, small_params());
+  const ScreenCamera cam = test::top_down(0.0f, 30.0f, 25.0f, kSmall);  // still all along
+  Obstacle boulder;
+  boulder.radius = 3.0f;
+  Obstacle hull;  // a polygon, turned
+  hull.polygon = {{-1.0f, -4.0f}, {1.0f, -4.0f}, {1.5f, 3.0f}, {-1.5f, 3.0f}};
+  const auto inside = [&](const Particle& p, const DryFootprint& d) {
+    return footprint_distance(*d.obstacle, d.centre_xz, glm::dvec2(p.world.x, p.world.z)) < 0.0;
+  };
+  const auto count_inside = [&](std::initializer_list<DryFootprint> dry) {
+    size_t n = 0;
+    for (const Particle& p : field.particles()) {
+      for (const DryFootprint& d : dry) n += p.slot != 0 && inside(p, d) ? 1 : 0;
+    }
+    return n;
+  };
+  const DryFootprint here[] = {{&boulder, {-5.0, 30.0}}, {&hull, {6.0, 26.0}}};
+  ASSERT_TRUE(field.update(cam, 0, kDt, here).ok());
+  EXPECT_GT(field.stats().dry_hits, 0u) << "rays met the river on dry ground";
+  uint64_t frame = 1;
+  for (; frame < 3; ++frame) ASSERT_TRUE(field.update(cam, frame, kDt, here).ok());
+  EXPECT_GT(field.particles().size(), 200u);
+  EXPECT_EQ(count_inside({here[0], here[1]}), 0u) << "no particle on dry ground";
+
+  // The boulder rolls 8 m downstream: the next frame none is under its new place, and the water
+  // it left is covered as closely as open water (the camera has not moved).
+  const DryFootprint moved[] = {{&boulder, {-5.0, 38.0}}, here[1]};
+  ASSERT_TRUE(field.update(cam, frame++, kDt, moved).ok());
+  EXPECT_GT(field.stats().dry, 0u) << "particles under the new place went";
+  EXPECT_EQ(count_inside({moved[0]}), 0u);
+  const float left = worst_gap_in(field, cam, {-7.0f, 28.0f}, {-3.0f, 32.0f});
+  EXPECT_LE(left, field.cover_radius_px() * 1.0005f) << "the water the boulder left is covered";
+  expect_min_distance(field);
+
+  // Without footprints the same water is covered again.
+  ASSERT_TRUE(field.update(cam, frame++, kDt, {}).ok());
+  EXPECT_LE(worst_gap_in(field, cam, {-7.0f, 35.0f}, {-3.0f, 41.0f}), field.cover_radius_px() * 1.0005f);
+
+  const DryFootprint broken[] = {{nullptr, {0.0, 0.0}}};
+  const Status refused = field.update(cam, frame, kDt, broken);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_NE(refused.message().find("dry footprint 0"), std::string::npos) << refused.message();
+}
+
 // Worst distance from an interior water pixel of the channel to the nearest live particle.
 float worst_gap(const ParticleField& field, const ScreenCamera& camera, float width, float length) {
   const test::PixelRays cam(camera);
