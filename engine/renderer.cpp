@@ -295,7 +295,9 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   water_frame.look.surface = glm::vec4(look.fresnel_f0, repeat_tiles, look.sun_glint,
                                          static_cast<float>(debug_view));
   const float wrapped_time = static_cast<float>(std::fmod(time_seconds, SIVIFLOW_TDF_TIME_PERIOD));
-  water_frame.look.material = glm::vec4(static_cast<float>(look.material), wrapped_time, 0.0f, 0.0f);
+  water_frame.look.clock = glm::vec4(wrapped_time, 0.0f, 0.0f, 0.0f);
+  water_frame.material = look.material;
+  water_frame.debug_view = debug_view;
   water_frame.look.refraction =
       glm::vec4(look.opacity_per_metre * look.opacity_tint, look.refraction_distortion);
   tile_lattice.place(river->water_lo, river->water_hi, look.tile_size_m, view.camera_position,

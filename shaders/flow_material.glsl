@@ -40,6 +40,10 @@ const float kPi = 3.14159265;
 const float kMaxWaterPath = 1.0e4;       // metres: the host's far plane or sky behind the water
 const float kFoamEdge = 0.25;            // ripple-height band over which foam patches fade in
 const int kMaterialFlowMap = 1;          // siviflow::WaterMaterial::kFlowMap
+// One pipeline per material, and per debug views on or off (engine/passes/flow_pass.cpp): as
+// branches on the look they would cost every pixel even untaken, on a software rasterizer.
+layout(constant_id = 0) const int kMaterial = 0;  // siviflow::WaterMaterial
+layout(constant_id = 1) const bool kDebugViews = false;
 
 // How much of the water foam covers: where the ripple height through the tiles (moving with the
 // flow) rises above 1 - the foam there, so thin foam is scattered patches on the crests and full
@@ -75,10 +79,10 @@ void main() {
   float transparency = shore * mix(1.0 - kFadeInfluence, 1.0, fade);
   float strength = look.sun_color.w * transparency * transparency;
   TdfResult ripples;
-  if (int(look.material.x) == kMaterialFlowMap) {  // uniform: the look is the draw's
+  if (kMaterial == kMaterialFlowMap) {
     FlowMapSample here = flow_map_at(pixel, flow.water.w, flow_texture, particle_aux);
     ripples = flow_map_normal(in_world, strength, flow.water.z * look.surface.y / kTdfScaleFast,
-                              look.material.y, here, normal_map);
+                              look.clock.x, here, normal_map);
   } else {
     ripples = tdf_normal(in_world, vec3(0.0, 1.0, 0.0), strength, flow.water.z, look.surface.y,
                          tile_table, normal_map);
@@ -91,7 +95,7 @@ void main() {
   vec4 mirrored = texture(reflection_map, clamp(uv, vec2(0.0), vec2(1.0)));
   vec3 reflected_ray = reflect(-to_eye, n);
   reflected_ray.y = abs(reflected_ray.y);  // a ray tilted under the horizon sees the sky's edge
-  vec3 sky = sky_radiance(normalize(reflected_ray), flow.sun_direction.xyz, 0.0);
+  vec3 sky = sky_radiance(reflected_ray, flow.sun_direction.xyz, 0.0);  // still unit length
   vec3 reflection = mix(sky, mirrored.rgb, mirrored.a);
   float cos_theta = max(dot(n, to_eye), 0.0);
   float grazing = 1.0 - cos_theta;
@@ -152,10 +156,9 @@ void main() {
                                      (4.0 * max(cos_theta, 0.1)));
   colour += glint * (shore * (1.0 - foam)) / max(alpha, 1e-3);  // foam is rough: no glint
   out_color = vec4(colour, alpha);
-  int debug_view = int(look.surface.w);
-  if (debug_view != kDebugViewNone) {
-    out_color = debug_view_colour(debug_view, out_color, texel, fade, in_world, flow.water.z,
-                                  look.surface.y, tile_table);
+  if (kDebugViews) {
+    out_color = debug_view_colour(int(look.surface.w), out_color, texel, fade, in_world,
+                                  flow.water.z, look.surface.y, tile_table);
   }
 #ifdef SIVIFLOW_FLOW_AOVS
   out_mask = 1.0;

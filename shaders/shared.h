@@ -107,8 +107,8 @@ struct WaterLookConstants {
                      // (the ripples' size), z the sun glint's strength, w the debug view
                      // (siviflow::DebugView as a float; 0 the water's look)
   vec4 foam;         // rgb linear colour of foam, w foam amount
-  vec4 material;     // x the material (siviflow::WaterMaterial as a float), y scene time wrapped
-                     // to SIVIFLOW_TDF_TIME_PERIOD (s): the flow map's phases; zw unused
+  vec4 clock;        // x scene time wrapped to SIVIFLOW_TDF_TIME_PERIOD (s): the flow map's
+                     // phases; yzw unused
   vec4 refraction;   // rgb opacity per metre of view path per colour channel, w refraction
                      // distortion (uv per unit tilt per metre of water below, up to one)
 };

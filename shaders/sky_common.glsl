@@ -5,9 +5,12 @@ vec3 sky_radiance(vec3 direction, vec3 sun_direction, float sun_intensity) {
   vec3 zenith = vec3(0.18, 0.36, 0.78);
   vec3 horizon = vec3(0.70, 0.80, 0.92);
   vec3 ground = vec3(0.32, 0.30, 0.27);
-  vec3 sky = up >= 0.0 ? mix(horizon, zenith, pow(up, 0.45)) : mix(horizon, ground, pow(-up, 0.6));
+  // Square roots and products, not pow: the water evaluates this for every pixel it reflects.
+  vec3 sky = mix(horizon, up >= 0.0 ? zenith : ground, sqrt(abs(up)));
   float sun = max(dot(direction, sun_direction), 0.0);
-  sky += vec3(1.0, 0.85, 0.6) * (pow(sun, 8.0) * 0.25);                   // glow around the sun
+  float sun_2 = sun * sun;
+  float sun_4 = sun_2 * sun_2;
+  sky += vec3(1.0, 0.85, 0.6) * (sun_4 * sun_4 * 0.25);                    // glow around the sun
   sky += vec3(1.0, 0.95, 0.85) * (smoothstep(0.9995, 0.9998, sun) * sun_intensity);  // disc
   return sky;
 }

@@ -61,7 +61,12 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
   desc.alpha_blend = true;
   desc.bindings = {{0, sizeof(float) * 3, VK_VERTEX_INPUT_RATE_VERTEX}};
   desc.attributes = {{SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
-  SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, desc, &pipeline_));
+  for (uint32_t material = 0; material < kWaterMaterialCount; ++material) {
+    for (uint32_t debug_views = 0; debug_views < 2; ++debug_views) {
+      desc.fragment_constants = {material, debug_views};
+      SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, desc, &pipelines_[material][debug_views]));
+    }
+  }
   SIVIFLOW_TRY(create_layouts(gpu, kTileBindings, VK_SHADER_STAGE_COMPUTE_BIT,
                               sizeof(gpu::FlowTileConstants), &tiles_set_layout_, &tiles_layout_));
   SIVIFLOW_TRY(
@@ -71,6 +76,7 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
   // exactly its pixels and writes them as the water does.
   GraphicsPipelineDesc floor = desc;
   floor.fragment_shader = "flow_floor.frag";
+  floor.fragment_constants.clear();
   floor.extra_color_formats.clear();
   return create_graphics_pipeline(gpu, cache, floor, &floor_pipeline_);
 }
@@ -78,7 +84,12 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
 void FlowPass::destroy(const GpuContext& gpu) {
   const DeviceTable& vk = *gpu.table;
   const VkAllocationCallbacks* callbacks = gpu.allocation_callbacks;
-  for (VkPipeline pipeline : {pipeline_, tiles_pipeline_, floor_pipeline_}) {
+  for (const auto& variants : pipelines_) {
+    for (VkPipeline pipeline : variants) {
+      if (pipeline != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline, callbacks);
+    }
+  }
+  for (VkPipeline pipeline : {tiles_pipeline_, floor_pipeline_}) {
     if (pipeline != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline, callbacks);
   }
   for (VkDescriptorPool pool : {pool_, tiles_pool_}) {
@@ -213,7 +224,10 @@ void FlowPass::declare(FrameGraph& graph, uint32_t index_count, Handles* handles
   pass.index_read(handles->indices);
   const Handles h = *handles;
   pass.record([this, h, index_count](const PassContext& ctx) {
-    draw_river(ctx, pipeline_, h, index_count);
+    const Frame& frame = ctx.data(frame_data_);
+    const VkPipeline pipeline = pipelines_[static_cast<uint32_t>(frame.material)]
+                                          [frame.debug_view != DebugView::kNone ? 1 : 0];
+    draw_river(ctx, pipeline, h, index_count);
     return Status::success();
   });
 }

@@ -115,6 +115,8 @@ class FlowPass {
     bool reverse_z = false;
     VkRect2D viewport{};
     gpu::WaterLookConstants look{};
+    WaterMaterial material = WaterMaterial::kTiledDirectionalFlow;  // which pipeline draws
+    DebugView debug_view = DebugView::kNone;
     gpu::FlowConstants flow{};
     gpu::FlowTileConstants tiles{};
   };
@@ -161,7 +163,8 @@ class FlowPass {
   VkPipeline floor_pipeline_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  // The material's pipelines: per WaterMaterial, without and with the debug views.
+  VkPipeline pipelines_[kWaterMaterialCount][2] = {};
   VkPipeline tiles_pipeline_ = VK_NULL_HANDLE;  // compute, with a layout and set of its own
   VkDescriptorSetLayout tiles_set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout tiles_layout_ = VK_NULL_HANDLE;

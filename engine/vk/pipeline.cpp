@@ -47,6 +47,14 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
     stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
     stages[1].module = fragment;
     stages[1].pName = "main";
+    std::vector<VkSpecializationMapEntry> entries;
+    for (uint32_t i = 0; i < desc.fragment_constants.size(); ++i) {
+      entries.push_back({i, i * static_cast<uint32_t>(sizeof(uint32_t)), sizeof(uint32_t)});
+    }
+    const VkSpecializationInfo specialization{
+        static_cast<uint32_t>(entries.size()), entries.data(),
+        desc.fragment_constants.size() * sizeof(uint32_t), desc.fragment_constants.data()};
+    if (!entries.empty()) stages[1].pSpecializationInfo = &specialization;
 
     VkPipelineVertexInputStateCreateInfo vertex_input{
         VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
