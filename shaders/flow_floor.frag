@@ -29,7 +29,7 @@ void main() {
   for (int i = 0; i < 4; ++i) slots += texelFetch(tile_table, (lattice + ivec2(i & 1, i >> 1)) & wrap, 0).r;
   vec4 aux = texelFetch(particle_aux, ivec2(int(slots % SIVIFLOW_AUX_WIDTH), 0), 0);
   vec2 uv = pixel * flow.screen.zw;
-  vec3 sum = texture(reflection_map, uv).rgb + texture(refraction_map, uv).rgb +
+  vec3 sum = texture(reflection_map, uv).rgb + texelFetch(refraction_map, ivec2(pixel), 0).rgb +
              texelFetch(host_depth, ivec2(gl_FragCoord.xy), 0).r +
              texelFetch(host_depth, ivec2(gl_FragCoord.xy) + 1, 0).r;
   // Normal-map coordinates at the material's map scale (its mid-speed scale), with the world

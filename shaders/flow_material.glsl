@@ -16,7 +16,8 @@ layout(set = 0, binding = 3) uniform sampler2D normal_map;      // tileable ripp
 layout(set = 0, binding = 4) uniform usampler2D tile_table;     // this frame's, flow_tiles.comp
 layout(set = 0, binding = 5) uniform sampler2D host_depth;      // what the host drew, texelFetch
 layout(set = 0, binding = 6) uniform Look { WaterLookConstants look; };  // siviflow/water_look.h
-layout(set = 0, binding = 7) uniform sampler2D refraction_map;  // the host's colour before the water
+layout(set = 0, binding = 7) uniform sampler2D refraction_map;  // the host's colour before the
+                                                                 // water, texelFetch only
 
 layout(location = 0) in vec3 in_world;
 layout(location = 0) out vec4 out_color;
@@ -109,8 +110,8 @@ void main() {
   // the refraction never shows what is in front.
   vec2 viewport_size = 1.0 / flow.screen.zw;
   vec2 bend = ripples.tilt * (look.refraction.w * min(below, 1.0)) * viewport_size;  // pixels
-  // The texel whose depth is checked is the one sampled: a filtered sample could blend in a
-  // neighbour in front of the water.
+  // The texel whose depth is checked is the one taken, unfiltered: a filtered sample could
+  // blend in a neighbour in front of the water.
   vec2 bent = floor(clamp(pixel + bend, vec2(0.0), viewport_size - 1.0)) + 0.5;
   float bent_behind = texelFetch(host_depth, ivec2(flow.screen.xy + bent), 0).r;
   float bent_path = eye_distance * ((gl_FragCoord.z - k) / (bent_behind - k) - 1.0);
@@ -118,7 +119,7 @@ void main() {
     bent = pixel;
     bent_path = path;
   }
-  vec3 seen = texture(refraction_map, bent * flow.screen.zw).rgb;
+  vec3 seen = texelFetch(refraction_map, ivec2(bent), 0).rgb;
 
   // The water's own colour, and what lies behind absorbed per colour channel by the water the
   // light crosses (Beer-Lambert), the water's colour scattered in for what it takes: clear in
@@ -137,8 +138,8 @@ void main() {
 
   // Sunlight: the sun's specular glint on the rippled surface (GGX distribution, Schlick Fresnel,
   // no shadowing), as broad as the applied ripples make the water rough: sharp glints on calm
-  // water, a broad sheen on rough. It is light the surface adds, whatever shows through it:
-  // divided by alpha so that blending adds it whole.
+  // water, a broad sheen on rough. It is light the surface adds over what shows through it;
+  // blending takes a share alpha = shore of it, as of the rest of the water.
   vec3 sun = flow.sun_direction.xyz;
   vec3 half_vector = normalize(sun + to_eye);
   // (The shore's calm, not the particles' fade: a per-particle roughness would print their cells.)
@@ -147,14 +148,14 @@ void main() {
   float a2 = roughness * roughness * roughness * roughness;
   float n_dot_h = max(dot(n, half_vector), 0.0);
   float d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
-  float distribution = a2 / (kPi * d * d);
   float v_dot_h = 1.0 - max(dot(half_vector, to_eye), 0.0);
   float v_dot_h_sq = v_dot_h * v_dot_h;
   float sun_fresnel = f0 + (1.0 - f0) * v_dot_h_sq * v_dot_h_sq * v_dot_h;
-  float lit = step(0.0, dot(n, sun)) * step(0.0, sun.y);
-  vec3 glint = look.sun_color.rgb * (kSunIntensity * look.surface.z * distribution * sun_fresnel * lit /
-                                     (4.0 * max(cos_theta, 0.1)));
-  colour += glint * (shore * (1.0 - foam)) / max(alpha, 1e-3);  // foam is rough: no glint
+  float lit = step(0.0, dot(n, sun)) * step(0.0, sun.y) * (1.0 - foam);  // foam is rough: none
+  // GGX's a2 / (pi d^2) over the 4 cos(theta) of the specular term, in one division.
+  float glint = kSunIntensity * look.surface.z * a2 * sun_fresnel * lit /
+                (4.0 * kPi * d * d * max(cos_theta, 0.1));
+  colour += look.sun_color.rgb * glint;
   out_color = vec4(colour, alpha);
   if (kDebugViews) {
     out_color = debug_view_colour(int(look.surface.w), out_color, texel, fade, in_world,

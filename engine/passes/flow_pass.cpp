@@ -160,7 +160,7 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
     }
   };
   for (VkDescriptorSet set : sets_) write(set, kMaterialBindings, material);
-  const VkDescriptorImageInfo refraction{linear_clamp_, textures.refraction, read};
+  const VkDescriptorImageInfo refraction{nearest_, textures.refraction, read};
   for (VkDescriptorSet set : sets_) {
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = set;
