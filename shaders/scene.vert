@@ -21,7 +21,8 @@ out gl_PerVertex {
 
 void main() {
   out_world = in_position;
-  SceneLight light = light_scene(scene, in_color.a, in_position, in_normal);
+  float occlusion = in_color.a < 0.0 ? 1.0 : in_color.a;  // ground: SIVIFLOW_GROUND_VERTEX
+  SceneLight light = light_scene(scene, occlusion, in_position, in_normal);
   out_irradiance = light.irradiance;
   out_fog = light.fog;
   out_color = in_color;

@@ -25,13 +25,21 @@ using uint = uint32_t;
 #define SIVIFLOW_ATTR_COLOR 2
 #define SIVIFLOW_ATTR_TEXCOORD 3
 
+// The color.a of ground vertices (terrain, riverbed): the scene shader colours them per fragment
+// from texcoord.x, the height above the nearby water (m), and texcoord.y, how much rock shows
+// (0..1), so the borders of riverbed, wet sand, sand and grass follow the ground's contours,
+// not its grid. Shaders test for a negative alpha (interpolation moves it a hair). Ground has no
+// ambient occlusion of its own: 1.
+#define SIVIFLOW_GROUND_VERTEX (-1.0)
+
 #ifdef __cplusplus
 // One vertex of the scene pipeline's vertex buffer (GLSL reads it through the attributes above).
 struct SceneVertex {
   vec3 position;
   vec3 normal;
-  vec4 color;  // rgb linear albedo (objects: base-colour factor), a ambient occlusion
-  vec2 texcoord;  // objects: base-colour texture coordinates; terrain: unused
+  vec4 color;  // rgb linear albedo (objects: base-colour factor), a ambient occlusion; ground:
+               // a SIVIFLOW_GROUND_VERTEX
+  vec2 texcoord;  // objects: base-colour texture coordinates; ground: see SIVIFLOW_GROUND_VERTEX
 };
 static_assert(sizeof(SceneVertex) == 48);
 static_assert(offsetof(SceneVertex, position) == 0);

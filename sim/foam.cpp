@@ -41,9 +41,11 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
       !(params.deficit_full > params.deficit_onset) || !(params.step_s > 0.0f) ||
       !(params.bank_width_m > 0.0f) || !(params.bank_speed_full > 0.0f) ||
       !(params.front_share >= 0.0f && params.front_share <= 1.0f) ||
+      !(params.min_section_speed > 0.0f) ||
       !(params.lee_acceleration > 0.0f)) {
     return Status::error("FoamParams: full above onset, positive lifetime, step, bank width, bank "
-                         "speed and lee acceleration, and a front share in [0, 1] expected");
+                         "speed, lee acceleration and least section speed, and a front share in "
+                         "[0, 1] expected");
   }
   FoamField field;
   field.positions_ = positions;
@@ -134,7 +136,8 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
                                           smoothstep(-p.lee_acceleration, p.lee_acceleration, along);
     const float bank = p.bank_strength * std::exp(-bank_distance[v] / p.bank_width_m) *
                        std::min(section_speed / p.bank_speed_full, 1.0f);
-    source_[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, gradient),
+    const float relative_gradient = gradient / std::max(section_speed, p.min_section_speed);
+    source_[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
                            lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
 
     // Where this vertex's water was one step ago: cast down onto the surface there.

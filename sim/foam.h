@@ -3,8 +3,9 @@
 // Which quantity, and why: foam is air the water took in where its flow was disturbed, and it
 // drifts with the current until it bursts. So
 //   - the sources: the flow's velocity gradient |grad u| (Frobenius norm of the 2x2 horizontal
-//     gradient, 1/s), large where the flow speeds up or turns sharply, i.e. at the shoulders of
-//     every obstacle and in tight bends, small in open water; the velocity deficit
+//     gradient, 1/s) over its section's mean speed, large where the flow speeds up or turns
+//     sharply for its speed, i.e. at the shoulders of every obstacle and in tight bends, small in
+//     open water however fast (relative, so a fast river is not all foam); the velocity deficit
 //     1 - speed / (its section's mean speed), large in the still water in an obstacle's lee
 //     (where a real rock's eddies churn: the stream function is irrotational and has no eddies
 //     of its own, and is as slow in front of the rock as behind it, so the deficit counts a
@@ -29,8 +30,12 @@
 namespace siviflow {
 
 struct FoamParams {
-  float gradient_onset = 0.35f;  // 1/s: |grad u| where foam starts (open water stays below)
-  float gradient_full = 1.2f;    // 1/s: where it is full (a boulder's shoulders in 1 m/s water)
+  // |grad u| relative to the section's mean speed, 1/m (1 over the length over which the flow
+  // changes by its own speed): where foam starts (open water, and the shear across a fast
+  // narrow channel, stay below) and where it is full (a boulder's shoulders).
+  float gradient_onset = 0.28f;
+  float gradient_full = 0.75f;
+  float min_section_speed = 0.3f;  // m/s: slower sections count as this fast
   float deficit_onset = 0.5f;    // velocity deficit where foam starts (banks' own slow water
                                  // stays below)
   float deficit_full = 0.9f;     // where it is full (nearly still water)

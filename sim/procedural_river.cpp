@@ -63,13 +63,21 @@ float ProceduralRiver::terrain_height(float x, float z) const {
   // Bank: rises to bank_height over a few metres, then the valley floor climbs to the walls.
   const float bank_run = 3.0f;
   const float bank = params_.bank_height * glm::smoothstep(0.0f, 1.0f, (d - half_width) / bank_run);
-  const float wall_t = std::clamp((d - half_width - bank_run) /
-                                      (params_.valley_half_width - half_width - bank_run),
-                                  0.0f, 1.0f);
-  const float wall = params_.valley_wall_height * wall_t * wall_t;
-  // Gentle undulation so the valley floor is not a perfect extrusion.
+  const float s = std::max(0.0f, (d - half_width - bank_run) /
+                                     (params_.valley_half_width - half_width - bank_run));
+  // The walls steepen to the valley's rim (s = 1), then round over into hills beyond it rather
+  // than stopping at a flat top.
+  const float beyond = std::max(0.0f, s - 1.0f);
+  const float wall = params_.valley_wall_height *
+                     (s <= 1.0f ? s * s : 1.0f + 2.0f * beyond / (1.0f + 2.0f * beyond));
+  // Gentle undulation so the valley floor is not a perfect extrusion, growing into the hills'
+  // own crests and saddles on the rim.
+  const float wall_t = std::min(s, 1.0f);
   const float undulation = 0.6f * std::sin(0.11f * x + phase_b_) * std::sin(0.07f * z + phase_a_);
-  return bank + wall + undulation * wall_t;
+  const float crests = params_.valley_wall_height * 0.3f * glm::smoothstep(0.6f, 1.2f, s) *
+                       (std::sin(0.045f * z + phase_a_) * std::sin(0.05f * x + phase_w_) +
+                        0.4f * std::sin(0.13f * z + 2.0f * phase_b_));
+  return bank + wall + undulation * wall_t + crests;
 }
 
 float ProceduralRiver::depth_at(float x, float z) const {

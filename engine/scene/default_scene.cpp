@@ -1,5 +1,7 @@
 #include "scene/default_scene.h"
 
+#include "scene/river_ground.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -22,19 +24,6 @@ glm::vec3 terrain_normal(const ProceduralRiver& river, float x, float z) {
   return glm::normalize(glm::vec3(-dx, 2.0f * e, -dz));
 }
 
-glm::vec3 terrain_albedo(float height, float slope_y) {
-  const glm::vec3 riverbed(0.30f, 0.27f, 0.21f);
-  const glm::vec3 sand(0.62f, 0.55f, 0.42f);
-  const glm::vec3 grass(0.13f, 0.24f, 0.07f);
-  const glm::vec3 rock(0.42f, 0.40f, 0.38f);
-  // Wide, smooth transitions: colour is interpolated per vertex on a 1 m grid, so a narrow band
-  // would show the grid as a saw-tooth edge.
-  glm::vec3 c = glm::mix(riverbed, sand, glm::smoothstep(-0.8f, 0.1f, height));
-  c = glm::mix(c, grass, glm::smoothstep(0.35f, 0.9f, height));
-  c = glm::mix(c, rock, glm::clamp((0.85f - slope_y) * 4.0f, 0.0f, 1.0f));
-  return glm::mix(c, rock * 1.1f, glm::clamp((height - 14.0f) / 6.0f, 0.0f, 1.0f));
-}
-
 void add_terrain(const ProceduralRiver& river, SceneGeometry* geometry) {
   const float half_length = 0.5f * river.params().length;
   const uint32_t base = static_cast<uint32_t>(geometry->vertices.size());
@@ -44,9 +33,8 @@ void add_terrain(const ProceduralRiver& river, SceneGeometry* geometry) {
       const float x = -kTerrainHalfWidth + 2.0f * kTerrainHalfWidth * static_cast<float>(col) /
                                                kTerrainColumns;
       const float y = river.terrain_height(x, z);
-      const glm::vec3 n = terrain_normal(river, x, z);
-      const glm::vec3 albedo = terrain_albedo(y, n.y);
-      geometry->vertices.push_back({{x, y, z}, n, glm::vec4(albedo, 1.0f)});
+      geometry->vertices.push_back(
+          ground_vertex({x, y, z}, terrain_normal(river, x, z), y - river.water_level()));
     }
   }
   const uint32_t stride = kTerrainColumns + 1;
@@ -134,6 +122,14 @@ void add_obstacle_boulders(const std::vector<Obstacle>& obstacles, SceneGeometry
 
 }  // namespace
 
+SceneVertex ground_vertex(const glm::vec3& position, const glm::vec3& normal, float above_water) {
+  // Bare rock where the ground is steep and high on the hills; the rest by height, per fragment.
+  const float rock = std::max(glm::clamp((0.85f - normal.y) * 4.0f, 0.0f, 1.0f),
+                              glm::clamp((above_water - 14.0f) / 6.0f, 0.0f, 1.0f));
+  return {position, normal, glm::vec4(0.0f, 0.0f, 0.0f, SIVIFLOW_GROUND_VERTEX),
+          glm::vec2(above_water, rock)};
+}
+
 SceneLook default_scene_look() { return SceneLook{}; }
 
 SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles) {
@@ -151,10 +147,9 @@ SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vect
   return geometry;
 }
 
-SceneGeometry build_riverbed_geometry(const RiverMesh& river, const std::vector<Obstacle>& obstacles) {
+Status build_riverbed_geometry(const RiverMesh& river, const std::vector<Obstacle>& obstacles,
+                              std::span<const RiverMesh> ground_rivers, SceneGeometry* out) {
   SceneGeometry geometry;
-  const glm::vec3 riverbed(0.30f, 0.27f, 0.21f);
-  const glm::vec3 sand(0.62f, 0.55f, 0.42f);
   std::vector<glm::vec3> normals(river.positions.size(), glm::vec3(0.0f));
   std::vector<glm::vec3> bed(river.positions.size());
   for (size_t v = 0; v < bed.size(); ++v) bed[v] = river.positions[v] - glm::vec3(0.0f, river.depth[v], 0.0f);
@@ -166,12 +161,13 @@ SceneGeometry build_riverbed_geometry(const RiverMesh& river, const std::vector<
   for (size_t v = 0; v < bed.size(); ++v) {
     glm::vec3 n = glm::length(normals[v]) > 0.0f ? glm::normalize(normals[v]) : glm::vec3(0, 1, 0);
     if (n.y < 0.0f) n = -n;  // the file's winding may face down; the bed is lit from above
-    const glm::vec3 albedo = glm::mix(sand, riverbed, glm::smoothstep(0.0f, 0.8f, river.depth[v]));
-    geometry.vertices.push_back({bed[v], n, glm::vec4(albedo, 1.0f)});
+    geometry.vertices.push_back(ground_vertex(bed[v], n, -river.depth[v]));
   }
   geometry.indices = river.indices;
+  SIVIFLOW_TRY(add_ground_around_rivers(ground_rivers, &geometry));
   add_obstacle_boulders(obstacles, &geometry);
-  return geometry;
+  *out = std::move(geometry);
+  return Status::success();
 }
 
 Camera river_overview_camera(std::span<const glm::vec3> positions) {

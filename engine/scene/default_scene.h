@@ -41,11 +41,17 @@ struct SceneLook {
 };
 
 SceneLook default_scene_look();
+
+// A vertex of the ground (SIVIFLOW_GROUND_VERTEX) `above_water` metres above the water near it
+// (negative: under it), coloured by the scene shader from that height and its steepness.
+SceneVertex ground_vertex(const glm::vec3& position, const glm::vec3& normal, float above_water);
 // Terrain of the river's valley, trees and boulders on its banks, and a boulder for each obstacle.
 SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles);
 // For a river from a file, which brings no terrain: its bed (the surface lowered by the depth
-// of each vertex), and a boulder for each obstacle. Banks and valley come from the scene's objects.
-SceneGeometry build_riverbed_geometry(const RiverMesh& river, const std::vector<Obstacle>& obstacles);
+// of each vertex), the ground around `ground_rivers` (river_ground.h: the scene's glTF rivers,
+// all in one, with its first river's bed), and a boulder for each obstacle.
+Status build_riverbed_geometry(const RiverMesh& river, const std::vector<Obstacle>& obstacles,
+                               std::span<const RiverMesh> ground_rivers, SceneGeometry* out);
 // The camera of the default scene at time t (seconds): it glides down the valley.
 Camera default_camera(const ProceduralRiver& river, double time_seconds);
 // A still camera for a river from a file without camera keys: above and in front of its bounds,

@@ -62,6 +62,7 @@ struct World::Impl {
   bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
   RiverMesh river_mesh;          // for a glTF river's bed and overview camera
   std::vector<SceneGeometry> other_rivers;  // the scene's rivers after the first, until uploaded
+  std::vector<RiverMesh> other_meshes;      // those from files, for the ground, until built
   std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is at the frame's time
   // Per boulder: where the host stood it (overriding its obstacle's keys), and whether it is
   // drawn (spares start hidden).
@@ -118,8 +119,14 @@ Status World::Impl::load_scene() {
   for (size_t i = 1; i < rivers; ++i) {
     SceneRiverData other;
     SIVIFLOW_TRY(scene_river_data(info.scene, i, &other));
-    other_rivers.push_back(other.procedural ? build_scene_geometry(*other.procedural, {})
-                                            : build_riverbed_geometry(other.mesh, {}));
+    SceneGeometry geometry;
+    if (other.procedural) {
+      geometry = build_scene_geometry(*other.procedural, {});
+    } else {
+      SIVIFLOW_TRY(build_riverbed_geometry(other.mesh, {}, {}, &geometry));
+      other_meshes.push_back(std::move(other.mesh));
+    }
+    other_rivers.push_back(std::move(geometry));
   }
   obstacles = info.scene != nullptr ? info.scene->obstacles : default_scene_obstacles(river);
   shown.assign(obstacles.size(), true);
@@ -135,8 +142,14 @@ Status World::Impl::load_scene() {
 }
 
 Status World::Impl::create_resources() {
-  SceneGeometry geometry = river_from_file ? build_riverbed_geometry(river_mesh, obstacles)
-                                           : build_scene_geometry(river, obstacles);
+  SceneGeometry geometry;
+  if (river_from_file) {
+    other_meshes.insert(other_meshes.begin(), river_mesh);
+    SIVIFLOW_TRY(build_riverbed_geometry(river_mesh, obstacles, other_meshes, &geometry));
+    other_meshes.clear();
+  } else {
+    geometry = build_scene_geometry(river, obstacles);
+  }
   SceneObjects objects;
   if (info.scene != nullptr) SIVIFLOW_TRY(load_scene_objects(*info.scene, &objects));
   // Sized once: the draws point into it.

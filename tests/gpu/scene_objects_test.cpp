@@ -165,6 +165,42 @@ TEST_F(SceneObjectsTest, GltfRiverFlowsDownstreamAroundAnObjectObstacle) {
   EXPECT_LT(aside, water / 5);
 }
 
+// A glTF river brings no terrain: the world grows ground around it that meets its banks, so
+// seen from above nothing of the picture is void, and the ground beside the water is the
+// sand and grass of a bank, lit, at the water's own level.
+TEST_F(SceneObjectsTest, GltfRiverHasGroundAroundIt) {
+  write_channel_gltf(dir_ / "channel.gltf", 41, 9, 8.0f, 1.0f, 0.05f);
+  const fs::path scene = dir_ / "scene.json";
+  write_text(scene, R"({"version":1,"river":{"gltf":"channel.gltf"},)"
+                    R"("camera":{"keys":[{"t":0,"position":[0,40,0],"target":[0,0,20]}]}})");
+  const RunResult r = run_siviflow("capture " + scene.string() + " --frames 1 --size 320x180 "
+                                   "--aov depth,flow --validation --out " + (dir_ / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ExrImage image;
+  ASSERT_TRUE(read_exr((dir_ / "out" / "frame_00000.exr").string(), &image).ok());
+  const std::vector<float>& depth = *image.find("depth.Z");
+  const std::vector<float>& mask = *image.find("water.mask");
+  const std::vector<float>& green = *image.find("G");
+  size_t void_pixels = 0, water = 0, ground = 0, grassy = 0;
+  for (size_t i = 0; i < depth.size(); ++i) {
+    if (!std::isfinite(depth[i])) {
+      ++void_pixels;
+      continue;
+    }
+    if (mask[i] == 1.0f) {
+      ++water;
+      continue;
+    }
+    ++ground;
+    grassy += green[i] > (*image.find("R"))[i] * 1.3f ? 1 : 0;
+  }
+  std::printf("%zu water, %zu ground (%zu grassy), %zu void pixels\n", water, ground, grassy,
+              void_pixels);
+  EXPECT_EQ(void_pixels, 0u) << "the river does not float in a void";
+  EXPECT_GT(water, size_t{kWidth * kHeight / 20}) << "the channel is in view";
+  EXPECT_GT(grassy, ground / 2) << "beyond the banks, grass";
+}
+
 // A scene of two rivers captured: both drawn over the world (their beds), with the depth AOV;
 // the AOVs that belong to one river are refused by name before any GPU work.
 TEST_F(SceneObjectsTest, CaptureOfTwoRivers) {
