@@ -19,4 +19,9 @@ std::vector<Obstacle> default_scene_obstacles(const ProceduralRiver& river);
 // The point on the valley's ground `lateral_offset` metres across from the centreline at `z`.
 glm::vec3 on_ground(const ProceduralRiver& river, float lateral_offset, float z);
 
+// The boulder the built-in world draws for an obstacle: as wide as its footprint reaches from
+// its centre, this much of that as high above it.
+inline constexpr float kBoulderHeightRatio = 0.95f;
+float boulder_radius(const Obstacle& obstacle);
+
 }  // namespace siviflow

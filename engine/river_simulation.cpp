@@ -71,6 +71,7 @@ Obstacle flow_obstacle(const WaterObstacle& placed) {
   Obstacle obstacle;
   obstacle.centre = placed.centre;
   obstacle.radius = placed.radius;
+  obstacle.height = placed.height;
   const float c = std::cos(placed.rotation_rad);
   const float s = std::sin(placed.rotation_rad);
   obstacle.polygon.reserve(placed.polygon.size());
@@ -193,7 +194,7 @@ void RiverFlow::dry_footprints(std::vector<DryFootprint>* out) const {
   const std::span<const Obstacle> obstacles = flow_.obstacles();
   for (size_t i = 0; i < obstacles.size(); ++i) {
     const glm::vec3 centre = flow_.obstacle_centre(i);
-    out->push_back({&obstacles[i], glm::dvec2(centre.x, centre.z)});
+    out->push_back({&obstacles[i], glm::dvec2(centre.x, centre.z), centre.y + obstacles[i].height});
   }
 }
 

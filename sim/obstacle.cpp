@@ -47,6 +47,10 @@ Status validate_obstacle(const Obstacle& o, size_t index) {
   if (!finite3(o.centre)) {
     return Status::error(text_format("obstacle %zu has a non-finite centre", index));
   }
+  if (!std::isfinite(o.height) || !(o.height >= 0.0f)) {
+    return Status::error(text_format("obstacle %zu has height %g: it must be finite and >= 0",
+                                     index, double(o.height)));
+  }
   if (o.polygon.empty()) {
     if (!std::isfinite(o.radius) || !(o.radius > 0.0f)) {
       return Status::error(text_format(

@@ -23,6 +23,9 @@ struct Obstacle {
   glm::vec3 centre{0.0f};  // world position when there are no keys
   // Circle footprint of this radius (metres) when `polygon` is empty.
   float radius = 0.0f;
+  // How far it stands above its centre (metres, >= 0): a solid from the water up to there that
+  // hides the water behind it (0: flat, hides nothing).
+  float height = 0.0f;
   // Polygon footprint: (x, z) offsets from the centre, either winding, simple, >= 3 points.
   std::vector<glm::vec2> polygon;
   // Keyframed centre: strictly increasing t; linear in between, held before the first key and

@@ -393,14 +393,15 @@ bool ParticleField::take_dry(std::span<const DryFootprint> dry) {
   for (size_t i = 0; i < dry.size(); ++i) {
     PlacedFootprint& placed = dry_[i];
     const Obstacle& o = *dry[i].obstacle;
-    if (i < before && placed.centre_xz == dry[i].centre_xz && placed.obstacle.radius == o.radius &&
-        placed.obstacle.polygon == o.polygon) {
+    if (i < before && placed.centre_xz == dry[i].centre_xz && placed.top_y == dry[i].top_y &&
+        placed.obstacle.radius == o.radius && placed.obstacle.polygon == o.polygon) {
       continue;
     }
     if (i < before) dry_changed_.push_back({placed.lo, placed.hi});
     placed.obstacle.radius = o.radius;
     placed.obstacle.polygon = o.polygon;
     placed.centre_xz = dry[i].centre_xz;
+    placed.top_y = dry[i].top_y;
     footprint_bounds(placed.obstacle, placed.centre_xz, &placed.lo, &placed.hi);
     dry_changed_.push_back({placed.lo, placed.hi});
   }
@@ -420,6 +421,40 @@ void ParticleField::recheck_around_changed_footprints() {
         break;
       }
     }
+  }
+}
+
+bool ParticleField::hidden_by_obstacle(const glm::dvec3& eye, const glm::vec3& p) const {
+  for (const PlacedFootprint& d : dry_) {
+    if (!(d.top_y > p.y)) continue;  // no higher than the water here: hides nothing
+    // The part of the sight line below the obstacle's top, seen from above.
+    const double t = eye.y > d.top_y ? (eye.y - d.top_y) / (eye.y - double(p.y)) : 0.0;
+    const glm::dvec3 from = eye + t * (glm::dvec3(p) - eye);
+    const glm::dvec2 a(from.x, from.z), b(p.x, p.z);
+    if (std::max(a.x, b.x) < d.lo.x || std::min(a.x, b.x) > d.hi.x ||
+        std::max(a.y, b.y) < d.lo.y || std::min(a.y, b.y) > d.hi.y) {
+      continue;
+    }
+    if (footprint_overlaps_segment(d.obstacle, d.centre_xz, a, b)) return true;
+  }
+  return false;
+}
+
+void ParticleField::pixel_ray(const Frame& f, const glm::vec2& screen, glm::dvec3* origin,
+                              glm::dvec3* dir, float* t_max) {
+  // From the near plane to the far plane (or towards infinity).
+  const double nx = 2.0 * screen.x / f.size.x - 1.0, ny = 2.0 * screen.y / f.size.y - 1.0;
+  const double near_depth = f.reverse_z ? 1.0 : 0.0;
+  const glm::dvec4 a = f.inv_vp * glm::dvec4(nx, ny, near_depth, 1.0);
+  const glm::dvec4 b = f.inv_vp * glm::dvec4(nx, ny, 1.0 - near_depth, 1.0);
+  *origin = glm::dvec3(a) / a.w;
+  *t_max = 1.0f;
+  if (std::fabs(b.w) > 1e-12 * std::fabs(a.w) && (b.w > 0.0) == (a.w > 0.0)) {
+    *dir = glm::dvec3(b) / b.w - *origin;
+  } else {  // infinite far plane
+    const glm::dvec4 m = f.inv_vp * glm::dvec4(nx, ny, 0.5, 1.0);
+    *dir = glm::dvec3(m) / m.w - *origin;
+    *t_max = std::numeric_limits<float>::max();
   }
 }
 
@@ -534,7 +569,13 @@ void ParticleField::project_and_cull(Frame& f) {
     if (p.slot == 0) continue;
     glm::vec2 s;
     const bool in_view = project(f.vp, f.size, p.world, &s) && f.cull.contains(s);
-    const bool dry = in_view && on_dry_ground(p.world);
+    bool dry = in_view && on_dry_ground(p.world);
+    if (in_view && !dry && !dry_.empty()) {
+      glm::dvec3 origin, dir;
+      float t_max = 0.0f;
+      pixel_ray(f, s, &origin, &dir, &t_max);
+      dry = hidden_by_obstacle(origin, p.world);
+    }
     if (in_view && !dry) {
       p.screen = s;
       continue;
@@ -632,21 +673,9 @@ void ParticleField::thin_and_revive(Frame& f) {
 
 bool ParticleField::try_create(Frame& f, const glm::vec2& screen, uint32_t* index) {
   if (f.slots_exhausted || !f.fill.contains(screen)) return false;
-  // The pixel's ray from the near plane to the far plane (or towards infinity).
-  const double nx = 2.0 * screen.x / f.size.x - 1.0, ny = 2.0 * screen.y / f.size.y - 1.0;
-  const double near_depth = f.reverse_z ? 1.0 : 0.0;
-  const glm::dvec4 a = f.inv_vp * glm::dvec4(nx, ny, near_depth, 1.0);
-  const glm::dvec4 b = f.inv_vp * glm::dvec4(nx, ny, 1.0 - near_depth, 1.0);
-  const glm::dvec3 origin = glm::dvec3(a) / a.w;
-  glm::dvec3 dir;
+  glm::dvec3 origin, dir;
   float t_max = 1.0f;
-  if (std::fabs(b.w) > 1e-12 * std::fabs(a.w) && (b.w > 0.0) == (a.w > 0.0)) {
-    dir = glm::dvec3(b) / b.w - origin;
-  } else {  // infinite far plane
-    const glm::dvec4 m = f.inv_vp * glm::dvec4(nx, ny, 0.5, 1.0);
-    dir = glm::dvec3(m) / m.w - origin;
-    t_max = std::numeric_limits<float>::max();
-  }
+  pixel_ray(f, screen, &origin, &dir, &t_max);
   stats_.rays++;
   RayHit hit;
   if (!bvh_->intersect(glm::vec3(origin), glm::vec3(dir), t_max, &hit)) {
@@ -655,6 +684,10 @@ bool ParticleField::try_create(Frame& f, const glm::vec2& screen, uint32_t* inde
   }
   if (on_dry_ground(hit.position)) {  // as a miss: no water to be seen there
     stats_.dry_hits++;
+    return false;
+  }
+  if (hidden_by_obstacle(origin, hit.position)) {
+    stats_.hidden_hits++;
     return false;
   }
   // Distances are checked at the re-projected hit, the position every later frame will use.

@@ -19,7 +19,8 @@
 //      the matrix equals the one the camera last settled on up to rounding (kStillCameraEpsilon);
 //   6. conversion: a new particle's pixel ray is cast into the river (BVH); a miss makes none,
 //      and so does a hit inside an obstacle's dry footprint (the water there is not seen and
-//      its flow is the still water of a wall); a particle a footprint comes to cover goes.
+//      its flow is the still water of a wall) or behind an obstacle the ray meets first (its
+//      footprint raised to its top); a particle a footprint comes to cover or hide goes.
 // Fill method: Dunbar & Humphreys boundary sampling, not Bridson's dart throwing. It only works
 // at the boundary of the covered region (cost scales with the gap, not the screen), it yields
 // a maximal set (no point of the water is left farther than the spacing from a particle, which
@@ -40,6 +41,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -98,10 +100,12 @@ struct ParticleParams {
   float advection_scale = 1.0f;
 };
 
-// An obstacle's footprint where it stands this frame: dry ground in the river.
+// An obstacle where it stands this frame: its footprint is dry ground in the river, and up to
+// its top it hides the water behind it.
 struct DryFootprint {
   const Obstacle* obstacle = nullptr;  // read during the update only
   glm::dvec2 centre_xz{0.0};
+  double top_y = -std::numeric_limits<double>::infinity();  // world height of its top
 };
 
 enum class ParticleState : uint8_t { kActive, kFadingIn, kFadingOut };
@@ -136,8 +140,9 @@ struct ParticleStats {
   uint32_t revived = 0;   // fading out, spot free again: fading back in
   uint32_t evicted = 0;   // fading out, slot taken early because the slots ran out
   uint32_t left_river = 0;  // advection carried it off the water
-  uint32_t dry = 0;       // a footprint came to cover it (removed at once, as a culled one)
+  uint32_t dry = 0;       // a footprint came to cover or hide it (removed at once, as culled)
   uint32_t dry_hits = 0;  // pixel rays that met the river inside a footprint (no particle)
+  uint32_t hidden_hits = 0;  // pixel rays that met an obstacle before the river (no particle)
   uint32_t rays = 0;      // pixel rays cast (conversion and seeding)
   uint32_t ray_misses = 0;
   uint32_t arc_checks = 0;  // particles whose fill circle was recomputed
@@ -208,6 +213,12 @@ class ParticleField {
   // Takes this frame's footprints (with bounds); true when they differ from the last frame's.
   bool take_dry(std::span<const DryFootprint> dry);
   bool on_dry_ground(const glm::vec3& p) const;
+  // Whether the sight line from `eye` to the water at `p` passes through an obstacle's solid
+  // (its footprint from the water up to its top).
+  bool hidden_by_obstacle(const glm::dvec3& eye, const glm::vec3& p) const;
+  // The point where the pixel ray through `screen` starts (the near plane), and its direction.
+  static void pixel_ray(const Frame& f, const glm::vec2& screen, glm::dvec3* origin, glm::dvec3* dir,
+                        float* t_max);
   // The particles next to where a footprint was or now is look at their fill circles again:
   // water a footprint left is covered at once, even under a still camera.
   void recheck_around_changed_footprints();
@@ -267,6 +278,7 @@ class ParticleField {
   struct PlacedFootprint {
     Obstacle obstacle;  // a copy: the caller's may change in place between frames
     glm::dvec2 centre_xz{0.0};
+    double top_y = 0.0;
     glm::dvec2 lo{0.0}, hi{0.0};
   };
   std::vector<PlacedFootprint> dry_;  // this frame's

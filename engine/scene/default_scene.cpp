@@ -111,10 +111,9 @@ void add_tree(glm::vec3 foot, float height, SceneGeometry* geometry) {
 void add_obstacle_boulders(const std::vector<Obstacle>& obstacles, SceneGeometry* geometry) {
   geometry->static_index_count = static_cast<uint32_t>(geometry->indices.size());
   for (size_t i = 0; i < obstacles.size(); ++i) {
-    float radius = obstacles[i].radius;
-    for (const glm::vec2& corner : obstacles[i].polygon) radius = std::max(radius, glm::length(corner));
+    const float radius = boulder_radius(obstacles[i]);
     const uint32_t first = static_cast<uint32_t>(geometry->indices.size());
-    add_boulder(glm::vec3(0.0f), {radius, 0.95f * radius, 0.92f * radius},
+    add_boulder(glm::vec3(0.0f), {radius, kBoulderHeightRatio * radius, 0.92f * radius},
                 i % 2 == 0 ? kGranite : kSandstone, 3.0f + static_cast<float>(i), geometry);
     geometry->obstacle_boulders.push_back({first, static_cast<uint32_t>(geometry->indices.size()) - first});
   }

@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "default_river.h"
 #include "scene/gltf_import.h"
 #include "scene/look_fields.h"
 #include "sim/river_tuning.h"
@@ -403,7 +404,7 @@ Status parse_obstacles(const Reader& r, const Json& v, std::vector<Obstacle>* ou
     const std::string path = element("obstacles", i);
     const Json& o = v[i];
     SIVIFLOW_TRY(r.object(o, path));
-    SIVIFLOW_TRY(r.keys(o, path, {"center", "radius", "polygon", "keys"}));
+    SIVIFLOW_TRY(r.keys(o, path, {"center", "radius", "polygon", "height", "keys"}));
     Obstacle obstacle;
     const Json* center = find(o, "center");
     const Json* radius = find(o, "radius");
@@ -418,6 +419,11 @@ Status parse_obstacles(const Reader& r, const Json& v, std::vector<Obstacle>* ou
     SIVIFLOW_TRY(r.vec3(*center, join(path, "center"), &obstacle.centre));
     if (radius) SIVIFLOW_TRY(r.positive(*radius, join(path, "radius"), &obstacle.radius));
     if (polygon) SIVIFLOW_TRY(parse_polygon(r, *polygon, join(path, "polygon"), &obstacle.polygon));
+    // Without a height, the boulder the world draws for it stands this high.
+    obstacle.height = kBoulderHeightRatio * boulder_radius(obstacle);
+    if (const Json* height = find(o, "height")) {
+      SIVIFLOW_TRY(r.real(*height, join(path, "height"), &obstacle.height));
+    }
     if (const Json* keys = find(o, "keys")) {
       const std::string keys_path = join(path, "keys");
       SIVIFLOW_TRY(r.array(*keys, keys_path, kMaxObstacleKeys));

@@ -185,6 +185,7 @@ Status scene_object_obstacles(const SceneFile& scene, std::span<const glm::vec3>
     Obstacle obstacle;
     const Status footprint = footprint_obstacle(object, level, &obstacle);
     if (!footprint.ok()) return Status::error(scene.path + ": " + what + footprint.message());
+    obstacle.height = std::max(0.0f, hi.y - obstacle.centre.y);  // it hides the water up to its top
     obstacles.push_back(std::move(obstacle));
   }
   *out = std::move(obstacles);
@@ -209,6 +210,7 @@ WaterObstacle water_obstacle(const Obstacle& obstacle) {
   WaterObstacle out;
   out.centre = obstacle.centre;
   out.radius = obstacle.radius;
+  out.height = obstacle.height;
   out.polygon = obstacle.polygon;
   for (const ObstacleKey& key : obstacle.keys) out.keys.push_back({key.t, key.centre});
   return out;

@@ -331,6 +331,53 @@ TEST(Particles, NoneInsideAnObstaclesFootprintAndTheWaterItLeavesIsCoveredAtOnce
   EXPECT_NE(refused.message().find("dry footprint 0"), std::string::npos) << refused.message();
 }
 
+TEST(Particles, NoneWhereAnObstacleStandsBetweenTheCameraAndTheWater) {
+  // A tall block in the channel seen at a low angle: the water behind it, up to its top, is
+  // hidden; a flat footprint of the same shape hides only what it covers.
+  const GridRiver r = test::straight_channel(30.0f, 200.0f, 31, 201);
+  ParticleField field = make_field(r, small_params());
+  const ScreenCamera cam = test::look_at({0.0f, 3.0f, 0.0f}, {0.0f, 0.0f, 30.0f}, kSmall);
+  Obstacle block;
+  block.polygon = {{-3.0f, -1.0f}, {3.0f, -1.0f}, {3.0f, 1.0f}, {-3.0f, 1.0f}};
+  block.height = 2.0f;
+  const DryFootprint standing[] = {{&block, {0.0, 15.0}, 2.0}};
+  // The test's own sight-line check: the eye-to-water segment, below the top, over the block.
+  const glm::vec3 eye(0.0f, 3.0f, 0.0f);
+  const auto hidden = [&](const Particle& p) {
+    for (float t = 0.0f; t <= 1.0f; t += 0.002f) {
+      const glm::vec3 q = eye + t * (p.world - eye);
+      if (q.y <= 2.0f && std::abs(q.x) < 3.0f && std::abs(q.z - 15.0f) < 1.0f) return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(field.update(cam, 0, kDt, standing).ok());
+  EXPECT_GT(field.stats().hidden_hits, 0u) << "rays met the block before the water";
+  size_t behind = 0, beside = 0;
+  for (const Particle& p : field.particles()) {
+    EXPECT_FALSE(hidden(p)) << "particle " << p.id << " at " << p.world.x << ", " << p.world.z;
+    behind += p.world.z > 16.0f && std::abs(p.world.x) < 2.0f ? 1 : 0;
+    beside += p.world.z > 16.0f && std::abs(p.world.x) > 5.0f ? 1 : 0;
+  }
+  EXPECT_GT(beside, 20u) << "the water beside the block is seen";
+  EXPECT_GT(behind, 0u) << "far behind it, over its top, the water is seen again";
+
+  // The block drops to the water: what it hid is covered again at once, as closely as by a
+  // field that never saw it stand.
+  const DryFootprint flat[] = {{&block, {0.0, 15.0}, 0.0}};
+  ASSERT_TRUE(field.update(cam, 1, kDt, flat).ok());
+  ParticleField fresh = make_field(r, small_params());
+  ASSERT_TRUE(fresh.update(cam, 0, kDt, flat).ok());
+  const auto close_behind = [](const ParticleField& f) {
+    size_t n = 0;
+    for (const Particle& p : f.particles()) {
+      n += p.live() && p.world.z > 16.0f && p.world.z < 25.0f && std::abs(p.world.x) < 2.0f;
+    }
+    return n;
+  };
+  EXPECT_GT(close_behind(fresh), 5u);
+  EXPECT_GE(close_behind(field), close_behind(fresh) * 8 / 10);
+}
+
 // Worst distance from an interior water pixel of the channel to the nearest live particle.
 float worst_gap(const ParticleField& field, const ScreenCamera& camera, float width, float length) {
   const test::PixelRays cam(camera);

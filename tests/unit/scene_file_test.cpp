@@ -572,6 +572,18 @@ TEST(SceneFile, LookKeysReachTheLookAndBadOnesAreNamed) {
   expect_error(with({{"look", {{"gloss", 1}}}}), {"look.gloss: unknown key", "fresnel_f0"});
 }
 
+TEST(SceneFile, ObstacleHeightDefaultsToItsBouldersAndMustNotBeNegative) {
+  SceneFile scene;
+  ASSERT_TRUE(parse(with({{"obstacles", {{{"center", {0, 0, 5}}, {"radius", 2.0}},
+                                         {{"center", {0, 0, 9}}, {"radius", 1.0}, {"height", 3.5}}}}}),
+                    &scene).ok());
+  ASSERT_EQ(scene.obstacles.size(), 2u);
+  EXPECT_FLOAT_EQ(scene.obstacles[0].height, 0.95f * 2.0f) << "the boulder drawn for it";
+  EXPECT_FLOAT_EQ(scene.obstacles[1].height, 3.5f);
+  expect_error(with({{"obstacles", {{{"center", {0, 0, 5}}, {"radius", 2.0}, {"height", -1}}}}}),
+               {"obstacles[0]", "height -1", ">= 0"});
+}
+
 TEST(SceneFile, LookMaterialIsNamedAndAnUnknownOneRefused) {
   SceneFile scene;
   ASSERT_TRUE(parse(with({{"look", {{"material", "flowmap"}}}}), &scene).ok());
@@ -622,7 +634,7 @@ TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {
   const Json& obstacle = top["obstacles"]["items"];
   std::set<std::string> obstacle_keys;
   for (const auto& item : obstacle["properties"].items()) obstacle_keys.insert(item.key());
-  EXPECT_EQ(obstacle_keys, (std::set<std::string>{"center", "radius", "polygon", "keys"}));
+  EXPECT_EQ(obstacle_keys, (std::set<std::string>{"center", "radius", "polygon", "height", "keys"}));
   EXPECT_EQ(obstacle["required"], Json({"center"}));
   ASSERT_EQ(obstacle["oneOf"].size(), 2u);
   EXPECT_EQ(obstacle["properties"]["polygon"]["minItems"].get<int>(), 3);

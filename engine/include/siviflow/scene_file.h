@@ -11,6 +11,7 @@
 //                                                  the default of "rivers" without their own
 //     "obstacles": [ { "center": [x,y,z], "radius": 1.5,            a circle, or a footprint:
 //                      | "polygon": [[x,z], [x,z], [x,z], ...],      offsets around center
+//                      "height": 1.4,                                above center
 //                      "keys": [ { "t": 0.0, "center": [..] } ] } ],
 //     "objects":   [ { "gltf": "duck.glb", "translation": [..], "rotation": [x,y,z,w],
 //                      "scale": [..], "obstacle": true } ],
@@ -30,6 +31,9 @@
 //                           [x, z] offsets in metres from `center` in the XZ plane, either
 //                           winding, convex or not, but simple (no crossing or touching edges,
 //                           no repeated points; the outline closes by itself)
+//   obstacles[].height      0.95 of the footprint's reach from `center` (the boulder drawn for
+//                           it): how far it stands above `center`, hiding the water behind it
+//   objects[] obstacle      its height: the top of its transformed mesh
 //   objects[].translation   [0, 0, 0];  rotation [0, 0, 0, 1] (normalised on load);
 //   objects[].scale         [1, 1, 1];  obstacle false. An obstacle object is static (no keys):
 //                           its footprint is the XZ convex hull of its transformed mesh where it

@@ -23,6 +23,9 @@ struct WaterObstacleKey {
 struct WaterObstacle {
   glm::vec3 centre{0.0f};  // world position; the footprint lies around it in x and z
   float radius = 0.0f;     // a circle of this radius (metres) when `polygon` is empty
+  // How far it stands above its centre, metres: the water behind it, seen through it up to
+  // there, gets no particles (0: flat, hides nothing).
+  float height = 0.0f;
   // A polygon footprint: (x, z) offsets from the centre, 3 .. 4096 points, simple, either winding.
   std::vector<glm::vec2> polygon;
   float rotation_rad = 0.0f;  // turns the polygon about +Y as glm::rotate does (+X towards -Z)
