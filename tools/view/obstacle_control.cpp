@@ -6,6 +6,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "default_river.h"
+
 namespace siviflow::view {
 namespace {
 
@@ -53,6 +55,7 @@ Status ObstacleControl::init(std::span<const SceneRiverData> rivers, size_t scen
   for (uint32_t i = 0; i < kSpareBoulders; ++i) {
     Entry spare;
     spare.obstacle.radius = kSpareBoulderRadius;
+    spare.obstacle.height = kBoulderHeightRatio * kSpareBoulderRadius;  // as the world draws it
     spare.boulder = static_cast<uint32_t>(scene_obstacles) + i;
     spare.active = false;
     entries_.push_back(std::move(spare));
