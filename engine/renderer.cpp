@@ -121,10 +121,26 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
                    std::to_string(info.extent.height) + " exceeds the device limit of " +
                    std::to_string(limit));
   }
+  // The water pass draws the AOVs it reads back beside the colour, unblended.
+  const uint32_t attachments = 1 + ((info.readback_images & kAovReadbackImages) != 0
+                                        ? FlowPass::kAovAttachmentCount : 0);
+  if (props.properties.limits.maxColorAttachments < attachments) {
+    return Status::error("siviflow::Renderer: CreateInfo::readback_images asks for the water "
+                         "pass's AOVs, " + std::to_string(attachments) +
+                         " colour attachments, and this device draws at most " +
+                         std::to_string(props.properties.limits.maxColorAttachments),
+                         VK_ERROR_FEATURE_NOT_PRESENT);
+  }
   VkFormatProperties format_props;
   table.vkGetPhysicalDeviceFormatProperties(info.physical_device, info.color_format, &format_props);
-  if ((format_props.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT) == 0) {
-    return Status::error("siviflow::Renderer: color_format cannot be rendered to on this device",
+  // Drawn to; and, as the refraction's copy, copied into, out of and sampled.
+  const VkFormatFeatureFlags color_needs =
+      VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT |
+      VK_FORMAT_FEATURE_TRANSFER_SRC_BIT | VK_FORMAT_FEATURE_TRANSFER_DST_BIT;
+  if ((format_props.optimalTilingFeatures & color_needs) != color_needs) {
+    return Status::error("siviflow::Renderer: CreateInfo::color_format " +
+                             std::to_string(info.color_format) +
+                             " cannot be drawn to, copied and sampled on this device",
                          VK_ERROR_FORMAT_NOT_SUPPORTED);
   }
   table.vkGetPhysicalDeviceFormatProperties(info.physical_device, info.depth_format, &format_props);

@@ -199,6 +199,7 @@ void RiverFlow::dry_footprints(std::vector<DryFootprint>* out) const {
 }
 
 Status RiverView::simulate(const glm::mat4& view_proj, float dt_seconds) {
+  if (river_ == nullptr) return Status::error("particles: simulate on a view create() did not make");
   river_->dry_footprints(&dry_);
   return particles_.update(ScreenCamera{view_proj, viewport_}, particles_.next_frame(), dt_seconds,
                            dry_);

@@ -31,7 +31,7 @@ void main() {
   vec2 uv = pixel * flow.screen.zw;
   vec3 sum = texture(reflection_map, uv).rgb + texelFetch(refraction_map, ivec2(pixel), 0).rgb +
              texelFetch(host_depth, ivec2(gl_FragCoord.xy), 0).r +
-             texelFetch(host_depth, ivec2(gl_FragCoord.xy) + 1, 0).r;
+             texelFetch(host_depth, min(ivec2(gl_FragCoord.xy) + 1, textureSize(host_depth, 0) - 1), 0).r;
   // Normal-map coordinates at the material's map scale (its mid-speed scale), with the world
   // position's gradients, so the reads come from the same mip levels as the material's.
   vec2 tile = in_world.xz * (0.5 * (kTdfScaleStill + kTdfScaleFast) / (look.surface.y * flow.water.z));

@@ -905,9 +905,9 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
   }
   for (size_t i = 0; i < dry.size(); ++i) {
     if (dry[i].obstacle == nullptr || !std::isfinite(dry[i].centre_xz.x) ||
-        !std::isfinite(dry[i].centre_xz.y)) {
+        !std::isfinite(dry[i].centre_xz.y) || std::isnan(dry[i].top_y)) {
       return Status::error("particles: dry footprint " + std::to_string(i) +
-                           " has no obstacle or a centre that is not finite");
+                           " has no obstacle, a centre that is not finite or a top that is NaN");
     }
   }
   Frame f;

@@ -81,6 +81,7 @@ class FlowPass {
   static constexpr VkFormat kNormalFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
   static constexpr VkFormat kReflectionFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
   static constexpr VkFormat kFoamFormat = VK_FORMAT_R32_SFLOAT;
+  static constexpr uint32_t kAovAttachmentCount = 4;  // mask, normal, reflection, foam
 
   static constexpr VkFormat kTileTableFormat = VK_FORMAT_R32G32B32A32_UINT;  // shaders/shared.h
   static constexpr VkFormat kWaterHeightsFormat = VK_FORMAT_R32_SFLOAT;

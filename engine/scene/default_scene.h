@@ -48,8 +48,10 @@ SceneVertex ground_vertex(const glm::vec3& position, const glm::vec3& normal, fl
 // Terrain of the river's valley, trees and boulders on its banks, and a boulder for each obstacle.
 SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles);
 // For a river from a file, which brings no terrain: its bed (the surface lowered by the depth
-// of each vertex), the ground around `ground_rivers` (river_ground.h: the scene's glTF rivers,
-// all in one, with its first river's bed), and a boulder for each obstacle.
+// of each vertex), the ground around `ground_rivers` (river_ground.h: all the scene's glTF
+// rivers, in one, with the first river's bed when that one is from a file; a procedural first
+// river brings its own valley, and glTF rivers beside it get no ground), and a boulder for
+// each obstacle.
 Status build_riverbed_geometry(const RiverMesh& river, const std::vector<Obstacle>& obstacles,
                                std::span<const RiverMesh> ground_rivers, SceneGeometry* out);
 // The camera of the default scene at time t (seconds): it glides down the valley.

@@ -47,12 +47,11 @@ class BankLookup {
                                          glm::ivec2(0), size_ - 1);
     uint32_t best = 0;
     float best_sq = std::numeric_limits<float>::max();
-    // Rings of cells outwards until the ring's nearest edge lies beyond the best found.
-    const float outside = std::max({lo_.x - xz.x, xz.x - (lo_.x + size_.x * kHashCellM),
-                                    lo_.y - xz.y, xz.y - (lo_.y + size_.y * kHashCellM), 0.0f});
+    // Rings of cells outwards until the ring's nearest possible point lies beyond the best found
+    // (ring r is at least r - 1 cells away, whether the point is inside the grid or beyond it).
     for (int ring = 0; ring <= std::max(size_.x, size_.y); ++ring) {
-      const float reach = outside + (ring - 1) * kHashCellM;
-      if (ring > 0 && reach > 0.0f && reach * reach > best_sq) break;
+      const float reach = (ring - 1) * kHashCellM;
+      if (ring > 1 && reach * reach > best_sq) break;
       for (int y = centre.y - ring; y <= centre.y + ring; ++y) {
         for (int x = centre.x - ring; x <= centre.x + ring; ++x) {
           if (std::max(std::abs(x - centre.x), std::abs(y - centre.y)) != ring) continue;

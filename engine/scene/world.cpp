@@ -149,6 +149,7 @@ Status World::Impl::create_resources() {
     other_meshes.clear();
   } else {
     geometry = build_scene_geometry(river, obstacles);
+    other_meshes.clear();
   }
   SceneObjects objects;
   if (info.scene != nullptr) SIVIFLOW_TRY(load_scene_objects(*info.scene, &objects));

@@ -18,8 +18,8 @@ namespace siviflow {
 struct GraphicsPipelineDesc {
   std::string_view vertex_shader;    // embedded module name, e.g. "scene.vert"
   std::string_view fragment_shader;  // e.g. "scene.frag"
-  // The fragment shader's specialization constants: constant_id i takes value i (32 bits each;
-  // a bool is 0 or 1). Variants that would otherwise be uniform branches, which a software
+  // The fragment shader's specialization constants: constant_id i takes fragment_constants[i]
+  // (32 bits each; a bool is 0 or 1). Variants that would otherwise be uniform branches, which a software
   // rasterizer pays for even when untaken.
   std::vector<uint32_t> fragment_constants;
   std::vector<VkVertexInputBindingDescription> bindings;

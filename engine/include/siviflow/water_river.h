@@ -24,7 +24,8 @@ struct WaterObstacle {
   glm::vec3 centre{0.0f};  // world position; the footprint lies around it in x and z
   float radius = 0.0f;     // a circle of this radius (metres) when `polygon` is empty
   // How far it stands above its centre, metres: the water behind it, seen through it up to
-  // there, gets no particles (0: flat, hides nothing).
+  // there, gets no particles (0: flat, hides nothing). It counts as a solid over its whole
+  // footprint: water seen under an overhang (a leaning log) counts as hidden.
   float height = 0.0f;
   // A polygon footprint: (x, z) offsets from the centre, 3 .. 4096 points, simple, either winding.
   std::vector<glm::vec2> polygon;
