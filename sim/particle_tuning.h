@@ -61,9 +61,13 @@ inline constexpr uint32_t kDrySectors = 32;
 inline constexpr uint32_t kArcRecheckFrames = 8;
 // With the camera moving, dry sectors are forgotten every this many frames (staggered by id).
 inline constexpr uint32_t kDryRecheckFrames = 16;
-// Where an obstacle's footprint moved, came or went, the particles within this many metres of
-// its old and new bounds (or as far again as it is wide, if wider) recheck their fill circles.
-inline constexpr double kDryRecheckMarginM = 2.0;
+// Where an obstacle's footprint moved, came or went, the particles whose fill circles (this many
+// of them, in the screen's scale at the particle) reach its old or new bounds recheck them; at
+// least this many metres, at most that many (a particle at the horizon).
+inline constexpr float kDryRecheckCircles = 2.0f;
+inline constexpr double kDryRecheckMarginM = 1.0;
+inline constexpr double kDryRecheckMaxM = 50.0;
+inline constexpr float kScaleProbeM = 0.1f;  // metres stepped to measure the screen's scale
 // Seeding (finding water not connected on screen to any particle): a fill-domain cell is
 // re-tested every this many frames when the camera moves; cells on the domain border (where a
 // pan brings new water in) more often.

@@ -387,7 +387,11 @@ void ParticleField::clear_state() {
 
 bool ParticleField::take_dry(std::span<const DryFootprint> dry) {
   dry_changed_.clear();
-  for (size_t i = dry.size(); i < dry_.size(); ++i) dry_changed_.push_back({dry_[i].lo, dry_[i].hi});
+  dry_changed_hides_ = false;
+  for (size_t i = dry.size(); i < dry_.size(); ++i) {
+    dry_changed_.push_back({dry_[i].lo, dry_[i].hi});
+    dry_changed_hides_ = dry_changed_hides_ || dry_[i].obstacle.height > 0.0f;
+  }
   const size_t before = dry_.size();
   dry_.resize(dry.size());
   for (size_t i = 0; i < dry.size(); ++i) {
@@ -397,25 +401,41 @@ bool ParticleField::take_dry(std::span<const DryFootprint> dry) {
         placed.obstacle.radius == o.radius && placed.obstacle.polygon == o.polygon) {
       continue;
     }
-    if (i < before) dry_changed_.push_back({placed.lo, placed.hi});
+    if (i < before) {
+      dry_changed_.push_back({placed.lo, placed.hi});
+      dry_changed_hides_ = dry_changed_hides_ || placed.obstacle.height > 0.0f;
+    }
     placed.obstacle.radius = o.radius;
+    placed.obstacle.height = o.height;
     placed.obstacle.polygon = o.polygon;
     placed.centre_xz = dry[i].centre_xz;
     placed.top_y = dry[i].top_y;
     footprint_bounds(placed.obstacle, placed.centre_xz, &placed.lo, &placed.hi);
     dry_changed_.push_back({placed.lo, placed.hi});
+    dry_changed_hides_ = dry_changed_hides_ || placed.obstacle.height > 0.0f;
   }
   return !dry_changed_.empty();
 }
 
-void ParticleField::recheck_around_changed_footprints() {
+void ParticleField::recheck_around_changed_footprints(const Frame& f) {
   for (Particle& p : particles_) {
     if (p.slot == 0) continue;
+    // How far this particle's fill circle reaches on the water: the circle's pixels over the
+    // screen's scale there (along the more foreshortened of x and z), at least a margin.
+    double reach = kDryRecheckMarginM;
+    glm::vec2 along_x, along_z;
+    if (project(f.vp, f.size, p.world + glm::vec3(kScaleProbeM, 0.0f, 0.0f), &along_x) &&
+        project(f.vp, f.size, p.world + glm::vec3(0.0f, 0.0f, kScaleProbeM), &along_z)) {
+      const float pixels_per_metre =
+          std::min(glm::length(along_x - p.screen), glm::length(along_z - p.screen)) / kScaleProbeM;
+      if (pixels_per_metre > 0.0f) {
+        reach = std::clamp(double(kDryRecheckCircles * spacing_ / pixels_per_metre), reach,
+                           kDryRecheckMaxM);
+      }
+    }
     const glm::dvec2 xz(p.world.x, p.world.z);
     for (const auto& [lo, hi] : dry_changed_) {
-      // As far again as the footprint is wide: the particles whose fill circles reach over it.
-      const glm::dvec2 margin = glm::max(hi - lo, glm::dvec2(kDryRecheckMarginM));
-      if (glm::all(glm::greaterThanEqual(xz, lo - margin)) && glm::all(glm::lessThanEqual(xz, hi + margin))) {
+      if (glm::all(glm::greaterThanEqual(xz, lo - reach)) && glm::all(glm::lessThanEqual(xz, hi + reach))) {
         slots_[p.slot].dry_mask = 0;
         slots_[p.slot].dirty = true;
         break;
@@ -932,13 +952,14 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
   f.cull = {-cm, -cm, f.size.x + cm, f.size.y + cm};
 
   stats_ = {};
-  // Advection moves the particles on screen just as a camera move does, and moved footprints
-  // change where the water is seen. Compared with the camera the epoch began with, not last
-  // frame's, so a drift within the tolerance cannot add up; exact equality would call a
-  // recomputed matrix's rounding a move.
+  // Advection moves the particles on screen just as a camera move does, and so does an obstacle
+  // that hides water moving (what it uncovers may lie far behind it on screen); a flat
+  // footprint moving only concerns the particles around it (recheck_around_changed_footprints).
+  // Compared with the camera the epoch began with, not last frame's, so a drift within the
+  // tolerance cannot add up; exact equality would call a recomputed matrix's rounding a move.
   const bool dry_changed = take_dry(dry);
   f.camera_changed = next_frame_ == 0 || !same_camera(f.vp, epoch_view_proj_) ||
-                     (params_.advect && dt_seconds > 0.0f) || dry_changed;
+                     (params_.advect && dt_seconds > 0.0f) || (dry_changed && dry_changed_hides_);
   if (f.camera_changed) {
     ++camera_epoch_;
     epoch_view_proj_ = f.vp;
@@ -949,7 +970,7 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
   uint32_t live_before = 0;
   for (const Particle& p : particles_) live_before += p.slot != 0 && p.live();
   project_and_cull(f);
-  if (dry_changed) recheck_around_changed_footprints();
+  if (dry_changed) recheck_around_changed_footprints(f);
   uint32_t live_after = 0;
   for (const Particle& p : particles_) live_after += p.slot != 0 && p.live();
   remove_dead();

@@ -219,9 +219,9 @@ class ParticleField {
   // The point where the pixel ray through `screen` starts (the near plane), and its direction.
   static void pixel_ray(const Frame& f, const glm::vec2& screen, glm::dvec3* origin, glm::dvec3* dir,
                         float* t_max);
-  // The particles next to where a footprint was or now is look at their fill circles again:
+  // The particles whose fill circles reach where a footprint was or now is look at them again:
   // water a footprint left is covered at once, even under a still camera.
-  void recheck_around_changed_footprints();
+  void recheck_around_changed_footprints(const Frame& f);
   void take_vertex_attributes(Particle& p) const;
   void advance_fades(float dt);
   void advect(float dt);
@@ -283,6 +283,7 @@ class ParticleField {
   };
   std::vector<PlacedFootprint> dry_;  // this frame's
   std::vector<std::pair<glm::dvec2, glm::dvec2>> dry_changed_;  // bounds where they changed
+  bool dry_changed_hides_ = false;  // one of those stands above the water (or stood)
   ParticleStats stats_;
 };
 
