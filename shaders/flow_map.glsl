@@ -39,8 +39,7 @@ FlowMapSample flow_map_at(vec2 pixel, float texel_px, usampler2D flow_texture,
     if (texel.r == SIVIFLOW_PARTICLE_NONE) continue;
     vec2 axis = mix(1.0 - f, f, vec2(corner));
     float w = axis.x * axis.y;
-    float foam = texelFetch(particle_aux, ivec2(texel.r % SIVIFLOW_AUX_WIDTH,
-                                                 texel.r / SIVIFLOW_AUX_WIDTH), 0).b;
+    float foam = texelFetch(particle_aux, SIVIFLOW_AUX_TEXEL(texel.r), 0).b;
     sum += w * vec3(tdf_texel_flow(texel).xz, foam);
     weight += w;
   }

@@ -61,8 +61,7 @@ void main() {
   vec2 pixel = gl_FragCoord.xy - flow.screen.xy;  // in the view's viewport
   uvec4 texel = texelFetch(flow_texture, ivec2(pixel * (1.0 / flow.water.w)), 0);
   uint own = texel.r;
-  float fade = texelFetch(particle_aux, ivec2(own % SIVIFLOW_AUX_WIDTH,
-                                               own / SIVIFLOW_AUX_WIDTH), 0).a;
+  float fade = texelFetch(particle_aux, SIVIFLOW_AUX_TEXEL(own), 0).a;
 
   // The water the view ray crosses: from the surface to what the host drew behind it. Both
   // depths lie on this pixel's ray, where view distances go as (depth - k).

@@ -21,7 +21,7 @@ const float kNeighbourWeight[9] = float[9](1.0, 1.0, 1.0, 1.0, 1.0, 0.5, 0.5, 0.
 // The foam of a flow texel's particle (slot 0, no particle, reads the aux texture's all-zero
 // texel 0: no foam).
 float texel_foam(uint slot) {
-  return texelFetch(particle_aux, ivec2(slot % SIVIFLOW_AUX_WIDTH, slot / SIVIFLOW_AUX_WIDTH), 0).b;
+  return texelFetch(particle_aux, SIVIFLOW_AUX_TEXEL(slot), 0).b;
 }
 
 void main() {

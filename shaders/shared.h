@@ -81,6 +81,8 @@ struct SceneConstants {
 #define SIVIFLOW_FLOW_TEXEL_PX 4
 #define SIVIFLOW_PARTICLE_NONE 0u
 #define SIVIFLOW_AUX_WIDTH 256u
+// The aux texel of particle slot s (GLSL).
+#define SIVIFLOW_AUX_TEXEL(s) ivec2((s) % SIVIFLOW_AUX_WIDTH, (s) / SIVIFLOW_AUX_WIDTH)
 
 #ifdef __cplusplus
 struct FlowTexel {

@@ -147,30 +147,26 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
        {VK_NULL_HANDLE, textures.tile_table, VK_IMAGE_LAYOUT_GENERAL},
        {nearest_, textures.aux, read}}};
   std::vector<VkWriteDescriptorSet> writes;
-  const auto write = [&writes](VkDescriptorSet set, std::span<const VkDescriptorType> types,
+  // Bindings first, first + 1, ... of `set` to `images`.
+  const auto write = [&writes](VkDescriptorSet set, uint32_t first,
+                               std::span<const VkDescriptorType> types,
                                std::span<const VkDescriptorImageInfo> images) {
     for (uint32_t i = 0; i < images.size(); ++i) {
       VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
       w.dstSet = set;
-      w.dstBinding = i;
+      w.dstBinding = first + i;
       w.descriptorCount = 1;
-      w.descriptorType = types[i];
+      w.descriptorType = types[first + i];
       w.pImageInfo = &images[i];
       writes.push_back(w);
     }
   };
-  for (VkDescriptorSet set : sets_) write(set, kMaterialBindings, material);
   const VkDescriptorImageInfo refraction{nearest_, textures.refraction, read};
   for (VkDescriptorSet set : sets_) {
-    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    w.dstSet = set;
-    w.dstBinding = kRefractionBinding;
-    w.descriptorCount = 1;
-    w.descriptorType = kMaterialBindings[kRefractionBinding];
-    w.pImageInfo = &refraction;
-    writes.push_back(w);
+    write(set, 0, kMaterialBindings, material);
+    write(set, kRefractionBinding, kMaterialBindings, {&refraction, 1});
   }
-  write(tiles_set_, kTileBindings, tiles);
+  write(tiles_set_, 0, kTileBindings, tiles);
   std::vector<VkDescriptorBufferInfo> looks(slot_count_);
   for (uint32_t slot = 0; slot < slot_count_; ++slot) {
     looks[slot] = {look_buffer_.buffer, kLookStride * slot, sizeof(gpu::WaterLookConstants)};
