@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <glm/geometric.hpp>
@@ -194,7 +195,10 @@ void RiverFlow::dry_footprints(std::vector<DryFootprint>* out) const {
   const std::span<const Obstacle> obstacles = flow_.obstacles();
   for (size_t i = 0; i < obstacles.size(); ++i) {
     const glm::vec3 centre = flow_.obstacle_centre(i);
-    out->push_back({&obstacles[i], glm::dvec2(centre.x, centre.z), centre.y + obstacles[i].height});
+    // Flat (no height): it hides nothing, wherever its centre stands.
+    const double top = obstacles[i].height > 0.0f ? double(centre.y) + obstacles[i].height
+                                                  : -std::numeric_limits<double>::infinity();
+    out->push_back({&obstacles[i], glm::dvec2(centre.x, centre.z), top});
   }
 }
 

@@ -382,6 +382,7 @@ void ParticleField::clear_state() {
   camera_epoch_ = 0;
   epoch_view_proj_ = glm::mat4(0.0f);
   dry_.clear();
+  any_dry_hides_ = false;
   stats_ = {};
 }
 
@@ -390,7 +391,7 @@ bool ParticleField::take_dry(std::span<const DryFootprint> dry) {
   dry_changed_hides_ = false;
   for (size_t i = dry.size(); i < dry_.size(); ++i) {
     dry_changed_.push_back({dry_[i].lo, dry_[i].hi});
-    dry_changed_hides_ = dry_changed_hides_ || dry_[i].obstacle.height > 0.0f;
+    dry_changed_hides_ = dry_changed_hides_ || dry_[i].hides();
   }
   const size_t before = dry_.size();
   dry_.resize(dry.size());
@@ -403,17 +404,17 @@ bool ParticleField::take_dry(std::span<const DryFootprint> dry) {
     }
     if (i < before) {
       dry_changed_.push_back({placed.lo, placed.hi});
-      dry_changed_hides_ = dry_changed_hides_ || placed.obstacle.height > 0.0f;
+      dry_changed_hides_ = dry_changed_hides_ || placed.hides();
     }
     placed.obstacle.radius = o.radius;
-    placed.obstacle.height = o.height;
     placed.obstacle.polygon = o.polygon;
     placed.centre_xz = dry[i].centre_xz;
     placed.top_y = dry[i].top_y;
     footprint_bounds(placed.obstacle, placed.centre_xz, &placed.lo, &placed.hi);
     dry_changed_.push_back({placed.lo, placed.hi});
-    dry_changed_hides_ = dry_changed_hides_ || placed.obstacle.height > 0.0f;
+    dry_changed_hides_ = dry_changed_hides_ || placed.hides();
   }
+  any_dry_hides_ = std::any_of(dry_.begin(), dry_.end(), [](const PlacedFootprint& d) { return d.hides(); });
   return !dry_changed_.empty();
 }
 
@@ -445,6 +446,7 @@ void ParticleField::recheck_around_changed_footprints(const Frame& f) {
 }
 
 bool ParticleField::hidden_by_obstacle(const glm::dvec3& eye, const glm::vec3& p) const {
+  if (!any_dry_hides_) return false;
   for (const PlacedFootprint& d : dry_) {
     if (!(d.top_y > p.y)) continue;  // no higher than the water here: hides nothing
     // The part of the sight line below the obstacle's top, seen from above.
@@ -589,20 +591,20 @@ void ParticleField::project_and_cull(Frame& f) {
     if (p.slot == 0) continue;
     glm::vec2 s;
     const bool in_view = project(f.vp, f.size, p.world, &s) && f.cull.contains(s);
-    bool dry = in_view && on_dry_ground(p.world);
-    if (in_view && !dry && !dry_.empty()) {
+    bool unseen = in_view && on_dry_ground(p.world);  // covered or hidden by an obstacle
+    if (in_view && !unseen && any_dry_hides_) {
       glm::dvec3 origin, dir;
       float t_max = 0.0f;
       pixel_ray(f, s, &origin, &dir, &t_max);
-      dry = hidden_by_obstacle(origin, p.world);
+      unseen = hidden_by_obstacle(origin, p.world);
     }
-    if (in_view && !dry) {
+    if (in_view && !unseen) {
       p.screen = s;
       continue;
     }
     release_slot(p.slot);
     p.slot = 0;
-    (dry ? stats_.dry : stats_.culled)++;
+    (unseen ? stats_.dry : stats_.culled)++;
   }
 }
 

@@ -105,7 +105,8 @@ struct ParticleParams {
 struct DryFootprint {
   const Obstacle* obstacle = nullptr;  // read during the update only
   glm::dvec2 centre_xz{0.0};
-  double top_y = -std::numeric_limits<double>::infinity();  // world height of its top
+  // World height of its top: it hides the water behind it below there (-inf: flat, hides none).
+  double top_y = -std::numeric_limits<double>::infinity();
 };
 
 enum class ParticleState : uint8_t { kActive, kFadingIn, kFadingOut };
@@ -280,10 +281,12 @@ class ParticleField {
     glm::dvec2 centre_xz{0.0};
     double top_y = 0.0;
     glm::dvec2 lo{0.0}, hi{0.0};
+    bool hides() const { return top_y > -std::numeric_limits<double>::infinity(); }
   };
   std::vector<PlacedFootprint> dry_;  // this frame's
   std::vector<std::pair<glm::dvec2, glm::dvec2>> dry_changed_;  // bounds where they changed
   bool dry_changed_hides_ = false;  // one of those stands above the water (or stood)
+  bool any_dry_hides_ = false;      // some footprint of this frame stands above the water
   ParticleStats stats_;
 };
 

@@ -111,7 +111,8 @@ Status add_ground_around_rivers(std::span<const RiverMesh> rivers, SceneGeometry
   const glm::vec2 extent = glm::vec2(hi.x - lo.x, hi.z - lo.z) + 2.0f * kMarginM;
   const float spacing = std::max(kMinSpacingM, std::sqrt(extent.x * extent.y / kMaxQuads));
   const glm::ivec2 quads = glm::max(glm::ivec2(glm::ceil(extent / spacing)), glm::ivec2(1));
-  const float ray_top = hi.y + 1000.0f;
+  const float ray_top = hi.y + 1.0f;  // down from above every river, to below every one
+  const float ray_length = hi.y - lo.y + 2.0f;
 
   // Heights first (normals need the neighbours'), with each point's water level.
   const size_t columns = size_t(quads.x) + 1;
@@ -128,8 +129,7 @@ Status add_ground_around_rivers(std::span<const RiverMesh> rivers, SceneGeometry
            (0.5f + 0.5f * std::sin(0.045f * xz.x + 1.3f) * std::sin(0.037f * xz.y + 0.4f));
       for (size_t r = 0; r < rivers.size(); ++r) {
         RayHit hit;
-        if (bvhs[r].intersect({xz.x, ray_top, xz.y}, {0.0f, -1.0f, 0.0f}, 2000.0f + ray_top - lo.y,
-                              &hit)) {
+        if (bvhs[r].intersect({xz.x, ray_top, xz.y}, {0.0f, -1.0f, 0.0f}, ray_length, &hit)) {
           // Under the water: below the bed there, out of sight.
           const uint32_t v = bvhs[r].nearest_vertex(hit.position, spacing, hit.triangle);
           y = std::min(y, hit.position.y - rivers[r].depth[v] - kBelowBedM);

@@ -57,14 +57,7 @@ class DebugViewTest : public RenderTest {
  protected:
   // Frames [0, 4) of the default scene through a fresh renderer showing `view`.
   Frame last_frame_with(DebugView view) {
-    renderer_.reset();
-    world_.reset();
-    Status status = create_renderer(make_create_info(kWidth, kHeight));
-    EXPECT_TRUE(status.ok()) << status.message();
-    status = renderer_->set_debug_view(view);
-    EXPECT_TRUE(status.ok()) << status.message();
-    std::vector<Frame> frames = render(0, 4);
-    return frames.empty() ? Frame{} : frames.back();
+    return fourth_frame_with([view](Renderer& renderer) { return renderer.set_debug_view(view); });
   }
 };
 

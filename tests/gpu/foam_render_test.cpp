@@ -21,16 +21,9 @@ class FoamRenderTest : public RenderTest {
  protected:
   // Frame 3 of the default scene with the default look but `foam_amount`.
   Frame frame_with_foam(float foam_amount) {
-    renderer_.reset();
-    world_.reset();
-    Status status = create_renderer(make_create_info(kWidth, kHeight));
-    EXPECT_TRUE(status.ok()) << status.message();
     WaterLook look;
     look.foam_amount = foam_amount;
-    status = renderer_->set_look(look);
-    EXPECT_TRUE(status.ok()) << status.message();
-    std::vector<Frame> frames = render(0, 4);
-    return frames.empty() ? Frame{} : frames.back();
+    return fourth_frame_with([&look](Renderer& renderer) { return renderer.set_look(look); });
   }
 };
 

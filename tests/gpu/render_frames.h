@@ -42,6 +42,21 @@ class RenderTest : public GpuTest {
     });
   }
 
+  // Frame 3 of the default scene through a fresh renderer that `configure` (Status(Renderer&))
+  // set up before its first frame.
+  template <typename Configure>
+  Frame fourth_frame_with(Configure configure) {
+    renderer_.reset();
+    world_.reset();
+    Status status = create_renderer(make_create_info(kWidth, kHeight));
+    EXPECT_TRUE(status.ok()) << status.message();
+    if (!status.ok()) return Frame{};
+    status = configure(*renderer_);
+    EXPECT_TRUE(status.ok()) << status.message();
+    std::vector<Frame> frames = render(0, 4);
+    return frames.empty() ? Frame{} : frames.back();
+  }
+
   // The same through the host's own view matrices at each time.
   template <typename ViewAt>
   std::vector<Frame> render_views(uint32_t first, uint32_t end, uint32_t width, uint32_t height,

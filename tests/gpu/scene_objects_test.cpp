@@ -30,21 +30,30 @@ class SceneObjectsTest : public ::testing::Test {
     dir_ = fresh_test_dir("scene_objects");
     fs::create_directories(dir_ / "out");
   }
+  // Captures frames [0, frames) of `scene` at kWidth x kHeight with `flags` into out/<its
+  // name>/ and reads the last one (use under ASSERT_NO_FATAL_FAILURE).
+  void capture_file(const fs::path& scene, uint32_t frames, const std::string& flags,
+                    ExrImage* image) {
+    const fs::path out = dir_ / "out" / scene.stem();
+    fs::create_directories(out);
+    const RunResult r = run_siviflow("capture " + scene.string() + " --frames " +
+                                     std::to_string(frames) + " --size " + std::to_string(kWidth) +
+                                     "x" + std::to_string(kHeight) + " " + flags + " --out " +
+                                     out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%05u.exr", frames - 1);
+    ASSERT_TRUE(read_exr((out / name).string(), image).ok());
+  }
   // Writes `name`.json (default procedural river, the given objects and camera) and captures
-  // its frame 0 with `aovs` into out/`name`/.
+  // its frame 0 with `aovs`.
   ExrImage capture(const std::string& name, const std::string& objects, const std::string& camera,
                    const std::string& aovs) {
     const fs::path scene = dir_ / (name + ".json");
     write_text(scene, R"({"version":1,"river":{"procedural":{}},"objects":[)" + objects +
                           R"(],"camera":)" + camera + "}");
-    const fs::path out = dir_ / "out" / name;
-    fs::create_directories(out);
-    const RunResult r = run_siviflow("capture " + scene.string() + " --frames 1 --size " +
-                                     std::to_string(kWidth) + "x" + std::to_string(kHeight) +
-                                     " --aov " + aovs + " --out " + out.string());
-    EXPECT_EQ(r.exit_code, 0) << r.output;
     ExrImage image;
-    EXPECT_TRUE(read_exr((out / "frame_00000.exr").string(), &image).ok());
+    capture_file(scene, 1, "--aov " + aovs, &image);
     return image;
   }
   // A PNG of one colour (linear RGB), 8x8, beside the scene.
@@ -142,11 +151,8 @@ TEST_F(SceneObjectsTest, GltfRiverFlowsDownstreamAroundAnObjectObstacle) {
   const fs::path scene = dir_ / "scene.json";
   write_text(scene, R"({"version":1,"river":{"gltf":"channel.gltf"},"flow":{"discharge":8.0},)"
                     R"("objects":[{"gltf":"crate.gltf","translation":[0,-0.6,20],"obstacle":true}]})");
-  const RunResult r = run_siviflow("capture " + scene.string() + " --frames 2 --size 320x180 "
-                                   "--aov flow,reflection --preview --out " + (dir_ / "out").string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
   ExrImage image;
-  ASSERT_TRUE(read_exr((dir_ / "out" / "frame_00001.exr").string(), &image).ok());
+  ASSERT_NO_FATAL_FAILURE(capture_file(scene, 2, "--aov flow,reflection --preview", &image));
   size_t water = 0;
   size_t downstream = 0;
   size_t aside = 0;  // turned by more than 6 degrees
@@ -173,11 +179,8 @@ TEST_F(SceneObjectsTest, GltfRiverHasGroundAroundIt) {
   const fs::path scene = dir_ / "scene.json";
   write_text(scene, R"({"version":1,"river":{"gltf":"channel.gltf"},)"
                     R"("camera":{"keys":[{"t":0,"position":[0,40,0],"target":[0,0,20]}]}})");
-  const RunResult r = run_siviflow("capture " + scene.string() + " --frames 1 --size 320x180 "
-                                   "--aov depth,flow --validation --out " + (dir_ / "out").string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
   ExrImage image;
-  ASSERT_TRUE(read_exr((dir_ / "out" / "frame_00000.exr").string(), &image).ok());
+  ASSERT_NO_FATAL_FAILURE(capture_file(scene, 1, "--aov depth,flow --validation", &image));
   const std::vector<float>& depth = *image.find("depth.Z");
   const std::vector<float>& mask = *image.find("water.mask");
   const std::vector<float>& green = *image.find("G");
@@ -210,11 +213,8 @@ TEST_F(SceneObjectsTest, CaptureOfTwoRivers) {
   write_text(scene, R"({"version":1,"rivers":[{"gltf":"west.gltf"},)"
                     R"({"gltf":"east.gltf","flow":{"discharge":30}}],)"
                     R"("camera":{"keys":[{"t":0,"position":[0,30,-12],"target":[0,0,30]}]}})");
-  RunResult r = run_siviflow("capture " + scene.string() + " --frames 1 --size 320x180 --aov depth "
-                             "--validation --out " + (dir_ / "out").string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
   ExrImage image;
-  ASSERT_TRUE(read_exr((dir_ / "out" / "frame_00000.exr").string(), &image).ok());
+  ASSERT_NO_FATAL_FAILURE(capture_file(scene, 1, "--aov depth --validation", &image));
   // Water is bluer than the grey-lit beds it lies on: count the bluish pixels in front of a bed
   // (finite depth, not the sky) on each side of the picture's middle.
   const std::vector<float>& red = *image.find("R");
@@ -228,8 +228,8 @@ TEST_F(SceneObjectsTest, CaptureOfTwoRivers) {
   }
   EXPECT_GT(left, 500u) << "the east river (+X is on the left looking down +Z)";
   EXPECT_GT(right, 500u) << "the west river";
-  r = run_siviflow("capture " + scene.string() + " --frames 1 --size 64x36 --aov flow --out " +
-                   (dir_ / "out").string());
+  const RunResult r = run_siviflow("capture " + scene.string() + " --frames 1 --size 64x36 "
+                                   "--aov flow --out " + (dir_ / "out").string());
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("the scene has 2"), std::string::npos) << r.output;
 }

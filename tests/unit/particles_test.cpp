@@ -363,7 +363,7 @@ TEST(Particles, NoneWhereAnObstacleStandsBetweenTheCameraAndTheWater) {
 
   // The block drops to the water: what it hid is covered again at once, as closely as by a
   // field that never saw it stand.
-  const DryFootprint flat[] = {{&block, {0.0, 15.0}, 0.0}};
+  const DryFootprint flat[] = {{&block, {0.0, 15.0}}};  // no top: hides nothing
   ASSERT_TRUE(field.update(cam, 1, kDt, flat).ok());
   ParticleField fresh = make_field(r, small_params());
   ASSERT_TRUE(fresh.update(cam, 0, kDt, flat).ok());
