@@ -89,6 +89,7 @@ struct Renderer::Impl {
   Status add_obstacle(const WaterObstacle& obstacle, uint32_t* id);
   Status move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad);
   Status remove_obstacle(uint32_t id);
+  Status set_occluders(const OccluderMesh& mesh);
   Status set_look(const WaterLook& new_look);
   Status simulate(const View& host_view, double time_seconds);
   float visible_water_level();

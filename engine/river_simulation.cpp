@@ -109,8 +109,8 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
     bank_distance_[v] = std::min(vertex.d_left, vertex.d_right);
     section_[v] = vertex.section;
   }
-  auto bvh = std::make_shared<RiverBvh>();
-  SIVIFLOW_TRY(RiverBvh::build(mesh_.positions, mesh_.indices, bvh.get()));
+  auto bvh = std::make_shared<TriangleBvh>();
+  SIVIFLOW_TRY(TriangleBvh::build(mesh_.positions, mesh_.indices, bvh.get()));
   bvh_ = std::move(bvh);
   SIVIFLOW_TRY(FoamField::create(mesh_.positions, mesh_.indices, section_, bvh_.get(), FoamParams{},
                                  &foam_field_));
@@ -202,9 +202,30 @@ void RiverFlow::dry_footprints(std::vector<DryFootprint>* out) const {
   }
 }
 
+Status RiverFlow::set_occluders(std::span<const glm::vec3> positions,
+                                std::span<const uint32_t> indices) {
+  if (positions.empty() && indices.empty()) {
+    occluders_.reset();
+    return Status::success();
+  }
+  // The mesh and its hierarchy in one block; the hierarchy's pointer shares the block's life.
+  struct Mesh {
+    std::vector<glm::vec3> positions;
+    std::vector<uint32_t> indices;
+    TriangleBvh bvh;
+  };
+  auto mesh = std::make_shared<Mesh>();
+  mesh->positions.assign(positions.begin(), positions.end());
+  mesh->indices.assign(indices.begin(), indices.end());
+  SIVIFLOW_TRY(TriangleBvh::build(mesh->positions, mesh->indices, &mesh->bvh, "occluders"));
+  occluders_ = std::shared_ptr<const TriangleBvh>(mesh, &mesh->bvh);
+  return Status::success();
+}
+
 Status RiverView::simulate(const glm::mat4& view_proj, float dt_seconds) {
   if (river_ == nullptr) return Status::error("particles: simulate on a view create() did not make");
   river_->dry_footprints(&dry_);
+  if (particles_.occluders() != river_->occluders()) particles_.set_occluders(river_->occluders());
   return particles_.update(ScreenCamera{view_proj, viewport_}, particles_.next_frame(), dt_seconds,
                            dry_);
 }

@@ -18,7 +18,7 @@
 #include "sim/foam.h"
 #include "sim/particles.h"
 #include "sim/procedural_river.h"
-#include "sim/river_bvh.h"
+#include "sim/triangle_bvh.h"
 #include "sim/river_surface.h"
 #include "sim/obstacle.h"
 #include "sim/status.h"
@@ -74,8 +74,15 @@ class RiverFlow {
   const RiverMesh& mesh() const { return mesh_; }
   // The surface, its flow and what the particles read per vertex (spans into this object).
   const RiverFlowField& field() const { return field_; }
-  std::shared_ptr<const RiverBvh> bvh() const { return bvh_; }
+  std::shared_ptr<const TriangleBvh> bvh() const { return bvh_; }
   uint64_t full_solves() const { return full_solves_; }  // 1: the one at create
+
+  // The host's geometry that can hide the water (Renderer::set_occluders): copied, with its
+  // ray-cast structure, for every view's particles from their next frame; no positions clears
+  // it. Errors name the field and index, and nothing changes then.
+  Status set_occluders(std::span<const glm::vec3> positions, std::span<const uint32_t> indices);
+  // Null when there are none.
+  std::shared_ptr<const TriangleBvh> occluders() const { return occluders_; }
 
  private:
   // Re-reads the solved velocity per vertex and derives the foam from it.
@@ -92,7 +99,8 @@ class RiverFlow {
   FoamField foam_field_;
   bool has_keys_ = false;            // some obstacle moves: re-solve as time goes
   RiverFlowField field_;
-  std::shared_ptr<const RiverBvh> bvh_;
+  std::shared_ptr<const TriangleBvh> bvh_;
+  std::shared_ptr<const TriangleBvh> occluders_;  // owns its mesh (aliasing)
   uint64_t full_solves_ = 0;
 };
 

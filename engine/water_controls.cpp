@@ -1,5 +1,5 @@
-// What a host changes on a running renderer: obstacles placed at runtime, the water's look and
-// its debug view.
+// What a host changes on a running renderer: obstacles placed at runtime, the geometry that
+// hides the water, the water's look and its debug view.
 #include <cmath>
 #include <string>
 
@@ -38,8 +38,19 @@ Status Renderer::remove_obstacle(uint32_t id) {
   return guarded(impl_->info, [&] { return impl_->remove_obstacle(id); });
 }
 
+Status Renderer::set_occluders(const OccluderMesh& mesh) {
+  return guarded(impl_->info, [&] { return impl_->set_occluders(mesh); });
+}
+
 Status Renderer::set_look(const WaterLook& look) {
   return guarded(impl_->info, [&] { return impl_->set_look(look); });
+}
+
+Status Renderer::Impl::set_occluders(const OccluderMesh& mesh) {
+  if (frame_begun) return argument_error("set_occluders called between begin_frame and record");
+  const Status built = river->flow.set_occluders(mesh.positions, mesh.indices);
+  if (!built.ok()) return argument_error("set_occluders: " + built.message());
+  return Status::success();
 }
 
 Status Renderer::Impl::add_obstacle(const WaterObstacle& obstacle, uint32_t* id) {

@@ -33,7 +33,7 @@ glm::vec3 barycentric_xz(const glm::vec3& p, const glm::vec3& a, const glm::vec3
 }  // namespace
 
 Status FoamField::create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                         std::span<const uint32_t> section, const RiverBvh* bvh,
+                         std::span<const uint32_t> section, const TriangleBvh* bvh,
                          const FoamParams& params, FoamField* out) {
   if (bvh == nullptr) return Status::error("FoamField: no ray-cast structure");
   if (section.size() != positions.size()) return Status::error("FoamField: a section per vertex");

@@ -24,7 +24,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "sim/river_bvh.h"
+#include "sim/triangle_bvh.h"
 #include "sim/status.h"
 
 namespace siviflow {
@@ -57,7 +57,7 @@ class FoamField {
   // one). `section`: each vertex's cross-section (river_surface.h). `bvh` is built on the same
   // positions and indices; it and the spans outlive this object.
   static Status create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                       std::span<const uint32_t> section, const RiverBvh* bvh,
+                       std::span<const uint32_t> section, const TriangleBvh* bvh,
                        const FoamParams& params, FoamField* out);
 
   // Foam per vertex in [0, 1] for the flow `velocity` (m/s per vertex); `bank_distance`: each
@@ -71,7 +71,7 @@ class FoamField {
  private:
   std::span<const glm::vec3> positions_;
   std::span<const uint32_t> section_;
-  const RiverBvh* bvh_ = nullptr;
+  const TriangleBvh* bvh_ = nullptr;
   FoamParams params_;
   std::vector<uint32_t> ring_start_;  // per vertex: first of its neighbours in ring_
   std::vector<uint32_t> ring_;        // one-ring neighbours (by shared triangle)

@@ -68,6 +68,9 @@ inline constexpr float kDryRecheckCircles = 2.0f;
 inline constexpr double kDryRecheckMarginM = 1.0;
 inline constexpr double kDryRecheckMaxM = 50.0;
 inline constexpr float kScaleProbeM = 0.1f;  // metres stepped to measure the screen's scale
+// A sight line from the water to the eye meets the occluders only beyond this many metres: the
+// ground that meets the water at the shore must not hide the water it touches.
+inline constexpr double kSightLineSkipM = 0.01;
 // Seeding (finding water not connected on screen to any particle): a fill-domain cell is
 // re-tested every this many frames when the camera moves; cells on the domain border (where a
 // pan brings new water in) more often.

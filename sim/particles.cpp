@@ -322,12 +322,12 @@ Status ParticleField::create(const RiverFlowField& river, const ParticleParams& 
   float d = 0.0f;
   uint32_t slot_count = 0;
   SIVIFLOW_TRY(check_inputs(river, params, &d, &slot_count));  // before the costly build
-  auto bvh = std::make_shared<RiverBvh>();
-  SIVIFLOW_TRY(RiverBvh::build(river.positions, river.indices, bvh.get()));
+  auto bvh = std::make_shared<TriangleBvh>();
+  SIVIFLOW_TRY(TriangleBvh::build(river.positions, river.indices, bvh.get()));
   return create(river, std::move(bvh), params, out);
 }
 
-Status ParticleField::create(const RiverFlowField& river, std::shared_ptr<const RiverBvh> bvh,
+Status ParticleField::create(const RiverFlowField& river, std::shared_ptr<const TriangleBvh> bvh,
                              const ParticleParams& params, ParticleField* out) {
   if (!bvh || bvh->positions().data() != river.positions.data() ||
       bvh->positions().size() != river.positions.size() ||
@@ -443,6 +443,21 @@ void ParticleField::recheck_around_changed_footprints(const Frame& f) {
       }
     }
   }
+}
+
+bool ParticleField::hidden_by_occluder(const glm::dvec3& eye, const glm::vec3& p) const {
+  if (occluders_ == nullptr) return false;
+  // From the water towards the eye, leaving out the first few centimetres: ground that meets
+  // the water at the shore must not hide the water it touches.
+  const glm::dvec3 to_eye = eye - glm::dvec3(p);
+  const double length = glm::length(to_eye);
+  if (!(length > kSightLineSkipM)) return false;
+  return occluders_->any_hit(p, glm::vec3(to_eye), float(kSightLineSkipM / length), 1.0f);
+}
+
+void ParticleField::set_occluders(std::shared_ptr<const TriangleBvh> occluders) {
+  occluders_changed_ = occluders_changed_ || occluders != occluders_;
+  occluders_ = std::move(occluders);
 }
 
 bool ParticleField::hidden_by_obstacle(const glm::dvec3& eye, const glm::vec3& p) const {
@@ -592,11 +607,14 @@ void ParticleField::project_and_cull(Frame& f) {
     glm::vec2 s;
     const bool in_view = project(f.vp, f.size, p.world, &s) && f.cull.contains(s);
     bool unseen = in_view && on_dry_ground(p.world);  // covered or hidden by an obstacle
-    if (in_view && !unseen && any_dry_hides_) {
+    // The occluders are static: only a camera move can make them hide a particle.
+    const bool check_occluders = occluders_ != nullptr && f.camera_changed;
+    if (in_view && !unseen && (any_dry_hides_ || check_occluders)) {
       glm::dvec3 origin, dir;
       float t_max = 0.0f;
       pixel_ray(f, s, &origin, &dir, &t_max);
-      unseen = hidden_by_obstacle(origin, p.world);
+      unseen = hidden_by_obstacle(origin, p.world) ||
+               (check_occluders && hidden_by_occluder(origin, p.world));
     }
     if (in_view && !unseen) {
       p.screen = s;
@@ -708,7 +726,7 @@ bool ParticleField::try_create(Frame& f, const glm::vec2& screen, uint32_t* inde
     stats_.dry_hits++;
     return false;
   }
-  if (hidden_by_obstacle(origin, hit.position)) {
+  if (hidden_by_obstacle(origin, hit.position) || hidden_by_occluder(origin, hit.position)) {
     stats_.hidden_hits++;
     return false;
   }
@@ -961,7 +979,9 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
   // tolerance cannot add up; exact equality would call a recomputed matrix's rounding a move.
   const bool dry_changed = take_dry(dry);
   f.camera_changed = next_frame_ == 0 || !same_camera(f.vp, epoch_view_proj_) ||
-                     (params_.advect && dt_seconds > 0.0f) || (dry_changed && dry_changed_hides_);
+                     (params_.advect && dt_seconds > 0.0f) || (dry_changed && dry_changed_hides_) ||
+                     occluders_changed_;
+  occluders_changed_ = false;
   if (f.camera_changed) {
     ++camera_epoch_;
     epoch_view_proj_ = f.vp;

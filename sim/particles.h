@@ -19,8 +19,10 @@
 //      the matrix equals the one the camera last settled on up to rounding (kStillCameraEpsilon);
 //   6. conversion: a new particle's pixel ray is cast into the river (BVH); a miss makes none,
 //      and so does a hit inside an obstacle's dry footprint (the water there is not seen and
-//      its flow is the still water of a wall) or behind an obstacle the ray meets first (its
-//      footprint raised to its top); a particle a footprint comes to cover or hide goes.
+//      its flow is the still water of a wall), behind an obstacle the ray meets first (its
+//      footprint raised to its top) or behind the host's occluders (its ground and objects);
+//      a particle a footprint comes to cover or hide goes, and so does one the occluders come to
+//      hide as the camera moves.
 // Fill method: Dunbar & Humphreys boundary sampling, not Bridson's dart throwing. It only works
 // at the boundary of the covered region (cost scales with the gap, not the screen), it yields
 // a maximal set (no point of the water is left farther than the spacing from a particle, which
@@ -52,7 +54,7 @@
 
 #include "sim/obstacle.h"
 #include "sim/particle_tuning.h"
-#include "sim/river_bvh.h"
+#include "sim/triangle_bvh.h"
 #include "sim/status.h"
 
 namespace siviflow {
@@ -160,7 +162,7 @@ class ParticleField {
                        ParticleField* out);
   // The same with a BVH already built on river.positions / river.indices (the same spans), so
   // a new viewport or a second view of a large river does not rebuild it.
-  static Status create(const RiverFlowField& river, std::shared_ptr<const RiverBvh> bvh,
+  static Status create(const RiverFlowField& river, std::shared_ptr<const TriangleBvh> bvh,
                        const ParticleParams& params, ParticleField* out);
 
   // Advances one frame (Algorithm 2). `camera.viewport` must equal params.viewport and
@@ -171,6 +173,12 @@ class ParticleField {
                 std::span<const DryFootprint> dry = {});
   // Back to the state before frame 0 (ids restart at 1).
   void reset();
+
+  // Static geometry that can stand between the camera and the water (the host's ground and
+  // objects; the obstacles come with update()): no particle is made on water it hides, and the
+  // next update re-examines every particle as a camera move does. Null: none.
+  void set_occluders(std::shared_ptr<const TriangleBvh> occluders);
+  const std::shared_ptr<const TriangleBvh>& occluders() const { return occluders_; }
 
   // In id order (ascending), so in birth order.
   std::span<const Particle> particles() const { return particles_; }
@@ -189,8 +197,8 @@ class ParticleField {
   // Slots run from 1 to slot_count() (0 is "no particle"): the aux data needs slot_count() + 1
   // entries. Fixed by the viewport and the spacing.
   uint32_t slot_count() const { return slot_count_; }
-  const RiverBvh& bvh() const { return *bvh_; }
-  std::shared_ptr<const RiverBvh> shared_bvh() const { return bvh_; }
+  const TriangleBvh& bvh() const { return *bvh_; }
+  std::shared_ptr<const TriangleBvh> shared_bvh() const { return bvh_; }
   const RiverFlowField& river() const { return river_; }
 
  private:
@@ -217,6 +225,8 @@ class ParticleField {
   // Whether the sight line from `eye` to the water at `p` passes through an obstacle's solid
   // (its footprint from the water up to its top).
   bool hidden_by_obstacle(const glm::dvec3& eye, const glm::vec3& p) const;
+  // Whether it meets one of the occluders' triangles.
+  bool hidden_by_occluder(const glm::dvec3& eye, const glm::vec3& p) const;
   // The point where the pixel ray through `screen` starts (the near plane), and its direction.
   static void pixel_ray(const Frame& f, const glm::vec2& screen, glm::dvec3* origin, glm::dvec3* dir,
                         float* t_max);
@@ -244,7 +254,9 @@ class ParticleField {
 
   RiverFlowField river_;
   ParticleParams params_;
-  std::shared_ptr<const RiverBvh> bvh_;
+  std::shared_ptr<const TriangleBvh> bvh_;
+  std::shared_ptr<const TriangleBvh> occluders_;
+  bool occluders_changed_ = false;  // since the last update: look at every particle again
   float min_distance_ = 0.0f;  // px
   float spacing_ = 0.0f;        // px: preferred placement distance of the fill (first tier)
   float tight_spacing_ = 0.0f;  // px: placement distance of the second tier (the gaps)

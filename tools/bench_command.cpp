@@ -165,6 +165,7 @@ int run_bench(int argc, char** argv) {
   std::unique_ptr<Renderer> renderer;
   auto create_start = std::chrono::steady_clock::now();
   status = Renderer::create(info, &renderer);
+  if (status.ok()) status = renderer->set_occluders(world->occluders());
   const double create_ms = ms_since(create_start);
   if (!status.ok()) return cli::fail(kCommand, status.message());
   const ImageState shown{VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,

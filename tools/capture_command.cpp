@@ -283,6 +283,7 @@ Status Capture::run() {
     info.readback_images = i + 1 == river_count ? readback_images() : 0;
     rivers_.emplace_back();
     SIVIFLOW_TRY(Renderer::create(info, &rivers_.back()));
+    SIVIFLOW_TRY(rivers_.back()->set_occluders(world_->occluders()));
     river_renderers_.push_back(rivers_.back().get());
   }
   renderer_ = river_renderers_.back();

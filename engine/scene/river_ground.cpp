@@ -8,7 +8,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
-#include "sim/river_bvh.h"
+#include "sim/triangle_bvh.h"
 
 namespace siviflow {
 namespace {
@@ -90,12 +90,12 @@ class BankLookup {
 
 Status add_ground_around_rivers(std::span<const RiverMesh> rivers, SceneGeometry* geometry) {
   if (rivers.empty()) return Status::success();
-  std::vector<RiverBvh> bvhs(rivers.size());
+  std::vector<TriangleBvh> bvhs(rivers.size());
   std::vector<glm::vec3> bank;
   glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
   for (size_t r = 0; r < rivers.size(); ++r) {
     const RiverMesh& river = rivers[r];
-    SIVIFLOW_TRY(RiverBvh::build(river.positions, river.indices, &bvhs[r]));
+    SIVIFLOW_TRY(TriangleBvh::build(river.positions, river.indices, &bvhs[r]));
     const size_t before = bank.size();
     for (size_t v = 0; v < river.positions.size(); ++v) {
       if (river.depth[v] <= 1e-4f) bank.push_back(river.positions[v]);

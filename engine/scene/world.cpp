@@ -70,6 +70,9 @@ struct World::Impl {
   std::vector<bool> shown;
   std::vector<uint32_t> boulder_index_counts;
   SceneCamera camera_path;          // keys empty: the scene's default camera
+  // The ground, beds and objects as World::occluders() gives them.
+  std::vector<glm::vec3> occluder_positions;
+  std::vector<uint32_t> occluder_indices;
   SceneLook look = default_scene_look();
 
   enum StaticBufferId : uint32_t { kVertices, kIndices };
@@ -185,6 +188,15 @@ Status World::Impl::create_resources() {
                           draw.texture + 1});
     reflection_draws.push_back({first_object_index + draw.first_index, draw.index_count,
                                 &reflection_constants, draw.texture + 1});
+  }
+  // Everything drawn with the view's own constants is static; the boulders stand for the
+  // renderer's obstacles, which it knows itself.
+  occluder_positions.reserve(geometry.vertices.size());
+  for (const SceneVertex& v : geometry.vertices) occluder_positions.push_back(v.position);
+  for (const SceneDraw& draw : main_draws) {
+    if (draw.constants != &main_constants) continue;
+    occluder_indices.insert(occluder_indices.end(), geometry.indices.begin() + draw.first_index,
+                            geometry.indices.begin() + draw.first_index + draw.index_count);
   }
   assets.add_buffer({"world vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                      bytes_of(geometry.vertices)});
@@ -333,6 +345,10 @@ Camera World::scene_camera(double time_seconds) const {
   camera.position = glm::mix(a.position, after->position, u);
   camera.target = glm::mix(a.target, after->target, u);
   return camera;
+}
+
+OccluderMesh World::occluders() const {
+  return {impl_->occluder_positions, impl_->occluder_indices};
 }
 
 uint32_t World::boulder_count() const { return static_cast<uint32_t>(impl_->obstacles.size()); }

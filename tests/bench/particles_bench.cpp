@@ -26,7 +26,7 @@ constexpr float kLength = 4000.0f;
 // The same meandering 40 m x 4 km channel, tessellated across x along.
 struct River {
   test::GridRiver mesh;
-  std::shared_ptr<const RiverBvh> bvh;
+  std::shared_ptr<const TriangleBvh> bvh;
 };
 
 River* river(uint32_t across, uint32_t along) {
@@ -48,8 +48,8 @@ River* river(uint32_t across, uint32_t along) {
   }
   slot->mesh = std::move(straight);
   const auto t0 = std::chrono::steady_clock::now();
-  auto bvh = std::make_shared<RiverBvh>();
-  if (!RiverBvh::build(slot->mesh.positions, slot->mesh.indices, bvh.get()).ok()) std::abort();
+  auto bvh = std::make_shared<TriangleBvh>();
+  if (!TriangleBvh::build(slot->mesh.positions, slot->mesh.indices, bvh.get()).ok()) std::abort();
   const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::fprintf(stderr, "river %ux%u (%zu vertices, %zu triangles): BVH built in %.2f s, %.1f MB\n",
                across, along, slot->mesh.positions.size(), bvh->triangle_count(), s,

@@ -47,7 +47,8 @@ class GpuTest : public ::testing::Test {
 
   // The built-in world of `scene` (null: the default scene) as the host's world (reflected
   // through the callback unless the info has a callback of its own), then the renderer of the
-  // scene's first river, with the scene's look unless the info has one.
+  // scene's first river, with the scene's look unless the info has one, and the world's ground
+  // and objects as its occluders, as our tools give them.
   Status create_renderer(CreateInfo info, const SceneFile* scene = nullptr) {
     renderer_.reset();
     world_.reset();
@@ -67,7 +68,8 @@ class GpuTest : public ::testing::Test {
       info.reflection = &World::draw_reflection;
       info.reflection_user = world_.get();
     }
-    return Renderer::create(info, &renderer_);
+    SIVIFLOW_TRY(Renderer::create(info, &renderer_));
+    return renderer_->set_occluders(world_->occluders());
   }
 
   std::unique_ptr<HeadlessContext> context_;

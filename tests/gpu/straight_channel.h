@@ -39,7 +39,8 @@ class StraightChannelTest : public RenderTest {
 
   // The world of the channel with its boulder at `boulder` and `objects`, and the water of the
   // channel with the boulder as a runtime obstacle (so that move_boulder can move it), which
-  // reflects the world unless `info` names a reflection of its own.
+  // reflects the world unless `info` names a reflection of its own; the world's ground and
+  // objects are its occluders.
   Status create_channel(CreateInfo info, const glm::vec3& boulder, const WaterLook& look = {},
                         const std::vector<SceneObject>& objects = {}) {
     renderer_.reset();
@@ -62,6 +63,7 @@ class StraightChannelTest : public RenderTest {
       info.reflection_user = world_.get();
     }
     SIVIFLOW_TRY(Renderer::create(info, &renderer_));
+    SIVIFLOW_TRY(renderer_->set_occluders(world_->occluders()));
     WaterObstacle obstacle;
     obstacle.centre = boulder;
     obstacle.radius = kBoulderRadius;

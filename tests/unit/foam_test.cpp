@@ -26,7 +26,7 @@ class FoamTest : public ::testing::Test {
     RiverSurface surface;
     ASSERT_TRUE(RiverSurface::build(mesh_.positions, mesh_.indices, {}, &surface).ok());
     ASSERT_TRUE(StreamFunction::create(std::move(surface), {kQ, 1.5f, 0.0f}, &flow_).ok());
-    ASSERT_TRUE(RiverBvh::build(mesh_.positions, mesh_.indices, &bvh_).ok());
+    ASSERT_TRUE(TriangleBvh::build(mesh_.positions, mesh_.indices, &bvh_).ok());
     for (size_t v = 0; v < mesh_.positions.size(); ++v) {
       const RiverVertex vertex = flow_.surface().vertex(v);
       bank_.push_back(std::min(vertex.d_left, vertex.d_right));
@@ -61,7 +61,7 @@ class FoamTest : public ::testing::Test {
 
   test::TestMesh mesh_;
   StreamFunction flow_;
-  RiverBvh bvh_;
+  TriangleBvh bvh_;
   FoamField field_;
   std::vector<float> bank_;
   std::vector<uint32_t> section_;
@@ -120,7 +120,7 @@ TEST(FoamParamsTest, BadParametersAreRefused) {
   too_much_front.front_share = 1.5f;
   for (const FoamParams& params : {lifeless, no_lee, too_much_front}) {
     FoamField field;
-    RiverBvh bvh;
+    TriangleBvh bvh;
     const Status status = FoamField::create({}, {}, {}, &bvh, params, &field);
     EXPECT_FALSE(status.ok());
     EXPECT_NE(status.message().find("FoamParams"), std::string::npos) << status.message();

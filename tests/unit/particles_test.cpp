@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
@@ -15,7 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "sim/flow_textures.h"
-#include "sim/river_bvh.h"
+#include "sim/triangle_bvh.h"
 #include "unit/particle_scenes.h"
 
 namespace siviflow {
@@ -82,10 +83,10 @@ float point_triangle_distance(glm::vec3 p, glm::vec3 a, glm::vec3 b, glm::vec3 c
 // ---------------------------------------------------------------------------------------------
 // BVH
 
-TEST(RiverBvh, RayHitsTheSurfaceAndMissesBesideIt) {
+TEST(TriangleBvh, RayHitsTheSurfaceAndMissesBesideIt) {
   const GridRiver r = test::straight_channel(10.0f, 50.0f, 11, 51);
-  RiverBvh bvh;
-  ASSERT_TRUE(RiverBvh::build(r.positions, r.indices, &bvh).ok());
+  TriangleBvh bvh;
+  ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
   RayHit hit;
   ASSERT_TRUE(bvh.intersect({1.25f, 5.0f, 20.3f}, {0.0f, -10.0f, 0.0f}, 1.0f, &hit));
   EXPECT_NEAR(hit.t, 0.5f, 1e-6f);
@@ -101,12 +102,12 @@ TEST(RiverBvh, RayHitsTheSurfaceAndMissesBesideIt) {
   EXPECT_NEAR(hit.position.z, 30.0f, 1e-3f);
 }
 
-TEST(RiverBvh, NearestVertexIsTheBruteForceOne) {
+TEST(TriangleBvh, NearestVertexIsTheBruteForceOne) {
   const GridRiver r = test::grid_river(
       23, 31, {-5.0f, 0.0f}, {5.0f, 20.0f}, [](float x, float z) { return 0.2f * std::sin(x + z); },
       [](float, float) { return glm::vec3(0.0f, 0.0f, 1.0f); }, 0.4f);
-  RiverBvh bvh;
-  ASSERT_TRUE(RiverBvh::build(r.positions, r.indices, &bvh).ok());
+  TriangleBvh bvh;
+  ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
   uint64_t state = 99;
   for (int n = 0; n < 2000; ++n) {
     state = state * 6364136223846793005ull + 1442695040888963407ull;
@@ -135,20 +136,48 @@ TEST(RiverBvh, NearestVertexIsTheBruteForceOne) {
   }
 }
 
-TEST(RiverBvh, NonIndexedMeshesAndBadMeshes) {
+TEST(TriangleBvh, AnyHitAgreesWithTheClosestHitOverTheSegment) {
+  // A wavy sheet, and segments of every direction: a hit within [t_min, t_max] exists exactly
+  // when the closest hit from t_min on lies within t_max.
+  const GridRiver r = test::grid_river(
+      17, 17, {-5.0f, -5.0f}, {5.0f, 5.0f}, [](float x, float z) { return std::sin(x) * std::cos(z); },
+      [](float, float) { return glm::vec3(0.0f, 0.0f, 1.0f); }, 0.4f);
+  TriangleBvh bvh;
+  ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
+  uint64_t state = 5;
+  const auto next = [&state] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<float>(state >> 40) * 0x1.0p-24f * 2.0f - 1.0f;  // [-1, 1)
+  };
+  int hits = 0, misses = 0;
+  for (int n = 0; n < 3000; ++n) {
+    const glm::vec3 from(6.0f * next(), 2.0f * next(), 6.0f * next());
+    const glm::vec3 to(6.0f * next(), 2.0f * next(), 6.0f * next());
+    const float t_min = 0.3f * (next() + 1.0f);
+    const glm::vec3 dir = to - from;
+    RayHit closest;
+    const bool want = bvh.intersect(from + t_min * dir, dir, 1.0f - t_min, &closest);
+    ASSERT_EQ(bvh.any_hit(from, dir, t_min, 1.0f), want) << "segment " << n;
+    (want ? hits : misses)++;
+  }
+  EXPECT_GT(hits, 500);
+  EXPECT_GT(misses, 500);
+}
+
+TEST(TriangleBvh, NonIndexedMeshesAndBadMeshes) {
   const std::vector<glm::vec3> tri = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}};
-  RiverBvh bvh;
-  ASSERT_TRUE(RiverBvh::build(tri, {}, &bvh).ok());
+  TriangleBvh bvh;
+  ASSERT_TRUE(TriangleBvh::build(tri, {}, &bvh).ok());
   RayHit hit;
   EXPECT_TRUE(bvh.intersect({0.2f, 1.0f, 0.2f}, {0.0f, -2.0f, 0.0f}, 1.0f, &hit));
-  EXPECT_FALSE(RiverBvh::build({}, {}, &bvh).ok());
-  EXPECT_FALSE(RiverBvh::build(std::span(tri).first(2), {}, &bvh).ok());
+  EXPECT_FALSE(TriangleBvh::build({}, {}, &bvh).ok());
+  EXPECT_FALSE(TriangleBvh::build(std::span(tri).first(2), {}, &bvh).ok());
   const std::vector<uint32_t> out_of_range = {0, 1, 3};
-  const Status s = RiverBvh::build(tri, out_of_range, &bvh);
+  const Status s = TriangleBvh::build(tri, out_of_range, &bvh);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("out of range"), std::string::npos) << s.message();
   const std::vector<glm::vec3> nan = {{0, 0, 0}, {1, std::nanf(""), 0}, {0, 0, 1}};
-  EXPECT_FALSE(RiverBvh::build(nan, {}, &bvh).ok());
+  EXPECT_FALSE(TriangleBvh::build(nan, {}, &bvh).ok());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -376,6 +405,64 @@ TEST(Particles, NoneWhereAnObstacleStandsBetweenTheCameraAndTheWater) {
   };
   EXPECT_GT(close_behind(fresh), 5u);
   EXPECT_GE(close_behind(field), close_behind(fresh) * 8 / 10);
+}
+
+TEST(Particles, NoneWhereTheOccludersStandBetweenTheCameraAndTheWater) {
+  // A wall across the channel (the host's geometry, not an obstacle: it stands on no footprint)
+  // seen at a low angle hides the water behind it up to the height of its top.
+  const GridRiver r = test::straight_channel(30.0f, 200.0f, 31, 201);
+  ParticleField field = make_field(r, small_params());
+  const std::vector<glm::vec3> wall = {{-3.0f, -0.5f, 15.0f}, {3.0f, -0.5f, 15.0f},
+                                       {3.0f, 2.0f, 15.0f},   {-3.0f, 2.0f, 15.0f}};
+  const std::vector<uint32_t> quad = {0, 1, 2, 0, 2, 3};
+  auto occluders = std::make_shared<TriangleBvh>();
+  ASSERT_TRUE(TriangleBvh::build(wall, quad, occluders.get()).ok());
+  // The test's own check: the eye-to-water segment crosses the wall's rectangle (not within
+  // the first kSightLineSkipM from the water, which the particles leave out).
+  const auto hidden = [](const Particle& p, glm::vec3 eye) {
+    const float t = (15.0f - eye.z) / (p.world.z - eye.z);
+    const float skip = static_cast<float>(kSightLineSkipM) / glm::length(p.world - eye);
+    if (!(t > 0.0f && t < 1.0f - skip)) return false;
+    const glm::vec3 q = eye + t * (p.world - eye);
+    return std::abs(q.x) < 3.0f && q.y < 2.0f;
+  };
+  const auto count_hidden = [&](glm::vec3 eye) {
+    size_t n = 0;
+    for (const Particle& p : field.particles()) n += p.slot != 0 && hidden(p, eye) ? 1 : 0;
+    return n;
+  };
+  glm::vec3 eye(0.0f, 3.0f, 0.0f);
+  ScreenCamera cam = test::look_at(eye, {0.0f, 0.0f, 30.0f}, kSmall);
+  uint64_t frame = 0;
+  for (; frame < 2; ++frame) ASSERT_TRUE(field.update(cam, frame, kDt).ok());
+  const size_t hidden_without = count_hidden(eye);
+  EXPECT_GT(hidden_without, 20u) << "without occluders the water behind the wall has particles";
+
+  // The wall comes: the next frame, under the same camera, the particles it hides are gone.
+  field.set_occluders(occluders);
+  ASSERT_TRUE(field.update(cam, frame++, kDt).ok());
+  EXPECT_GE(field.stats().dry, hidden_without) << "those the wall hides went";
+  EXPECT_EQ(count_hidden(eye), 0u);
+  size_t behind = 0, beside = 0;
+  for (const Particle& p : field.particles()) {
+    behind += p.slot != 0 && p.world.z > 16.0f && std::abs(p.world.x) < 2.0f ? 1 : 0;
+    beside += p.slot != 0 && p.world.z > 16.0f && std::abs(p.world.x) > 5.0f ? 1 : 0;
+  }
+  EXPECT_GT(beside, 20u) << "the water beside the wall is seen";
+  EXPECT_GT(behind, 0u) << "far behind it, over its top, the water is seen again";
+
+  // The camera steps aside: new rays meet the wall (no particle is made behind it) and the
+  // particles it now hides go at once.
+  eye = {2.5f, 2.6f, 1.0f};
+  cam = test::look_at(eye, {1.0f, 0.0f, 30.0f}, kSmall);
+  ASSERT_TRUE(field.update(cam, frame++, kDt).ok());
+  EXPECT_GT(field.stats().hidden_hits, 0u) << "rays met the wall before the water";
+  EXPECT_EQ(count_hidden(eye), 0u);
+
+  // The wall goes: the water behind it is covered again.
+  field.set_occluders(nullptr);
+  ASSERT_TRUE(field.update(cam, frame++, kDt).ok());
+  EXPECT_GT(count_hidden(eye), 10u);
 }
 
 // Worst distance from an interior water pixel of the channel to the nearest live particle.

@@ -223,6 +223,7 @@ Status Viewer::create_water() {
     info.reflection_user = world_.get();
     std::unique_ptr<Renderer> renderer;
     SIVIFLOW_TRY(Renderer::create(info, &renderer));
+    SIVIFLOW_TRY(renderer->set_occluders(world_->occluders()));
     renderer_list_.push_back(renderer.get());
     renderers_.push_back(std::move(renderer));
   }

@@ -126,6 +126,12 @@ std::vector<std::string> required_device_feature_names();
 // Names of required features a chain (enabled or supported features) does not hold.
 std::vector<std::string> missing_device_features(const VkPhysicalDeviceFeatures2* features);
 
+// Triangles in world space, as Renderer::set_occluders takes them.
+struct OccluderMesh {
+  std::span<const glm::vec3> positions;
+  std::span<const uint32_t> indices;  // 3 per triangle; empty: every 3 positions are one
+};
+
 // A host's view of the river: its matrices and where it lies in the host's images.
 struct View {
   glm::mat4 view{1.0f};  // world -> view space (right-handed, looking down -Z)
@@ -264,6 +270,15 @@ class Renderer {
   // Moves obstacle `id` to `centre`, its polygon turned to `rotation_rad`.
   Status move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad = 0.0f);
   Status remove_obstacle(uint32_t id);
+
+  // The host's geometry that can stand between a camera and the water (ground, buildings,
+  // props; not the obstacles, which the renderer knows): particles are made only on water a
+  // view sees, so no hidden water feeds the flow the visible water shows. World space, static
+  // until the next call; copied, and its ray-cast structure built (O(n log n) in the triangles).
+  // Shared by every view of the river from their next update() on; no positions clears it. Call
+  // outside begin_frame/record. A bad mesh (a count not a multiple of 3, an index out of range,
+  // a position not finite) is an error naming it, and nothing changes.
+  Status set_occluders(const OccluderMesh& mesh);
 
   // The water's look from the next update() on. A field out of its range (water_look.h) is an
   // error naming it and its value, and the look stays as it was.

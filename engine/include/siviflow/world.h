@@ -56,6 +56,11 @@ class World {
   // glTF river without keys is seen from above its upstream end).
   Camera scene_camera(double time_seconds) const;
 
+  // The ground, riverbeds and objects as triangles in world space, for Renderer::set_occluders
+  // (the boulders are left out: they stand for the renderer's own obstacles). Valid as long as
+  // the world.
+  OccluderMesh occluders() const;
+
   // The boulders: one per obstacle of the scene (its `obstacles`, in order), then the spares.
   uint32_t boulder_count() const;
   // Stands boulder `index` at `centre` from the next record() on (its keys no longer move it):

@@ -1,10 +1,12 @@
-// A bounding volume hierarchy over the river triangles: the closest hit of a ray (a pixel's ray
-// into the water surface) and the nearest river vertex to a point, each in O(log n) of the mesh.
-// Built once per mesh; the queries are const and allocate nothing.
+// A bounding volume hierarchy over a triangle mesh (the river surface, the ground, a host's
+// occluders): the closest hit of a ray (a pixel's ray into the water surface), whether a segment
+// meets any triangle (a sight line), and the nearest vertex to a point, each in O(log n) of the
+// mesh. Built once per mesh; the queries are const and allocate nothing.
 #pragma once
 
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -19,14 +21,15 @@ struct RayHit {
   glm::vec3 position{0.0f};
 };
 
-class RiverBvh {
+class TriangleBvh {
  public:
   // `indices` holds 3 vertex indices per triangle; when empty, every 3 positions are a triangle.
   // The spans are referenced, not copied: they must outlive the BVH and keep their contents.
   // Fails on no triangles, a count that is not a multiple of 3, an index out of range, a non-
   // finite position, or more triangles than 32-bit indices address.
+  // Messages begin with `mesh_name`.
   static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                      RiverBvh* out);
+                      TriangleBvh* out, std::string_view mesh_name = "river BVH");
 
   size_t triangle_count() const { return order_.size(); }
   std::span<const glm::vec3> positions() const { return positions_; }
@@ -42,6 +45,10 @@ class RiverBvh {
   // sides). False when the ray misses.
   bool intersect(const glm::vec3& origin, const glm::vec3& direction, float t_max,
                  RayHit* hit) const;
+  // Whether origin + t * direction meets any triangle for some t in [t_min, t_max] (stops at
+  // the first one found).
+  bool any_hit(const glm::vec3& origin, const glm::vec3& direction, float t_min,
+               float t_max) const;
 
   // The vertex nearest to `p` (ties: the lower index) among the vertices within `radius` of it;
   // when none is, the nearest corner of `hint_triangle` (usually the triangle `p` lies on).
@@ -55,6 +62,9 @@ class RiverBvh {
     uint32_t count;  // leaf: triangle count (> 0); inner: 0
   };
   static_assert(sizeof(Node) == 32);
+  template <bool kAnyHit>
+  bool trace(const glm::vec3& origin, const glm::vec3& direction, float t_min, float t_max,
+             RayHit* hit) const;
 
   std::span<const glm::vec3> positions_;
   std::span<const uint32_t> indices_;

@@ -1,4 +1,4 @@
-#include "sim/river_bvh.h"
+#include "sim/triangle_bvh.h"
 
 #include <algorithm>
 #include <cmath>
@@ -59,35 +59,36 @@ float box_distance2(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& p
 
 }  // namespace
 
-Status RiverBvh::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                       RiverBvh* out) {
+Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
+                          TriangleBvh* out, std::string_view mesh_name) {
+  const std::string name(mesh_name);
   const size_t corner_count = indices.empty() ? positions.size() : indices.size();
-  if (corner_count == 0) return Status::error("river BVH: the mesh has no triangles");
+  if (corner_count == 0) return Status::error(name + ": the mesh has no triangles");
   if (corner_count % 3 != 0) {
-    return Status::error("river BVH: " + std::to_string(corner_count) +
+    return Status::error(name + ": " + std::to_string(corner_count) +
                          (indices.empty() ? " positions" : " indices") +
                          " is not a multiple of 3 (a non-indexed mesh needs 3 per triangle)");
   }
   const size_t tri_count = corner_count / 3;
   if (tri_count > std::numeric_limits<uint32_t>::max() / 4 ||
       positions.size() > std::numeric_limits<uint32_t>::max()) {
-    return Status::error("river BVH: too many triangles (" + std::to_string(tri_count) + ")");
+    return Status::error(name + ": too many triangles (" + std::to_string(tri_count) + ")");
   }
   for (size_t i = 0; i < positions.size(); ++i) {
     const glm::vec3& p = positions[i];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return Status::error("river BVH: vertex " + std::to_string(i) + " is not finite");
+      return Status::error(name + ": vertex " + std::to_string(i) + " is not finite");
     }
   }
   for (size_t i = 0; i < indices.size(); ++i) {
     if (indices[i] >= positions.size()) {
-      return Status::error("river BVH: index " + std::to_string(i) + " (" +
+      return Status::error(name + ": index " + std::to_string(i) + " (" +
                            std::to_string(indices[i]) + ") is out of range (" +
                            std::to_string(positions.size()) + " vertices)");
     }
   }
 
-  RiverBvh bvh;
+  TriangleBvh bvh;
   bvh.positions_ = positions;
   bvh.indices_ = indices;
   std::vector<Ref> refs(tri_count);
@@ -209,12 +210,13 @@ Status RiverBvh::build(std::span<const glm::vec3> positions, std::span<const uin
   return Status::success();
 }
 
-size_t RiverBvh::memory_bytes() const {
+size_t TriangleBvh::memory_bytes() const {
   return nodes_.capacity() * sizeof(Node) + order_.capacity() * sizeof(uint32_t);
 }
 
-bool RiverBvh::intersect(const glm::vec3& origin, const glm::vec3& direction, float t_max,
-                         RayHit* hit) const {
+template <bool kAnyHit>
+bool TriangleBvh::trace(const glm::vec3& origin, const glm::vec3& direction, float t_min,
+                        float t_max, RayHit* hit) const {
   if (nodes_.empty()) return false;
   // A zero component would make 0 * inf = NaN in the slab test; a tiny one keeps it ordered.
   glm::vec3 inv;
@@ -257,7 +259,8 @@ bool RiverBvh::intersect(const glm::vec3& origin, const glm::vec3& direction, fl
         const float v = glm::dot(direction, q) * inv_det;
         if (v < 0.0f || u + v > 1.0f) continue;
         const float t = glm::dot(e2, q) * inv_det;
-        if (t < 0.0f || t > best) continue;
+        if (t < t_min || t > best) continue;
+        if constexpr (kAnyHit) return true;
         if (found && t == best && tri > hit->triangle) continue;  // ties: the lower triangle
         best = t;
         found = true;
@@ -283,7 +286,17 @@ bool RiverBvh::intersect(const glm::vec3& origin, const glm::vec3& direction, fl
   return found;
 }
 
-uint32_t RiverBvh::nearest_vertex(const glm::vec3& p, float radius, uint32_t hint_triangle) const {
+bool TriangleBvh::intersect(const glm::vec3& origin, const glm::vec3& direction, float t_max,
+                            RayHit* hit) const {
+  return trace<false>(origin, direction, 0.0f, t_max, hit);
+}
+
+bool TriangleBvh::any_hit(const glm::vec3& origin, const glm::vec3& direction, float t_min,
+                          float t_max) const {
+  return trace<true>(origin, direction, t_min, t_max, nullptr);
+}
+
+uint32_t TriangleBvh::nearest_vertex(const glm::vec3& p, float radius, uint32_t hint_triangle) const {
   uint32_t best_v = triangle_vertex(hint_triangle, 0);
   float best_d2 = distance2(p, positions_[best_v]);
   for (int k = 1; k < 3; ++k) {
