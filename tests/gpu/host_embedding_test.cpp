@@ -41,7 +41,8 @@ struct HostShot {
 
 class HostEmbeddingTest : public GpuTest {
  protected:
-  // The world of `world_scene` (null: the default scene) and the water of the default scene.
+  // The world of `world_scene` (null: the default scene) and the water of the default scene,
+  // with the world's ground and objects as the water's occluders (as our tools give them).
   void create(const SceneFile* world_scene, bool readback, uint64_t seed = 0) {
     renderer_.reset();
     world_.reset();
@@ -59,6 +60,7 @@ class HostEmbeddingTest : public GpuTest {
     info.reflection = &World::draw_reflection;
     info.reflection_user = world_.get();
     status = Renderer::create(info, &renderer_);
+    if (status.ok()) status = renderer_->set_occluders(world_->occluders());
     ASSERT_TRUE(status.ok()) << status.message();
   }
 
