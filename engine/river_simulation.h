@@ -78,8 +78,8 @@ class RiverFlow {
   uint64_t full_solves() const { return full_solves_; }  // 1: the one at create
 
   // The host's geometry that can hide the water (Renderer::set_occluders): copied, with its
-  // ray-cast structure, for every view's particles from their next frame; no positions clears
-  // it. Errors name the field and index, and nothing changes then.
+  // ray-cast structure, for every view's particles from their next frame; an empty mesh clears
+  // it. Errors name the OccluderMesh field and index, and nothing changes then.
   Status set_occluders(std::span<const glm::vec3> positions, std::span<const uint32_t> indices);
   // Null when there are none.
   std::shared_ptr<const TriangleBvh> occluders() const { return occluders_; }

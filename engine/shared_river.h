@@ -1,5 +1,5 @@
-// What the views of one river share (CreateInfo::share_river_with): the river's flow and its
-// obstacles, and its static GPU data (surface geometry, normal map, water heights). The first
+// What the views of one river share (CreateInfo::share_river_with): the river's flow, its
+// obstacles and the host's occluders, and its static GPU data (surface geometry, normal map, water heights). The first
 // renderer of a river makes it and every renderer that shares it keeps it alive; it holds its
 // own Vulkan function table, so it outlives the renderer that made it.
 #pragma once

@@ -607,7 +607,8 @@ void ParticleField::project_and_cull(Frame& f) {
     glm::vec2 s;
     const bool in_view = project(f.vp, f.size, p.world, &s) && f.cull.contains(s);
     bool unseen = in_view && on_dry_ground(p.world);  // covered or hidden by an obstacle
-    // The occluders are static: only a camera move can make them hide a particle.
+    // The occluders are static: only what counts as a camera move (f.camera_changed: the
+    // camera, advection, a hiding obstacle moving, new occluders) can make them hide one.
     const bool check_occluders = occluders_ != nullptr && f.camera_changed;
     if (in_view && !unseen && (any_dry_hides_ || check_occluders)) {
       glm::dvec3 origin, dir;
@@ -973,8 +974,9 @@ Status ParticleField::update(const ScreenCamera& camera, uint64_t frame_index, f
 
   stats_ = {};
   // Advection moves the particles on screen just as a camera move does, and so does an obstacle
-  // that hides water moving (what it uncovers may lie far behind it on screen); a flat
-  // footprint moving only concerns the particles around it (recheck_around_changed_footprints).
+  // that hides water moving (what it uncovers may lie far behind it on screen), and so do new
+  // occluders; a flat footprint moving only concerns the particles around it
+  // (recheck_around_changed_footprints).
   // Compared with the camera the epoch began with, not last frame's, so a drift within the
   // tolerance cannot add up; exact equality would call a recomputed matrix's rounding a move.
   const bool dry_changed = take_dry(dry);

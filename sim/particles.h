@@ -143,9 +143,9 @@ struct ParticleStats {
   uint32_t revived = 0;   // fading out, spot free again: fading back in
   uint32_t evicted = 0;   // fading out, slot taken early because the slots ran out
   uint32_t left_river = 0;  // advection carried it off the water
-  uint32_t dry = 0;       // a footprint came to cover or hide it (removed at once, as culled)
+  uint32_t dry = 0;       // a footprint or an occluder came to cover or hide it (removed at once)
   uint32_t dry_hits = 0;  // pixel rays that met the river inside a footprint (no particle)
-  uint32_t hidden_hits = 0;  // pixel rays that met an obstacle before the river (no particle)
+  uint32_t hidden_hits = 0;  // pixel rays that met an obstacle or occluder before the river
   uint32_t rays = 0;      // pixel rays cast (conversion and seeding)
   uint32_t ray_misses = 0;
   uint32_t arc_checks = 0;  // particles whose fill circle was recomputed

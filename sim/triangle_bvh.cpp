@@ -252,6 +252,7 @@ bool TriangleBvh::trace(const glm::vec3& origin, const glm::vec3& direction, flo
         const float det = glm::dot(e1, p);
         if (det == 0.0f || !std::isfinite(det)) continue;
         const float inv_det = 1.0f / det;
+        if (!std::isfinite(inv_det)) continue;  // a sliver: a subnormal det would make u, v NaN
         const glm::vec3 s = origin - v0;
         const float u = glm::dot(s, p) * inv_det;
         if (u < 0.0f || u > 1.0f) continue;
@@ -296,7 +297,8 @@ bool TriangleBvh::any_hit(const glm::vec3& origin, const glm::vec3& direction, f
   return trace<true>(origin, direction, t_min, t_max, nullptr);
 }
 
-uint32_t TriangleBvh::nearest_vertex(const glm::vec3& p, float radius, uint32_t hint_triangle) const {
+uint32_t TriangleBvh::nearest_vertex(const glm::vec3& p, float radius,
+                                     uint32_t hint_triangle) const {
   uint32_t best_v = triangle_vertex(hint_triangle, 0);
   float best_d2 = distance2(p, positions_[best_v]);
   for (int k = 1; k < 3; ++k) {

@@ -288,7 +288,7 @@ int run_bench(int argc, char** argv) {
   std::printf("flow / floor: %.2f\n", floor.median > 0.0 ? flow.median / floor.median : 0.0);
   std::printf("cpu update (particles + packing) %.3f ms, record %.3f ms (medians)\n", update.median,
               record.median);
-  std::printf("create %.1f ms (the flow solve and static data included)\n", create_ms);
+  std::printf("create %.1f ms (the flow solve, static data and occluders included)\n", create_ms);
   if (second != nullptr) {
     std::printf("second view: create %.1f ms, cpu update %.3f ms, water %.3f ms (medians; the "
                 "first view: %.1f, %.3f, %.3f)\n",

@@ -31,7 +31,8 @@ size_t particles_on_hidden_water(const Frame& frame, uint32_t height,
   const int w = static_cast<int>(frame.width), h = static_cast<int>(height);
   size_t hidden = 0;
   for (const Particle& p : particles) {
-    const int x = static_cast<int>(std::floor(p.screen.x)), y = static_cast<int>(std::floor(p.screen.y));
+    const int x = static_cast<int>(std::floor(p.screen.x)),
+              y = static_cast<int>(std::floor(p.screen.y));
     if (p.slot == 0 || x < 0 || y < 0 || x >= w || y >= h) continue;
     bool water_near = false;
     for (int dy = -kEdgePx; dy <= kEdgePx && !water_near; ++dy) {
@@ -65,7 +66,9 @@ class HiddenWaterTest : public StraightChannelTest {
     pier.translation = {0.0f, 0.7f, 4.0f};
     const Status status = create_channel(info, kBoulder, WaterLook{}, {pier});
     EXPECT_TRUE(status.ok()) << status.message();
-    if (!occluded) EXPECT_TRUE(renderer_->set_occluders({}).ok());
+    if (!occluded) {
+      EXPECT_TRUE(renderer_->set_occluders({}).ok());
+    }
     std::vector<Frame> frames = render_still(0, kFrames);
     if (frames.empty()) return 0;
     *last = frames.back();
@@ -93,39 +96,66 @@ TEST_F(HiddenWaterTest, NoParticleBehindAPierTheRendererKnows) {
 
 TEST_F(HiddenWaterTest, NoParticleOnWaterTheDefaultValleyHides) {
   // Along the default scene's camera path, low over the meanders, with the valley's ground as
-  // the occluders (as our tools give it) and without.
+  // the occluders (as our tools give it) and without: with them none sits on hidden water, and
+  // the visible water keeps its particles (the ground meeting the water hides none of it).
+  constexpr uint32_t kSeconds[] = {0, 8, 16, 24};
+  size_t on_water[2][4] = {};  // particles on visible water, without and with
   for (const bool occluded : {true, false}) {
     ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
-    if (!occluded) ASSERT_TRUE(renderer_->set_occluders({}).ok());
-    for (const uint32_t second : {0u, 8u, 16u, 24u}) {
-      const std::vector<Frame> frames = render(second * 30, second * 30 + kFrames);
-      ASSERT_EQ(frames.size(), kFrames);
-      const size_t hidden =
-          particles_on_hidden_water(frames.back(), kHeight, particle_field(*renderer_).particles());
-      std::printf("default scene at %2u s, %s occluders: %zu particles on hidden water\n", second,
-                  occluded ? "with" : "without", hidden);
-      if (occluded) EXPECT_EQ(hidden, 0u) << "at " << second << " s";
+    if (!occluded) {
+      ASSERT_TRUE(renderer_->set_occluders({}).ok());
     }
+    for (size_t i = 0; i < 4; ++i) {
+      const std::vector<Frame> frames = render(kSeconds[i] * 30, kSeconds[i] * 30 + kFrames);
+      ASSERT_EQ(frames.size(), kFrames);
+      const std::span<const Particle> particles = particle_field(*renderer_).particles();
+      const size_t hidden = particles_on_hidden_water(frames.back(), kHeight, particles);
+      for (const Particle& p : particles) {
+        const bool in = p.slot != 0 && p.screen.x >= 0.0f && p.screen.y >= 0.0f &&
+                        p.screen.x < kWidth && p.screen.y < kHeight;
+        const size_t pixel = size_t(p.screen.y) * kWidth + size_t(p.screen.x);
+        on_water[occluded][i] += in && frames.back().water_mask[pixel] == 1.0f ? 1 : 0;
+      }
+      std::printf("default scene at %2u s, %s occluders: %zu particles on visible water, %zu on "
+                  "hidden water\n", kSeconds[i], occluded ? "with" : "without",
+                  on_water[occluded][i], hidden);
+      if (occluded) {
+        EXPECT_EQ(hidden, 0u) << "at " << kSeconds[i] << " s";
+      }
+    }
+  }
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_GE(on_water[1][i] * 100, on_water[0][i] * 95) << "at " << kSeconds[i] << " s";
   }
 }
 
 TEST_F(HiddenWaterTest, ABadOccluderMeshIsRefusedByName) {
   ASSERT_TRUE(create_channel(make_create_info(kWidth, kHeight), kBoulder).ok());
+  ASSERT_EQ(render_still(0, 1).size(), 1u);
+  const auto world = particle_field(*renderer_).occluders();
+  ASSERT_NE(world, nullptr);
   const std::vector<glm::vec3> positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   const std::vector<uint32_t> out_of_range = {0, 1, 3};
   Status s = renderer_->set_occluders({positions, out_of_range});
   EXPECT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("set_occluders: occluders: index 2 (3) is out of range"),
-            std::string::npos)
+  EXPECT_NE(
+      s.message().find("set_occluders: OccluderMesh::indices[2] 3 is out of range (3 positions)"),
+      std::string::npos)
       << s.message();
-  const std::vector<glm::vec3> nan = {{0, 0, 0}, {1, std::numeric_limits<float>::quiet_NaN(), 0}, {0, 1, 0}};
+  const std::vector<glm::vec3> nan = {
+      {0, 0, 0}, {1, std::numeric_limits<float>::quiet_NaN(), 0}, {0, 1, 0}};
   s = renderer_->set_occluders({nan, {}});
   EXPECT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("vertex 1 is not finite"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("OccluderMesh::positions[1] is not finite"), std::string::npos)
+      << s.message();
   const std::vector<glm::vec3> two = {{0, 0, 0}, {1, 0, 0}};
-  EXPECT_FALSE(renderer_->set_occluders({two, {}}).ok());
-  // Nothing changed: the renderer still renders.
-  EXPECT_EQ(render_still(0, 2).size(), 2u);
+  s = renderer_->set_occluders({two, {}});
+  EXPECT_NE(s.message().find("OccluderMesh::positions has 2 values, not 3 per triangle"),
+            std::string::npos)
+      << s.message();
+  // Nothing changed: the renderer renders on with the world's occluders.
+  EXPECT_EQ(render_still(1, 3).size(), 2u);
+  EXPECT_EQ(particle_field(*renderer_).occluders(), world);
 }
 
 }  // namespace

@@ -459,6 +459,7 @@ TEST_F(RenderTest, ResizeBetweenFramesKeepsFramesInFlightValid) {
   EXPECT_EQ(renderer_->readback_bytes(ReadbackImage::kColor), 160u * 90u * 8u);
   const std::vector<Frame> small = render(3, 6, 160, 90);
   ASSERT_EQ(small.size(), 3u);
+  EXPECT_NE(particle_field(*renderer_).occluders(), nullptr) << "the new particles see the world";
   const float* sky = small[0].pixel(80, 2);
   EXPECT_GT(sky[2], sky[0]);
   EXPECT_EQ(small[0].depth[2 * 160 + 80], 1.0f);

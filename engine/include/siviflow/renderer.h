@@ -94,9 +94,10 @@ struct CreateInfo {
   // changes it.
   const WaterLook* look = nullptr;
   // Another view of the same river: a renderer on the same device whose river this one shares
-  // (its surface, flow, obstacles and static GPU data: no second flow solve), with particles,
-  // flow textures, tile table and reflection of its own; `river` is then not read. Obstacles
-  // added through either renderer re-route both. Null: a river of its own.
+  // (its surface, flow, obstacles, occluders and static GPU data: no second flow solve), with
+  // particles, flow textures, tile table and reflection of its own; `river` is then not read.
+  // Obstacles added and occluders set through either renderer reach both. Null: a river of its
+  // own.
   const Renderer* share_river_with = nullptr;
   bool enable_timing = false;          // GPU timestamps around every pass (see pass_times())
   // With enable_timing: also the flow pass's floor (a pass over the water's pixels making the
@@ -275,9 +276,10 @@ class Renderer {
   // props; not the obstacles, which the renderer knows): particles are made only on water a
   // view sees, so no hidden water feeds the flow the visible water shows. World space, static
   // until the next call; copied, and its ray-cast structure built (O(n log n) in the triangles).
-  // Shared by every view of the river from their next update() on; no positions clears it. Call
-  // outside begin_frame/record. A bad mesh (a count not a multiple of 3, an index out of range,
-  // a position not finite) is an error naming it, and nothing changes.
+  // Shared by every view of the river from their next update() or simulate() on; an empty mesh
+  // clears it. Call outside begin_frame/record. A bad mesh (a count not a multiple of 3, an index
+  // out of range, a position not finite) is an error naming the field and index, and nothing
+  // changes.
   Status set_occluders(const OccluderMesh& mesh);
 
   // The water's look from the next update() on. A field out of its range (water_look.h) is an
