@@ -1,0 +1,130 @@
+// A long run in one process: the default scene at 320x180 along its camera path, two frames in
+// flight, the shipping path (no readback), under validation. After a warm-up, resident memory
+// stays flat (the mean over the last frames within 1 MiB of the mean over the first) and the
+// renderer creates no device memory, buffer, image, descriptor pool or set (its staging blocks
+// and pools do not grow). The windows compared are a thousand frames, or a fifth of a shorter
+// run. CI runs 1,000 frames; SIVIFLOW_SOAK_FRAMES sets another count (500 at least).
+#include <malloc.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "counting_device_procs.h"
+#include "gpu_test.h"
+#include "siviflow/host_frame.h"
+
+namespace siviflow::testing {
+namespace {
+
+namespace counting = counting_device_procs;
+
+constexpr uint32_t kSoakWidth = 320;
+constexpr uint32_t kSoakHeight = 180;
+constexpr uint32_t kDefaultFrames = 1000;
+constexpr uint32_t kWarmUpFrames = 100;  // the caches of the driver and the layer fill up
+constexpr double kMiB = 1024.0 * 1024.0;
+#ifdef __SANITIZE_ADDRESS__
+// AddressSanitizer's quarantine holds freed memory back on purpose: resident memory says nothing
+// there, and LeakSanitizer judges the leaks at the end instead.
+constexpr bool kResidentJudged = false;
+#else
+constexpr bool kResidentJudged = true;
+#endif
+
+uint32_t soak_frames() {
+  const char* text = std::getenv("SIVIFLOW_SOAK_FRAMES");
+  const long frames = text != nullptr ? std::strtol(text, nullptr, 10) : 0;
+  return frames >= 500 ? static_cast<uint32_t>(frames) : kDefaultFrames;
+}
+
+// Resident set size of this process, bytes.
+double resident_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  long size = 0, resident = 0;
+  statm >> size >> resident;
+  return static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE));
+}
+
+double mean(const std::vector<double>& v, size_t first, size_t end) {
+  double sum = 0.0;
+  for (size_t i = first; i < end; ++i) sum += v[i];
+  return sum / static_cast<double>(end - first);
+}
+
+class SoakTest : public GpuTest {};
+
+TEST_F(SoakTest, ResidentMemoryAndDeviceObjectsStayFlat) {
+  // Freed memory stays with the process (no trimming, no mmap for large blocks): resident memory
+  // then follows the peak in use, not when glibc happens to hand pages back.
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  const uint32_t frames = soak_frames();
+  CreateInfo info = make_create_info(kSoakWidth, kSoakHeight);
+  info.readback_images = 0;
+  counting::install(info.get_device_proc_addr);
+  info.get_device_proc_addr = &counting::get_device_proc_addr;
+  ASSERT_TRUE(create_renderer(info).ok());
+  HostTargets targets[2];
+  for (HostTargets& slot : targets) {
+    ASSERT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
+                                    {kSoakWidth, kSoakHeight},
+                                    {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                    &slot).ok());
+  }
+
+  std::vector<double> resident;
+  resident.reserve(frames);
+  counting::Counts after_warm_up;
+  for (uint32_t frame = 0; frame < frames; ++frame) {
+    const uint32_t slot = frame % 2;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    ASSERT_TRUE(context_->begin_slot(slot, &cmd).ok());
+    ASSERT_TRUE(renderer_->begin_frame(slot).ok());
+    const double time = frame / 30.0;
+    const View view = camera_view(world_->scene_camera(time), {kSoakWidth, kSoakHeight});
+    Status status = renderer_->update(view, time);
+    ASSERT_TRUE(status.ok()) << "frame " << frame << ": " << status.message();
+    status = record_world_and_water(cmd, slot, *world_, *renderer_, view, time, {}, &targets[slot]);
+    ASSERT_TRUE(status.ok()) << "frame " << frame << ": " << status.message();
+    ASSERT_TRUE(context_->end_slot_and_submit(slot).ok());
+    resident.push_back(resident_bytes());
+    if (frame + 1 == kWarmUpFrames) after_warm_up = counting::counts;
+  }
+  for (uint32_t slot = 0; slot < 2; ++slot) ASSERT_TRUE(context_->wait_slot(slot).ok());
+
+  // Windows of a thousand frames (a fifth of the run when shorter).
+  const size_t window = std::min<size_t>(1000, (frames - kWarmUpFrames) / 5);
+  const double first = mean(resident, kWarmUpFrames, kWarmUpFrames + window);
+  const double last = mean(resident, frames - window, frames);
+  const counting::Counts& end = counting::counts;
+  std::printf("%u frames: resident %.2f MiB over frames %u..%zu, %.2f MiB over the last %zu "
+              "(%+.3f MiB); renderer created %llu memory allocations, %llu buffers, %llu images, "
+              "%llu descriptor pools, %llu set allocations, none after frame %u: %s\n",
+              frames, first / kMiB, kWarmUpFrames, kWarmUpFrames + window, last / kMiB, window,
+              (last - first) / kMiB, static_cast<unsigned long long>(end.allocate_memory),
+              static_cast<unsigned long long>(end.create_buffer),
+              static_cast<unsigned long long>(end.create_image),
+              static_cast<unsigned long long>(end.create_descriptor_pool),
+              static_cast<unsigned long long>(end.allocate_descriptor_sets), kWarmUpFrames,
+              end == after_warm_up ? "yes" : "no");
+  if (kResidentJudged) {
+    EXPECT_LE(last - first, 1.0 * kMiB) << "resident memory grows";
+  } else {
+    std::printf("resident memory not judged under AddressSanitizer (its quarantine keeps freed "
+                "memory); LeakSanitizer judges the leaks at exit\n");
+  }
+  EXPECT_GT(end.allocate_memory, 0u) << "the counting table is the renderer's";
+  EXPECT_TRUE(end == after_warm_up) << "the renderer creates device objects after its warm-up";
+}
+
+}  // namespace
+}  // namespace siviflow::testing
