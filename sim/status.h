@@ -3,7 +3,10 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
+
+#include "sim/printable_text.h"
 
 namespace siviflow {
 
@@ -12,9 +15,11 @@ class [[nodiscard]] Status {
   Status() = default;  // success
 
   static Status success() { return Status(); }
-  // code: the VkResult when Vulkan is the cause (negative), otherwise kGenericError.
-  static Status error(std::string message, int32_t code = kGenericError) {
-    return Status(code, std::move(message));
+  // code: the VkResult when Vulkan is the cause (negative), otherwise kGenericError. The
+  // message is kept as printable_text() of it: whatever bytes of a file it quotes, it is valid
+  // UTF-8 without control characters.
+  static Status error(std::string_view message, int32_t code = kGenericError) {
+    return Status(code, printable_text(message));
   }
 
   bool ok() const { return code_ == 0; }

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "sim/printable_text.h"
+
 namespace siviflow::cli {
 namespace {
 
@@ -94,7 +96,7 @@ Status unexpected_argument(std::string_view arg) {
 
 int fail(std::string_view command, const std::string& message) {
   std::fprintf(stderr, "siviflow %.*s: %s\n", static_cast<int>(command.size()), command.data(),
-               message.c_str());
+               printable_text(message).c_str());
   return kExitError;
 }
 

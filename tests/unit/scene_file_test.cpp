@@ -266,6 +266,18 @@ TEST(SceneFile, ProceduralParametersAreParsed) {
   EXPECT_EQ(p.vertices_across, 9u);
 }
 
+TEST(SceneFile, MessagesQuoteTheFilesBytesAsText) {
+  // A key holding a terminal's escape sequence, and a file that is not UTF-8 at all: the
+  // messages name them with the bytes escaped.
+  expect_error(R"({"version": 1, "river": {"procedural": {}}, "colour\u001b[31m": 1})",
+               {"colour\\x1B[31m: unknown key"});
+  SceneFile scene;
+  const Status status = parse("{\"version\": 1, \"na\xFF\xFEme\": 1}", &scene);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("\\xFF"), std::string::npos) << status.message();
+  EXPECT_EQ(status.message().find('\xFF'), std::string::npos) << "no raw byte";
+}
+
 TEST(SceneFile, UnknownKeysNameTheirPathAndTheFile) {
   expect_error(with({{"colour", "blue"}}),
                {"colour: unknown key", "allowed here: $schema, version, river"});
