@@ -291,7 +291,9 @@ class Renderer {
   DebugView debug_view() const;
 
   // New view size. Call between frames (not between begin_frame and record); images that
-  // frames in flight still use are freed once every slot has come round again.
+  // frames in flight still use are freed once every slot has come round again. When it fails
+  // (a size the particles cannot cover fails before anything changed; a failed allocation after
+  // the old images were let go), begin_frame refuses to render until a resize succeeds.
   Status resize(VkExtent2D extent);
 
   // With CreateInfo::enable_timing: the GPU time of each pass of the frame last recorded in
