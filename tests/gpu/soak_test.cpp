@@ -40,9 +40,11 @@ constexpr bool kResidentJudged = true;
 
 // Before any thread allocates: freed memory stays with the process (no trimming, no mmap for
 // large blocks) and every thread allocates from one arena, so resident memory follows the peak
-// in use, not when glibc hands pages back or which thread makes a new arena when.
-const bool kMallocSet = mallopt(M_TRIM_THRESHOLD, 1 << 30) && mallopt(M_MMAP_THRESHOLD, 32 << 20) &&
-                        mallopt(M_ARENA_MAX, 1);
+// in use, not when glibc hands pages back or which thread makes a new arena when. (Not under
+// AddressSanitizer, whose allocator is not glibc's.)
+const bool kMallocSet = !kResidentJudged || (mallopt(M_TRIM_THRESHOLD, 1 << 30) &&
+                                             mallopt(M_MMAP_THRESHOLD, 32 << 20) &&
+                                             mallopt(M_ARENA_MAX, 1));
 
 uint32_t soak_frames() {
   const char* text = std::getenv("SIVIFLOW_SOAK_FRAMES");
