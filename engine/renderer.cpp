@@ -16,11 +16,8 @@
 namespace siviflow {
 namespace {
 
-constexpr uint32_t kDefaultFramesInFlight = 2;
 constexpr uint32_t kMaxFramesInFlight = 8;
-constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDefaultDepthFormat = VK_FORMAT_D32_SFLOAT;
-constexpr VkDeviceSize kDefaultStagingBytes = 8ull << 20;
 constexpr float kTdfRepeatTiles = 3.5f;  // normal-map repeat in tiles at ripple scale 1 (van Hoesel 35/10)
 constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
 

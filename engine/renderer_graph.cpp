@@ -9,16 +9,6 @@
 #include "vk/pipeline.h"
 
 namespace siviflow {
-namespace {
-
-constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;
-// Layouts documented in shaders/shared.h.
-constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
-constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
-constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
-
-}  // namespace
-
 uint32_t texel_bytes(VkFormat format) {
   switch (format) {
     case VK_FORMAT_R8G8B8A8_UNORM:
@@ -35,6 +25,11 @@ uint32_t texel_bytes(VkFormat format) {
   }
 }
 
+VkExtent2D reflection_extent(VkExtent2D extent) {
+  return {std::max(1u, static_cast<uint32_t>(std::lround(extent.width * kDefaultReflectionScale))),
+          std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
+}
+
 ImageHandle Renderer::Impl::frame_image(ImageHandle handle, bool persistent) {
   frame_images.push_back({handle, Image{}, persistent});
   return handle;
@@ -42,9 +37,7 @@ ImageHandle Renderer::Impl::frame_image(ImageHandle handle, bool persistent) {
 
 Status Renderer::Impl::declare_graph() {
   const VkExtent2D extent = info.extent;
-  const VkExtent2D reflection_extent{
-      std::max(1u, static_cast<uint32_t>(std::lround(extent.width * kDefaultReflectionScale))),
-      std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
+  const VkExtent2D reflection_size = reflection_extent(extent);
   frame_images.clear();
   river_assets = river->assets.import_into(graph);
   VkClearValue transparent{};
@@ -64,9 +57,9 @@ Status Renderer::Impl::declare_graph() {
 
   // reflection: the host's world mirrored about the water plane, clipped below it.
   ImageHandle reflection =
-      frame_image(graph.create_image({"reflection", info.color_format, reflection_extent, transparent}));
+      frame_image(graph.create_image({"reflection", info.color_format, reflection_size, transparent}));
   reflection_depth = frame_image(
-      graph.create_image({"reflection depth", kReflectionDepthFormat, reflection_extent, {}}));
+      graph.create_image({"reflection depth", kReflectionDepthFormat, reflection_size, {}}));
   reflection_data = add_reflection_pass(graph, &reflection, &reflection_depth, info.reflection,
                                         info.reflection_user);
 

@@ -107,6 +107,18 @@ Status argument_error(const std::string& message);
 // Bytes per texel of a host colour format we take (RGBA8, RGBA16F, RGBA32F); 0 for any other.
 uint32_t texel_bytes(VkFormat format);
 inline constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we copy
+// What CreateInfo's zeros stand for.
+inline constexpr VkDeviceSize kDefaultStagingBytes = 8ull << 20;
+inline constexpr uint32_t kDefaultFramesInFlight = 2;
+inline constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+// The view's own images (renderer_graph.cpp; view_memory.cpp counts them). Layouts of the flow
+// texture and the particle aux data are documented in shaders/shared.h.
+inline constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;
+inline constexpr VkFormat kFlowTextureFormat = VK_FORMAT_R16G16B16A16_UINT;
+inline constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+inline constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
+// The reflection target's size for a view of `extent`.
+VkExtent2D reflection_extent(VkExtent2D extent);
 
 inline constexpr std::string_view kRendererErrorPrefix = "siviflow::Renderer: ";
 

@@ -23,6 +23,7 @@
 #include "renderer_inspect.h"
 #include "siviflow/host_frame.h"
 #include "siviflow/image_files.h"
+#include "sim/text_format.h"
 #include "siviflow/renderer.h"
 #include "siviflow/scene_file.h"
 #include "siviflow/scene_river.h"
@@ -34,9 +35,10 @@ constexpr const char* kCommand = "capture";
 constexpr uint32_t kFramesInFlight = 2;
 constexpr VkFormat kOutputFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
-// Colour (RGBA16F) + depth (D32) images and their readback copies, per frame in flight.
-constexpr uint64_t kBytesPerPixel = 2 * (8 + 4);
-// Lavapipe does not enforce its 2 GiB heap (reliability notes), so the capture enforces a budget.
+// Lavapipe does not enforce its 2 GiB heap (reliability notes), so the capture enforces a budget
+// on what grows with the size: the renderers' views, and per frame in flight the host's colour
+// (RGBA16F) and depth (D32) and the readback buffers.
+constexpr uint64_t kHostBytesPerPixel = 8 + 4;
 constexpr uint64_t kMaxCaptureBytes = 2ull << 30;
 
 struct CaptureOptions {
@@ -216,6 +218,9 @@ class Capture {
 
  private:
   uint32_t readback_images() const;
+  // Refuses, before anything is allocated, a size and AOV set over the memory budget, with the
+  // figure it would need.
+  Status check_memory_budget(CreateInfo info, size_t river_count) const;
   void copy_out(const SlotTargets& slot);
   Status write_frame();
   void report_progress(uint32_t done_count);
@@ -255,16 +260,11 @@ Status Capture::run() {
                          std::to_string(options_.size.height) + " exceeds the device limit of " +
                          std::to_string(max_dimension) + " pixels per side");
   }
-  const uint64_t pixels = uint64_t{options_.size.width} * options_.size.height;
-  if (pixels * kBytesPerPixel * kFramesInFlight > kMaxCaptureBytes) {
-    return Status::error("--size " + std::to_string(options_.size.width) + "x" +
-                         std::to_string(options_.size.height) + " needs more than the " +
-                         std::to_string(kMaxCaptureBytes >> 20) + " MiB memory budget");
-  }
-
   CreateInfo info = context_->renderer_create_info(
       {options_.size.width, options_.size.height}, kOutputFormat);
   info.frames_in_flight = kFramesInFlight;
+  info.depth_format = kDepthFormat;
+  SIVIFLOW_TRY(check_memory_budget(info, river_count));
   info.seed = options_.seed;
   const SceneFile* scene = scene_.has_value() ? &*scene_ : nullptr;
   info.look = scene != nullptr ? &scene->look : nullptr;
@@ -272,7 +272,6 @@ Status Capture::run() {
   world_info.frames_in_flight = kFramesInFlight;
   world_info.scene = scene;
   SIVIFLOW_TRY(World::create(world_info, &world_));
-  info.depth_format = kDepthFormat;
   info.reflection = &World::draw_reflection;
   info.reflection_user = world_.get();
   for (size_t i = 0; i < river_count; ++i) {
@@ -357,6 +356,24 @@ Status Capture::run() {
 }
 
 // The colour, and what the requested AOVs are made from.
+Status Capture::check_memory_budget(CreateInfo info, size_t river_count) const {
+  const uint64_t pixels = uint64_t{options_.size.width} * options_.size.height;
+  uint64_t needed = kFramesInFlight * pixels * kHostBytesPerPixel;
+  for (size_t i = 0; i < river_count; ++i) {  // the last river's renderer reads back
+    info.readback_images = i + 1 == river_count ? readback_images() : 0;
+    ViewMemory view;
+    SIVIFLOW_TRY(view_memory(info, &view));
+    needed += view.renderer_bytes + kFramesInFlight * view.readback_bytes;
+  }
+  if (needed <= kMaxCaptureBytes) return Status::success();
+  return Status::error(text_format(
+      "--size %ux%u (with the AOVs asked for) needs %llu MiB of device memory (the renderers' images and "
+      "staging, the frames' colour, depth and readback buffers), more than the %llu MiB budget",
+      options_.size.width, options_.size.height,
+      static_cast<unsigned long long>((needed + (1u << 20) - 1) >> 20),
+      static_cast<unsigned long long>(kMaxCaptureBytes >> 20)));
+}
+
 uint32_t Capture::readback_images() const {
   uint32_t images = readback_bit(ReadbackImage::kColor);
   if (options_.depth_aov) images |= readback_bit(ReadbackImage::kDepth);

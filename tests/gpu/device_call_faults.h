@@ -34,6 +34,7 @@ struct State {
   std::array<uint64_t, kKindCount> created{};  // successful calls of each kind
   std::array<int64_t, kKindCount> alive{};     // created minus destroyed
   uint64_t calls = 0;                          // watched calls made, failed ones included
+  uint64_t allocated_bytes = 0;                // device memory allocated (frees not subtracted)
   int64_t fail_at = -1;  // the watched call with this index (from 0) fails; negative: none
   std::string failed_call;  // the name of the call made to fail, once it has
 };
@@ -92,6 +93,7 @@ VKAPI_ATTR VkResult VKAPI_CALL create(VkDevice device, const Info* info,
   if (result == VK_SUCCESS) {
     ++state.created[K];
     ++state.alive[K];
+    if constexpr (K == kMemory) state.allocated_bytes += info->allocationSize;
   }
   return result;
 }

@@ -231,6 +231,21 @@ struct FrameInputs {
   ReadbackTargets readback;
 };
 
+// The device memory a view of `info` (its extent, formats, frames in flight, readback images,
+// timing) takes, for a host's budget before create(); no device needed. Upper bounds where the
+// river decides (the particles' slots, the tile table).
+struct ViewMemory {
+  // The renderer's own: the reflection and its depth, the refraction copy, the AOV attachments
+  // and the flow floor when asked for, the flow texture, particle aux data and tile table, and a
+  // staging block per frame in flight. Not the river's static data (by the river's size, shared
+  // by its views).
+  VkDeviceSize renderer_bytes = 0;
+  // The host's readback buffers of one frame in flight for CreateInfo::readback_images.
+  VkDeviceSize readback_bytes = 0;
+};
+// An extent of 0 or a colour format the renderer does not take is an error naming it.
+Status view_memory(const CreateInfo& info, ViewMemory* out);
+
 // "siviflow 0.1.0", as recorded in EXR metadata.
 const char* version_string();
 
