@@ -20,6 +20,12 @@
 // allocation is VK_ERROR_OUT_OF_HOST_MEMORY), errors in the caller's arguments carry no Vulkan
 // result (Status::kGenericError), and every error message starts with "siviflow::Renderer: "
 // and also reaches CreateInfo::log.
+// Threads: the library holds no global state and takes no locks. Calls on one renderer must not
+// overlap; a host may make them from different threads in turn when it orders them itself (a
+// mutex, a queue hand-off), say begin_frame and update on a simulation thread and record on the
+// render thread. Renderers that share a river (CreateInfo::share_river_with) share its flow,
+// obstacles and occluders, so their calls must not overlap either; renderers of different
+// rivers are independent. The log callback runs on the thread of the call that logs.
 #pragma once
 
 #include <cstdint>
