@@ -65,9 +65,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
   const size_t corner_count = indices.empty() ? positions.size() : indices.size();
   if (corner_count == 0) return Status::error(name + ": the mesh has no triangles");
   if (corner_count % 3 != 0) {
-    return Status::error(name + ": " + std::to_string(corner_count) +
-                         (indices.empty() ? " positions" : " indices") +
-                         " is not a multiple of 3 (a non-indexed mesh needs 3 per triangle)");
+    return Status::error(name + (indices.empty() ? "::positions" : "::indices") + " has " +
+                         std::to_string(corner_count) + " values, not 3 per triangle");
   }
   const size_t tri_count = corner_count / 3;
   if (tri_count > std::numeric_limits<uint32_t>::max() / 4 ||
@@ -77,14 +76,14 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
   for (size_t i = 0; i < positions.size(); ++i) {
     const glm::vec3& p = positions[i];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return Status::error(name + ": vertex " + std::to_string(i) + " is not finite");
+      return Status::error(name + "::positions[" + std::to_string(i) + "] is not finite");
     }
   }
   for (size_t i = 0; i < indices.size(); ++i) {
     if (indices[i] >= positions.size()) {
-      return Status::error(name + ": index " + std::to_string(i) + " (" +
-                           std::to_string(indices[i]) + ") is out of range (" +
-                           std::to_string(positions.size()) + " vertices)");
+      return Status::error(name + "::indices[" + std::to_string(i) + "] " +
+                           std::to_string(indices[i]) + " is out of range (" +
+                           std::to_string(positions.size()) + " positions)");
     }
   }
 

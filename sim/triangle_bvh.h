@@ -27,9 +27,9 @@ class TriangleBvh {
   // The spans are referenced, not copied: they must outlive the BVH and keep their contents.
   // Fails on no triangles, a count that is not a multiple of 3, an index out of range, a non-
   // finite position, or more triangles than 32-bit indices address.
-  // Messages begin with `mesh_name`.
+  // Messages name the fields after `mesh_name` ("RiverFlowField::positions[3] is not finite").
   static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                      TriangleBvh* out, std::string_view mesh_name = "river BVH");
+                      TriangleBvh* out, std::string_view mesh_name = "RiverFlowField");
 
   size_t triangle_count() const { return order_.size(); }
   std::span<const glm::vec3> positions() const { return positions_; }

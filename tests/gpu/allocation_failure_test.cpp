@@ -134,12 +134,7 @@ class FrameAfterFailuresTest : public AllocationFailureTest {
  protected:
   void SetUp() override {
     AllocationFailureTest::SetUp();
-    ASSERT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
-                                    {kWidth, kHeight},
-                                    {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                    &targets_).ok());
+    ASSERT_TRUE(create_sampled_targets({kWidth, kHeight}, &targets_).ok());
   }
 
   // A fresh renderer that has rendered frame 0.

@@ -139,12 +139,7 @@ TEST_F(DeviceFaultTest, FirstFramesFailCleanlyAndTheNextOnesRender) {
   CreateInfo info = watched_info();
   info.readback_images = 0;
   HostTargets targets;
-  ASSERT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
-                                  {kWidth, kHeight},
-                                  {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                   VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                  &targets).ok());
+  ASSERT_TRUE(create_sampled_targets({kWidth, kHeight}, &targets).ok());
   int64_t k = 0;
   for (;; ++k) {
     renderer_.reset();

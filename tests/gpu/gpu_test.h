@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "siviflow/headless_context.h"
+#include "siviflow/host_frame.h"
 #include "siviflow/renderer.h"
 #include "siviflow/scene_river.h"
 #include "siviflow/world.h"
@@ -35,6 +36,17 @@ class GpuTest : public ::testing::Test {
     std::string messages;
     for (const std::string& message : context_->validation_errors()) messages += message + "\n";
     EXPECT_EQ(context_->validation_error_count(), 0u) << messages;
+  }
+
+  // Colour (RGBA16F) and depth (D32) images of `extent` for one host slot, the colour left
+  // sampled after each frame.
+  Status create_sampled_targets(VkExtent2D extent, HostTargets* out) {
+    return create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
+                               extent,
+                               {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                                VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                               out);
   }
 
   CreateInfo make_create_info(uint32_t width, uint32_t height) const {

@@ -74,12 +74,7 @@ class RenderTest : public GpuTest {
     };
     Slot slots[2];
     for (Slot& slot : slots) {
-      EXPECT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT,
-                                      VK_FORMAT_D32_SFLOAT, {width, height},
-                                      {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                       VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                      &slot.targets).ok());
+      EXPECT_TRUE(create_sampled_targets({width, height}, &slot.targets).ok());
       for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
         EXPECT_TRUE(context_->create_readback_buffer(
             renderer_->readback_bytes(static_cast<ReadbackImage>(i)), &slot.readback[i]).ok());

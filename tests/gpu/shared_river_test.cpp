@@ -78,12 +78,7 @@ class SharedRiverTest : public GpuTest {
 
   HostTargets* targets(VkExtent2D extent) {
     targets_.push_back(std::make_unique<HostTargets>());
-    EXPECT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
-                                    extent,
-                                    {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                    targets_.back().get()).ok());
+    EXPECT_TRUE(create_sampled_targets(extent, targets_.back().get()).ok());
     return targets_.back().get();
   }
 

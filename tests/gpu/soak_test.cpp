@@ -78,12 +78,7 @@ TEST_F(SoakTest, ResidentMemoryAndDeviceObjectsStayFlat) {
   ASSERT_TRUE(create_renderer(info).ok());
   HostTargets targets[2];
   for (HostTargets& slot : targets) {
-    ASSERT_TRUE(create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
-                                    {kSoakWidth, kSoakHeight},
-                                    {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                    &slot).ok());
+    ASSERT_TRUE(create_sampled_targets({kSoakWidth, kSoakHeight}, &slot).ok());
   }
 
   std::vector<double> resident;
