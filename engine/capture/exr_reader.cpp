@@ -11,10 +11,13 @@
 
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
 #include <exception>
+#include <memory>
 
 #include "siviflow/atomic_file.h"
 #include "siviflow/image_files.h"
+#include "sim/text_format.h"
 
 namespace siviflow {
 namespace {
@@ -22,6 +25,13 @@ namespace {
 // Caps on what a (possibly corrupt) header may make us allocate: 2^28 pixels, 4 GiB of floats.
 constexpr int64_t kMaxReadPixels = int64_t{1} << 28;
 constexpr int64_t kMaxReadSamples = int64_t{1} << 30;
+// The most float-plane bytes one byte of a file can expand to. Deflate (zip, zips, pxr24) gives
+// at most 1032:1, and a half widens to a float: 4096 bounds every lossless codec with room to
+// spare; DWA keeps one DC value per 8x8 block before deflate, so it gets 64 times that. A header
+// asking for more than this (beyond a free 64 MiB) describes a file that cannot exist.
+constexpr int64_t kMaxLosslessExpansion = 4096;
+constexpr int64_t kMaxDwaExpansion = kMaxLosslessExpansion * 64;
+constexpr int64_t kFreeReadBytes = int64_t{64} << 20;
 
 const char* compression_name(Imf::Compression compression) {
   switch (compression) {
@@ -48,17 +58,86 @@ ExrPixelType pixel_type(Imf::PixelType type) {
 }
 
 // Opening a FIFO or device would block or read endlessly: regular files only.
-Status check_regular_file(const std::string& path, const std::string& what) {
+Status check_regular_file(const std::string& path, const std::string& what,
+                          int64_t* bytes = nullptr) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return Status::error(what + ": " + errno_message(errno));
   if (!S_ISREG(st.st_mode)) return Status::error(what + ": not a regular file");
+  if (bytes != nullptr) *bytes = st.st_size;
   return Status::success();
+}
+
+// OpenEXR sizes an attribute's value from the size field before reading it, so a few bytes that
+// claim 2 GiB make it allocate and clear 2 GiB. Walks every header of the file (name, type, size,
+// value; an empty name ends a header, and an empty header ends a multi-part file's headers) and
+// refuses a size that runs past the end of the file, before OpenEXR opens it.
+Status check_attribute_sizes(const std::string& path, const std::string& what, int64_t file_bytes) {
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                                             &std::fclose);
+  if (!file) return Status::error(what + ": " + errno_message(errno));
+  std::FILE* f = file.get();
+  unsigned char magic_and_version[8];
+  if (std::fread(magic_and_version, 1, 8, f) != 8) {
+    return Status::error(what + ": too short for an EXR header");
+  }
+  const bool multi_part = (magic_and_version[5] & 0x10) != 0;  // version bit 12
+  const auto read_text = [&](std::string* text) {  // NUL-terminated, at most 255 characters
+    text->clear();
+    for (int c = std::fgetc(f); c != 0; c = std::fgetc(f)) {
+      if (c == EOF || text->size() == 255) return false;
+      text->push_back(static_cast<char>(c));
+    }
+    return true;
+  };
+  std::string name;
+  std::string type;
+  for (;;) {
+    if (!read_text(&name)) return Status::error(what + ": header ends inside an attribute name");
+    if (name.empty()) return Status::success();  // no attribute, or after the last header
+    for (;;) {
+      unsigned char size_bytes[4];
+      if (!read_text(&type) || std::fread(size_bytes, 1, 4, f) != 4) {
+        return Status::error(what + ": header ends inside attribute '" + name + "'");
+      }
+      const int64_t size = static_cast<int32_t>(uint32_t{size_bytes[0]} |
+                                                uint32_t{size_bytes[1]} << 8 |
+                                                uint32_t{size_bytes[2]} << 16 |
+                                                uint32_t{size_bytes[3]} << 24);
+      const int64_t at = std::ftell(f);
+      if (size < 0 || size > file_bytes - at) {
+        return Status::error(what + text_format(": attribute '%s' claims %lld bytes, but the "
+                                                "file has %lld left",
+                                                name.c_str(), static_cast<long long>(size),
+                                                static_cast<long long>(file_bytes - at)));
+      }
+      std::fseek(f, static_cast<long>(size), SEEK_CUR);
+      if (!read_text(&name)) return Status::error(what + ": header ends inside an attribute name");
+      if (name.empty()) break;
+    }
+    if (!multi_part) return Status::success();
+  }
+}
+
+// Refuses a header whose planes could not come from a file of this size, before allocating them.
+Status check_plausible_size(const std::string& what, int64_t file_bytes, int64_t samples,
+                            Imf::Compression compression) {
+  const bool dwa = compression == Imf::DWAA_COMPRESSION || compression == Imf::DWAB_COMPRESSION;
+  const int64_t expansion = dwa ? kMaxDwaExpansion : kMaxLosslessExpansion;
+  const int64_t plane_bytes = samples * int64_t{sizeof(float)};
+  if (plane_bytes <= kFreeReadBytes + file_bytes * expansion) return Status::success();
+  return Status::error(what + text_format(": the header asks for %lld MiB of pixels, more than "
+                                          "a %lld-byte %s file can hold (corrupt or truncated)",
+                                          static_cast<long long>(plane_bytes >> 20),
+                                          static_cast<long long>(file_bytes),
+                                          compression_name(compression)));
 }
 
 Status read_exr_impl(const std::string& path, ExrImage* out) {
   const std::string what = "cannot read EXR '" + path + "'";
   if (out == nullptr) return Status::error(what + ": no output image");
-  SIVIFLOW_TRY(check_regular_file(path, what));
+  int64_t file_bytes = 0;
+  SIVIFLOW_TRY(check_regular_file(path, what, &file_bytes));
+  SIVIFLOW_TRY(check_attribute_sizes(path, what, file_bytes));
 
   Imf::InputFile file(path.c_str());
   const Imf::Header& header = file.header();
@@ -76,7 +155,6 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
   image.height = static_cast<int>(height);
   image.compression = compression_name(header.compression());
 
-  Imf::FrameBuffer frame_buffer;
   int64_t samples = 0;
   for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
     const Imf::Channel& channel = it.channel();
@@ -85,6 +163,12 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
     }
     samples += pixel_count;
     if (samples > kMaxReadSamples) return Status::error(what + ": too many samples");
+  }
+  SIVIFLOW_TRY(check_plausible_size(what, file_bytes, samples, header.compression()));
+
+  Imf::FrameBuffer frame_buffer;
+  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+    const Imf::Channel& channel = it.channel();
     ExrPlane& plane = image.channels[it.name()];
     plane.type = pixel_type(channel.type);
     plane.pixels.assign(static_cast<size_t>(pixel_count), 0.0f);

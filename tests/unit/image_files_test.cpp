@@ -264,6 +264,54 @@ TEST_F(ImageFilesExr, ReadAndCheckReportTruncatedFiles) {
   EXPECT_NE(missing.message().find("No such file"), std::string::npos) << missing.message();
 }
 
+// Overwrites the 4-byte little-endian int `index` places after the header attribute `name`'s
+// size field (0: the size itself) in `bytes`.
+void patch_attribute_int(std::string* bytes, const std::string& name, const std::string& type,
+                         int index, int32_t value) {
+  const std::string key = name + std::string(1, '\0') + type + std::string(1, '\0');
+  const size_t at = bytes->find(key);
+  ASSERT_NE(at, std::string::npos) << name;
+  std::memcpy(bytes->data() + at + key.size() + 4 * index, &value, 4);
+}
+
+// Found by fuzz_exr: OpenEXR sizes an attribute from its size field before reading it, so a
+// short file claiming a 2 GiB attribute made it allocate and clear 2 GiB (seconds per file).
+TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFile) {
+  TestFrame data(16, 16);
+  const std::string file = path("frame.exr");
+  ASSERT_TRUE(write_exr(file, data.frame()).ok());
+  std::string bytes = read_text(file);
+  patch_attribute_int(&bytes, "compression", "compression", 0, 0x7ffffff0);
+  const std::string bad = path("huge_attribute.exr");
+  write_text(bad, bytes);
+  ExrImage image;
+  const Status read = read_exr(bad, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("attribute 'compression' claims 2147483632 bytes"),
+            std::string::npos)
+      << read.message();
+  EXPECT_NE(read.message().find(bad), std::string::npos) << read.message();
+}
+
+// Found by fuzz_exr: a 460-byte file whose data window said 8454152x4 made the reader allocate
+// its 400 MiB of planes before OpenEXR found the pixels missing.
+TEST_F(ImageFilesExr, ReadRefusesDataWindowTheFileCannotHold) {
+  TestFrame data(16, 16);
+  const std::string file = path("frame.exr");
+  ASSERT_TRUE(write_exr(file, data.frame()).ok());
+  std::string bytes = read_text(file);
+  patch_attribute_int(&bytes, "dataWindow", "box2i", 3, 8000000);  // xMax
+  const std::string bad = path("huge_window.exr");
+  write_text(bad, bytes);
+  ExrImage image;
+  const Status read = read_exr(bad, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("more than a " + std::to_string(bytes.size()) + "-byte"),
+            std::string::npos)
+      << read.message();
+  EXPECT_NE(read.message().find("(corrupt or truncated)"), std::string::npos) << read.message();
+}
+
 TEST_F(ImageFilesExr, ReadRefusesFifoWithoutBlocking) {
   const std::string fifo = path("pipe.exr");
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);

@@ -9,6 +9,7 @@ packages=(
   libglm-dev libtinygltf-dev libopenexr-dev libpng-dev libjpeg62-turbo-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
   libglfw3-dev libimgui-dev xvfb
+  clang-15 libfuzzer-15-dev llvm-15
 )
 missing=()
 for p in "${packages[@]}"; do
