@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <glm/gtc/packing.hpp>
@@ -33,6 +34,11 @@ struct Frame {
 
 class RenderTest : public GpuTest {
  protected:
+  // Runs each frame's CPU part (begin_frame and update): on this thread, unless a test hands it
+  // to another as a host's simulation thread would.
+  std::function<void(const std::function<void()>&)> run_cpu_part_ =
+      [](const std::function<void()>& part) { part(); };
+
   // Renders frames [first, end) with two frames in flight (one host slot, target and readback
   // set each; a slot is waited on only when it is reused) and returns them in order.
   std::vector<Frame> render(uint32_t first, uint32_t end, uint32_t width = kWidth,
@@ -112,10 +118,15 @@ class RenderTest : public GpuTest {
       VkCommandBuffer cmd = VK_NULL_HANDLE;
       EXPECT_TRUE(context_->begin_slot(index, &cmd).ok());  // waits for this slot's last frame
       if (slot.pending) collect(slot);
-      EXPECT_TRUE(renderer_->begin_frame(index).ok());
       const double time = frame / 30.0;
       const View view = view_at(time);
-      Status status = renderer_->update(view, time);
+      Status begun;
+      Status status;
+      run_cpu_part_([&] {
+        begun = renderer_->begin_frame(index);
+        status = renderer_->update(view, time);
+      });
+      EXPECT_TRUE(begun.ok()) << begun.message();
       EXPECT_TRUE(status.ok()) << status.message();
       ReadbackTargets readback;
       for (uint32_t i = 0; i < kReadbackImageCount; ++i) readback.buffers[i] = slot.readback[i].buffer;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Quick start, command 2: install what is missing, build, and run every test tier; then build
 # again with AddressSanitizer and UndefinedBehaviorSanitizer (halting on any report) and run the
-# cpu and gpu tiers under them; last, build the libFuzzer targets with clang and run each for 30 s.
+# cpu and gpu tiers under them; then the thread tier under ThreadSanitizer; last, build the
+# libFuzzer targets with clang and run each for 30 s.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 bash "$root/tools/scripts/install_deps.sh"
@@ -12,6 +13,10 @@ cmake -S "$root" -B "$root/build/sanitize" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDe
   -DSIVIFLOW_SANITIZE=address,undefined
 cmake --build "$root/build/sanitize" -j2
 ctest --test-dir "$root/build/sanitize" -j2 --output-on-failure -L "cpu|gpu"
+cmake -S "$root" -B "$root/build/thread" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DSIVIFLOW_SANITIZE=thread
+cmake --build "$root/build/thread" -j2 --target thread_handoff_test
+ctest --test-dir "$root/build/thread" -j2 --output-on-failure -L thread
 cmake -S "$root" -B "$root/build/fuzz" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_COMPILER=clang++-15 -DSIVIFLOW_FUZZ=ON -DSIVIFLOW_BUILD_TOOLS=OFF \
   -DSIVIFLOW_BUILD_TESTS=OFF
