@@ -8,5 +8,6 @@ int run_capture(int argc, char** argv);
 int run_flow(int argc, char** argv);
 int run_bench(int argc, char** argv);
 int run_view(int argc, char** argv);
+int run_verify(int argc, char** argv);
 
 }  // namespace siviflow

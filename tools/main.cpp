@@ -15,6 +15,7 @@ void print_usage() {
       "  flow      solve a scene's river flow and write it as CSV\n"
       "  bench     time every pass of the default scene's frames (GPU timestamps) and the CPU work\n"
       "  view      a live window: fly along the river, drag boulders, tune the water\n"
+      "  verify    check a folder of captured frames: all present, complete and alike\n"
       "  info      print the Vulkan device, driver, required features and validation layer\n"
       "Run 'siviflow <command> --help' for the options of a command.\n");
 }
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   if (command == "flow") return siviflow::run_flow(argc, argv);
   if (command == "bench") return siviflow::run_bench(argc, argv);
   if (command == "view") return siviflow::run_view(argc, argv);
+  if (command == "verify") return siviflow::run_verify(argc, argv);
   std::fprintf(stderr, "siviflow: unknown command '%.*s' (try 'siviflow --help')\n",
                static_cast<int>(command.size()), command.data());
   return siviflow::cli::kExitError;

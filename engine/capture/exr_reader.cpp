@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <memory>
 
@@ -79,6 +80,10 @@ Status check_attribute_sizes(const std::string& path, const std::string& what, i
   unsigned char magic_and_version[8];
   if (std::fread(magic_and_version, 1, 8, f) != 8) {
     return Status::error(what + ": too short for an EXR header");
+  }
+  constexpr unsigned char kMagic[4] = {0x76, 0x2f, 0x31, 0x01};
+  if (std::memcmp(magic_and_version, kMagic, 4) != 0) {
+    return Status::error(what + ": not an EXR file (no EXR magic number)");
   }
   const bool multi_part = (magic_and_version[5] & 0x10) != 0;  // version bit 12
   const auto read_text = [&](std::string* text) {  // NUL-terminated, at most 255 characters

@@ -1,0 +1,39 @@
+// A folder of captured frames (DIR/frame_NNNNN.exr, as `siviflow capture` writes them): which
+// frames of a range are present, read whole, and agree with each other on what was captured.
+// What `siviflow verify` reports, and what a resumed capture will trust.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/status.h"
+
+namespace siviflow {
+
+// "frame_00042.exr".
+std::string frame_file_name(uint32_t frame);
+
+struct FrameProblem {
+  uint32_t frame = 0;
+  std::string file;     // the frame's file name in the folder
+  std::string problem;  // "missing", "cannot be read whole: ...", "seed 3, but ... has 1", ...
+};
+
+struct FrameFolderReport {
+  uint32_t first = 0;  // the range checked: frames [first, end)
+  uint32_t end = 0;
+  uint32_t complete = 0;              // frames read whole and in agreement
+  std::string reference;              // the frame the others were compared with ("" if none)
+  std::vector<FrameProblem> problems;  // in frame order, one per bad frame
+};
+
+// Checks frames [first, end) of `dir`; with `end` 0, the range from the lowest to the highest
+// frame file present. A frame is complete when OpenEXR reads every pixel of it, its frame number
+// is its file's, and its scene, seed, software version, size and channels equal those of the
+// first complete frame. Fails (and leaves `out` alone) only when the folder itself cannot be
+// checked: missing, not a folder, unreadable, or with no frame file and no range given.
+Status check_frame_folder(const std::string& dir, uint32_t first, uint32_t end,
+                          FrameFolderReport* out);
+
+}  // namespace siviflow
