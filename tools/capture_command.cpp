@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -19,6 +20,7 @@
 #include "commands.h"
 #include "shaders/shared.h"
 #include "siviflow/atomic_file.h"
+#include "siviflow/frame_folder.h"
 #include "siviflow/headless_context.h"
 #include "renderer_inspect.h"
 #include "siviflow/host_frame.h"
@@ -54,6 +56,8 @@ struct CaptureOptions {
   float fps = 30.0f;
   bool preview = false;
   bool validation = false;
+  bool resume = false;  // render only the frames of the range not already complete
+  bool force = false;   // with resume: re-render frames of another capture instead of refusing
   bool depth_aov = false;
   bool flow_aov = false;       // flow.X/Y/Z and water.mask
   bool particles_aov = false;  // particle.id and frame_NNNNN.particles.csv
@@ -66,6 +70,7 @@ void print_help() {
   std::printf(
       "usage: siviflow capture [SCENE.json] [--frames N | --range A:B] [--size WxH] --out DIR\n"
       "                        [--seed S] [--fps F] [--aov LIST] [--preview] [--validation]\n"
+      "                        [--resume [--force]]\n"
       "  Renders the scene file (its render settings unless a flag says otherwise), or the\n"
       "  built-in default scene, into DIR/frame_NNNNN.exr.\n"
       "  --frames N     frames 0..N-1 (same as --range 0:N; default 1)\n"
@@ -87,7 +92,11 @@ void print_help() {
       "                            blending (0 off water)\n"
       "                 foam       foam.Y: how much of the water foam covers, 0 none to 1 full\n"
       "  --preview      also write DIR/frame_NNNNN.png (sRGB, clamped)\n"
-      "  --validation   run with the Khronos validation layer; any error fails the capture\n");
+      "  --validation   run with the Khronos validation layer; any error fails the capture\n"
+      "  --resume       render only the frames of the range that are missing or cannot be read\n"
+      "                 whole; complete ones are left untouched. A complete frame of another\n"
+      "                 capture (scene, seed, size, AOVs, software version) is refused, naming it\n"
+      "  --force        with --resume: re-render such frames instead\n");
 }
 
 Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help) {
@@ -147,6 +156,10 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
       options->preview = true;
     } else if (arg == "--validation") {
       options->validation = true;
+    } else if (arg == "--resume") {
+      options->resume = true;
+    } else if (arg == "--force") {
+      options->force = true;
     } else if (!arg.empty() && arg[0] == '-') {
       return cli::unexpected_argument(arg);
     } else if (options->scene_path.empty()) {
@@ -156,6 +169,7 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
     }
   }
   if (options->out_dir.empty()) return Status::error("--out DIR is required");
+  if (options->force && !options->resume) return Status::error("--force goes with --resume");
   return Status::success();
 }
 
@@ -172,6 +186,55 @@ Status check_output_dir(const std::string& dir) {
 }
 
 constexpr uint32_t index_of(ReadbackImage image) { return static_cast<uint32_t>(image); }
+
+// The EXR channels of the AOVs made of three planes.
+constexpr const char* kFlowChannels[3] = {"flow.X", "flow.Y", "flow.Z"};
+constexpr const char* kNormalChannels[3] = {"normal.X", "normal.Y", "normal.Z"};
+constexpr const char* kReflectionChannels[3] = {"reflection.R", "reflection.G", "reflection.B"};
+
+// What every frame of this capture carries: what a resumed capture trusts a frame by.
+FrameExpectation frame_expectation(const CaptureOptions& options) {
+  FrameExpectation expected;
+  expected.scene = options.scene_path.empty() ? "default" : options.scene_path;
+  expected.seed = static_cast<int>(options.seed);
+  expected.width = static_cast<int>(options.size.width);
+  expected.height = static_cast<int>(options.size.height);
+  std::vector<std::string>& names = expected.channels;
+  names = {"R", "G", "B", "A"};
+  if (options.depth_aov) names.push_back("depth.Z");
+  if (options.flow_aov) {
+    names.insert(names.end(), std::begin(kFlowChannels), std::end(kFlowChannels));
+    names.push_back("water.mask");
+  }
+  if (options.particles_aov) names.push_back("particle.id");
+  if (options.normal_aov) {
+    names.insert(names.end(), std::begin(kNormalChannels), std::end(kNormalChannels));
+  }
+  if (options.reflection_aov) {
+    names.insert(names.end(), std::begin(kReflectionChannels), std::end(kReflectionChannels));
+  }
+  if (options.foam_aov) names.push_back("foam.Y");
+  std::sort(names.begin(), names.end());
+  expected.software_version = version_string();
+  return expected;
+}
+
+// With --resume: which frames of the range to render (false: complete, left untouched). A
+// complete frame of another capture is an error naming it, unless --force.
+Status frames_to_render(const CaptureOptions& options, std::vector<bool>* render) {
+  render->assign(options.end_frame - options.first_frame, true);
+  if (!options.resume) return Status::success();
+  const FrameExpectation expected = frame_expectation(options);
+  for (uint32_t frame = options.first_frame; frame < options.end_frame; ++frame) {
+    const FrameCheck check = check_frame(options.out_dir, frame, expected, "this capture");
+    if (check.state == FrameState::kMismatch && !options.force) {
+      return Status::error(options.out_dir + "/" + frame_file_name(frame) + " " + check.problem +
+                           "; nothing was overwritten (--force re-renders such frames)");
+    }
+    (*render)[frame - options.first_frame] = check.state != FrameState::kComplete;
+  }
+  return Status::success();
+}
 
 // Window depth (0 near .. 1 far, glm::perspectiveRH_ZO) to distance along the view axis.
 float linear_depth(float window_depth, float near_plane, float far_plane) {
@@ -215,6 +278,8 @@ class Capture {
   }
 
   Status run();
+  // After run(): the frames it wrote (the range, less the complete frames a resume kept).
+  uint32_t frames_written() const { return frames_to_write_; }
 
  private:
   uint32_t readback_images() const;
@@ -234,6 +299,7 @@ class Capture {
   Renderer* renderer_ = nullptr;  // the last river's: it reads the frame back
   Status write_particles_csv(const std::string& path) const;
 
+  uint32_t frames_to_write_ = 0;  // the range, less the complete frames a resume keeps
   FinishedFrame finished_;
   std::vector<float> rgba_;
   std::vector<float> depth_;
@@ -250,6 +316,10 @@ Status Capture::run() {
     return Status::error("--aov flow, particles, normal, reflection and foam are of one river; the scene has " +
                          std::to_string(river_count) + " (depth works with any number)");
   }
+  std::vector<bool> render;  // per frame of the range
+  SIVIFLOW_TRY(frames_to_render(options_, &render));
+  frames_to_write_ = static_cast<uint32_t>(std::count(render.begin(), render.end(), true));
+  if (frames_to_write_ == 0) return Status::success();
   HeadlessContextOptions context_options;
   context_options.enable_validation = options_.validation;
   context_options.require_validation = options_.validation;
@@ -308,9 +378,16 @@ Status Capture::run() {
     }
   }
 
+  uint32_t rendered = 0;
   uint32_t written = 0;
   for (uint32_t frame = options_.first_frame; frame < options_.end_frame; ++frame) {
-    const uint32_t index = (frame - options_.first_frame) % kFramesInFlight;
+    const double time = static_cast<double>(frame) / options_.fps;
+    if (!render[frame - options_.first_frame]) {  // complete already: only its simulation
+      const View view = camera_view(world_->scene_camera(time), extent);
+      for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->simulate(view, time));
+      continue;
+    }
+    const uint32_t index = rendered++ % kFramesInFlight;
     SlotTargets& slot = slots[index];
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     SIVIFLOW_TRY(context_->begin_slot(index, &cmd));  // waits for this slot's previous frame
@@ -318,7 +395,6 @@ Status Capture::run() {
     // only then is the previous frame encoded and written, while the GPU renders.
     const bool have_finished = slot.pending;
     if (have_finished) copy_out(slot);
-    const double time = static_cast<double>(frame) / options_.fps;
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->begin_frame(index));
     slot.camera = world_->scene_camera(time);
     const View view = camera_view(slot.camera, extent);
@@ -338,8 +414,8 @@ Status Capture::run() {
     }
   }
   // Drain: the last frames, at most one per slot, in submission order.
-  const uint32_t count = options_.end_frame - options_.first_frame;
-  for (uint32_t i = count > kFramesInFlight ? count - kFramesInFlight : 0; i < count; ++i) {
+  for (uint32_t i = rendered > kFramesInFlight ? rendered - kFramesInFlight : 0; i < rendered;
+       ++i) {
     SlotTargets& slot = slots[i % kFramesInFlight];
     SIVIFLOW_TRY(context_->wait_slot(i % kFramesInFlight));
     copy_out(slot);
@@ -445,9 +521,7 @@ Status Capture::write_frame() {
       flow_[1][i] = flow.y;
       flow_[2][i] = flow.z;
     }
-    frame.channels.push_back({"flow.X", flow_[0].data()});
-    frame.channels.push_back({"flow.Y", flow_[1].data()});
-    frame.channels.push_back({"flow.Z", flow_[2].data()});
+    for (int c = 0; c < 3; ++c) frame.channels.push_back({kFlowChannels[c], flow_[c].data()});
     frame.channels.push_back({"water.mask", finished_.water_mask.data()});
   }
   if (options_.particles_aov) {
@@ -471,14 +545,8 @@ Status Capture::write_frame() {
       frame.channels.push_back({names[c], planes[c].data()});
     }
   };
-  if (options_.normal_aov) {
-    static const char* const kNames[3] = {"normal.X", "normal.Y", "normal.Z"};
-    add_planes(finished_.normal, normal_, kNames);
-  }
-  if (options_.reflection_aov) {
-    static const char* const kNames[3] = {"reflection.R", "reflection.G", "reflection.B"};
-    add_planes(finished_.reflection, reflection_, kNames);
-  }
+  if (options_.normal_aov) add_planes(finished_.normal, normal_, kNormalChannels);
+  if (options_.reflection_aov) add_planes(finished_.reflection, reflection_, kReflectionChannels);
   if (options_.foam_aov) frame.channels.push_back({"foam.Y", finished_.foam.data()});
   frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
   frame.metadata.frame = static_cast<int>(finished_.frame);
@@ -486,14 +554,13 @@ Status Capture::write_frame() {
   frame.metadata.seed = static_cast<int>(options_.seed);
   frame.metadata.software_version = version_string();
 
-  char name[32];
-  std::snprintf(name, sizeof(name), "frame_%05u", finished_.frame);
-  const std::string base = options_.out_dir + "/" + name;
-  SIVIFLOW_TRY(write_exr(base + ".exr", frame));
+  const std::string exr = options_.out_dir + "/" + frame_file_name(finished_.frame);
+  const std::string base = exr.substr(0, exr.size() - 4);
+  SIVIFLOW_TRY(write_exr(exr, frame));
   if (options_.particles_aov) {
     const Status csv = write_particles_csv(base + ".particles.csv");
     if (!csv.ok()) {
-      std::remove((base + ".exr").c_str());  // a frame is its EXR and its CSV, or nothing
+      std::remove(exr.c_str());  // a frame is its EXR and its CSV, or nothing
       return csv;
     }
   }
@@ -516,7 +583,7 @@ Status Capture::write_particles_csv(const std::string& path) const {
 }
 
 void Capture::report_progress(uint32_t done_count) {
-  const uint32_t total = options_.end_frame - options_.first_frame;
+  const uint32_t total = frames_to_write_;
   if (isatty(STDOUT_FILENO)) {
     constexpr int kBarWidth = 40;
     const int filled = static_cast<int>(kBarWidth * done_count / total);
@@ -555,8 +622,12 @@ int run_capture(int argc, char** argv) {
   Capture capture(options, std::move(scene));
   status = capture.run();
   if (!status.ok()) return cli::fail(kCommand, status.message());
-  std::printf("wrote frames %u..%u to %s/frame_NNNNN.exr%s\n", options.first_frame,
-              options.end_frame - 1, options.out_dir.c_str(), options.preview ? " (+ .png)" : "");
+  const uint32_t range = options.end_frame - options.first_frame;
+  std::printf("wrote %u of frames %u..%u to %s/frame_NNNNN.exr%s", capture.frames_written(),
+              options.first_frame, options.end_frame - 1, options.out_dir.c_str(),
+              options.preview ? " (+ .png)" : "");
+  if (options.resume) std::printf("; %u were complete", range - capture.frames_written());
+  std::printf("\n");
   return cli::kExitOk;
 }
 

@@ -37,34 +37,43 @@ std::optional<uint32_t> frame_of_file_name(const std::string& name) {
   return static_cast<uint32_t>(frame);
 }
 
-std::string channel_list(const ExrImage& image) {
+std::string joined(const std::vector<std::string>& names) {
   std::string list;
-  for (const auto& [name, plane] : image.channels) list += (list.empty() ? "" : ",") + name;
+  for (const std::string& name : names) list += (list.empty() ? "" : ",") + name;
   return list;
 }
 
-// How `image` differs from the reference frame's ("" when it does not), every difference.
-std::string disagreement(const ExrImage& image, const ExrImage& reference,
-                         const std::string& reference_file) {
+FrameExpectation expectation_of(const ExrImage& image) {
+  FrameExpectation expected;
+  expected.scene = image.metadata.scene;
+  expected.seed = image.metadata.seed;
+  expected.width = image.width;
+  expected.height = image.height;
+  for (const auto& [name, plane] : image.channels) expected.channels.push_back(name);
+  expected.software_version = image.metadata.software_version;
+  return expected;
+}
+
+// How `image` differs from `expected` ("" when it does not), every difference.
+std::string disagreement(const ExrImage& image, const FrameExpectation& expected,
+                         const std::string& expected_name) {
+  const FrameExpectation a = expectation_of(image);
+  const FrameExpectation& b = expected;
   std::vector<std::string> differences;
-  const ExrMetadata& a = image.metadata;
-  const ExrMetadata& b = reference.metadata;
   if (a.scene != b.scene) differences.push_back("scene '" + a.scene + "' ('" + b.scene + "')");
   if (a.seed != b.seed) differences.push_back(text_format("seed %d (%d)", a.seed, b.seed));
-  if (image.width != reference.width || image.height != reference.height) {
-    differences.push_back(text_format("size %dx%d (%dx%d)", image.width, image.height,
-                                      reference.width, reference.height));
+  if (a.width != b.width || a.height != b.height) {
+    differences.push_back(text_format("size %dx%d (%dx%d)", a.width, a.height, b.width, b.height));
   }
-  if (channel_list(image) != channel_list(reference)) {
-    differences.push_back("channels " + channel_list(image) + " (" + channel_list(reference) +
-                          ")");
+  if (a.channels != b.channels) {
+    differences.push_back("channels " + joined(a.channels) + " (" + joined(b.channels) + ")");
   }
   if (a.software_version != b.software_version) {
     differences.push_back("software version '" + a.software_version + "' ('" +
                           b.software_version + "')");
   }
   if (differences.empty()) return "";
-  std::string text = "differs from " + reference_file + " (in brackets):";
+  std::string text = "differs from " + expected_name + " (in brackets):";
   for (size_t i = 0; i < differences.size(); ++i) text += (i ? ", " : " ") + differences[i];
   return text;
 }
@@ -75,13 +84,29 @@ std::string reader_problem(const std::string& message, const std::string& path) 
   return message.rfind(lead, 0) == 0 ? message.substr(lead.size()) : message;
 }
 
+// Reads frame `frame` whole into `image`; a state other than kComplete says why it could not.
+FrameCheck read_frame(const std::string& dir, uint32_t frame, ExrImage* image) {
+  const std::string path = (fs::path(dir) / frame_file_name(frame)).string();
+  std::error_code error;
+  if (!fs::exists(path, error)) return {FrameState::kMissing, "missing"};
+  const Status read = read_exr(path, image);
+  if (!read.ok()) {
+    return {FrameState::kIncomplete,
+            "cannot be read whole: " + reader_problem(read.message(), path)};
+  }
+  if (image->metadata.frame != static_cast<int>(frame)) {
+    return {FrameState::kMismatch, text_format("holds frame %d", image->metadata.frame)};
+  }
+  return {FrameState::kComplete, ""};
+}
+
 Status check_frames(const std::string& dir, uint32_t first, uint32_t end,
                     FrameFolderReport* out) {
   std::error_code error;
   const fs::file_status status = fs::status(dir, error);
   if (!fs::exists(status)) return Status::error("'" + dir + "': no such folder");
   if (!fs::is_directory(status)) return Status::error("'" + dir + "': not a folder");
-  std::vector<uint32_t> present;
+  std::vector<uint32_t> present;  // only to find the range when none is given
   for (fs::directory_iterator it(dir, error), done; !error && it != done; it.increment(error)) {
     if (auto frame = frame_of_file_name(it->path().filename().string())) present.push_back(*frame);
   }
@@ -95,45 +120,43 @@ Status check_frames(const std::string& dir, uint32_t first, uint32_t end,
   FrameFolderReport report;
   report.first = first;
   report.end = end;
-  std::optional<ExrImage> reference;
+  std::optional<FrameExpectation> reference;
   for (uint32_t frame = first; frame < end; ++frame) {
     const std::string file = frame_file_name(frame);
-    const std::string path = (fs::path(dir) / file).string();
-    const auto bad = [&](std::string problem) {
-      report.problems.push_back({frame, file, std::move(problem)});
-    };
-    if (std::find(present.begin(), present.end(), frame) == present.end()) {
-      bad("missing");
-      continue;
-    }
     ExrImage image;
-    const Status read = read_exr(path, &image);
-    if (!read.ok()) {
-      bad("cannot be read whole: " + reader_problem(read.message(), path));
-      continue;
+    FrameCheck check = read_frame(dir, frame, &image);
+    if (check.state == FrameState::kComplete && reference) {
+      check.problem = disagreement(image, *reference, report.reference);
     }
-    if (image.metadata.frame != static_cast<int>(frame)) {
-      bad(text_format("holds frame %d", image.metadata.frame));
+    if (!check.problem.empty()) {
+      report.problems.push_back({frame, file, std::move(check.problem)});
       continue;
     }
     if (!reference) {
-      reference = std::move(image);
+      reference = expectation_of(image);
       report.reference = file;
-      ++report.complete;
-      continue;
     }
-    const std::string differs = disagreement(image, *reference, report.reference);
-    if (differs.empty()) {
-      ++report.complete;
-    } else {
-      bad(differs);
-    }
+    ++report.complete;
   }
   *out = std::move(report);
   return Status::success();
 }
 
 }  // namespace
+
+FrameCheck check_frame(const std::string& dir, uint32_t frame, const FrameExpectation& expected,
+                       const std::string& expected_name) {
+  try {
+    ExrImage image;
+    FrameCheck check = read_frame(dir, frame, &image);
+    if (check.state != FrameState::kComplete) return check;
+    std::string differs = disagreement(image, expected, expected_name);
+    if (differs.empty()) return check;
+    return {FrameState::kMismatch, std::move(differs)};
+  } catch (const std::exception& e) {
+    return {FrameState::kIncomplete, std::string("cannot be checked: ") + e.what()};
+  }
+}
 
 std::string frame_file_name(uint32_t frame) {
   char name[32];

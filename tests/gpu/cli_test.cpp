@@ -2,9 +2,11 @@
 // problem; a capture writes readable EXR frames (and PNG previews) validation-clean.
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -29,6 +31,11 @@ class CliTest : public ::testing::Test {
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find(needle), std::string::npos) << "expected '" << needle << "' in:\n" << r.output;
     EXPECT_TRUE(fs::is_empty(dir_)) << "a failed run left files behind";
+  }
+  // The same for a folder that holds files already.
+  void expect_error_only(const RunResult& r, const std::string& needle) {
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find(needle), std::string::npos) << "expected '" << needle << "' in:\n" << r.output;
   }
   fs::path dir_;
 };
@@ -319,6 +326,67 @@ TEST_F(CliTest, RangeShardsEqualTheFullRun) {
     EXPECT_FALSE(a.empty()) << name;
     EXPECT_EQ(a, read_file(shard / name)) << name;
   }
+}
+
+// --resume renders only what is missing or cannot be read whole, bit-identical to a full run,
+// and leaves complete frames untouched; a complete frame of another capture is refused, naming
+// it, with nothing overwritten, unless --force.
+TEST_F(CliTest, ResumeRendersOnlyMissingOrIncompleteFrames) {
+  const fs::path full = dir_ / "full";
+  const fs::path resumed = dir_ / "resumed";
+  fs::create_directories(full);
+  const std::string args = "capture --range 0:6 --size 64x36 --aov depth --out ";
+  ASSERT_EQ(run_siviflow(args + full.string()).exit_code, 0);
+  fs::copy(full, resumed);
+  fs::remove(resumed / "frame_00002.exr");
+  const std::string frame4 = read_file(resumed / "frame_00004.exr");
+  {  // cut short, as a killed copy leaves it
+    std::ofstream cut(resumed / "frame_00004.exr", std::ios::binary | std::ios::trunc);
+    cut << frame4.substr(0, frame4.size() / 2);
+  }
+  const auto old_time = fs::file_time_type::clock::now() - std::chrono::hours(24);
+  for (const char* kept : {"frame_00000.exr", "frame_00001.exr", "frame_00003.exr",
+                           "frame_00005.exr"}) {
+    fs::last_write_time(resumed / kept, old_time);
+  }
+
+  RunResult run = run_siviflow(args + resumed.string() + " --resume");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("wrote 2 of frames 0..5"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("4 were complete"), std::string::npos) << run.output;
+  for (int frame = 0; frame < 6; ++frame) {
+    const std::string name = "frame_0000" + std::to_string(frame) + ".exr";
+    EXPECT_EQ(read_file(full / name), read_file(resumed / name)) << name;
+    const bool kept = frame != 2 && frame != 4;
+    EXPECT_EQ(fs::last_write_time(resumed / name) == old_time, kept) << name;
+  }
+
+  // Another size, or other AOVs: refused at the first frame, nothing overwritten.
+  run = run_siviflow("capture --range 0:6 --size 64x32 --aov depth --resume --out " +
+                     resumed.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("frame_00000.exr differs from this capture (in brackets): size "
+                            "64x36 (64x32)"),
+            std::string::npos)
+      << run.output;
+  run = run_siviflow("capture --range 3:6 --size 64x36 --resume --out " + resumed.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("frame_00003.exr differs from this capture (in brackets): channels "
+                            "A,B,G,R,depth.Z (A,B,G,R)"),
+            std::string::npos)
+      << run.output;
+  for (const char* kept : {"frame_00000.exr", "frame_00003.exr"}) {
+    EXPECT_EQ(fs::last_write_time(resumed / kept), old_time) << kept;
+  }
+  expect_error_only(run_siviflow(args + resumed.string() + " --force"), "--force goes with --resume");
+
+  // --force re-renders them.
+  run = run_siviflow(args + resumed.string() + " --seed 5 --resume --force");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("wrote 6 of frames 0..5"), std::string::npos) << run.output;
+  ExrImage image;
+  ASSERT_TRUE(read_exr((resumed / "frame_00003.exr").string(), &image).ok());
+  EXPECT_EQ(image.metadata.seed, 5);
 }
 
 }  // namespace

@@ -14,6 +14,33 @@ namespace siviflow {
 // "frame_00042.exr".
 std::string frame_file_name(uint32_t frame);
 
+// What makes frames of one capture alike: what each of its frames must carry.
+struct FrameExpectation {
+  std::string scene;
+  int seed = 0;
+  int width = 0;
+  int height = 0;
+  std::vector<std::string> channels;  // sorted, as OpenEXR lists them
+  std::string software_version;
+};
+
+enum class FrameState {
+  kMissing,
+  kIncomplete,  // OpenEXR cannot read it whole: a killed or failed write, or damage
+  kMismatch,    // whole, but of another frame number or another capture
+  kComplete,
+};
+
+struct FrameCheck {
+  FrameState state = FrameState::kMissing;
+  std::string problem;  // for all but kComplete: "missing", "cannot be read whole: ...", ...
+};
+
+// Checks frame `frame` of `dir` against `expected`; `expected_name` names it in the problem
+// ("this capture", "frame_00000.exr").
+FrameCheck check_frame(const std::string& dir, uint32_t frame, const FrameExpectation& expected,
+                       const std::string& expected_name);
+
 struct FrameProblem {
   uint32_t frame = 0;
   std::string file;     // the frame's file name in the folder
