@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -300,6 +301,7 @@ class Capture {
   Status write_particles_csv(const std::string& path) const;
 
   uint32_t frames_to_write_ = 0;  // the range, less the complete frames a resume keeps
+  std::chrono::steady_clock::time_point started_;  // of the first rendered frame
   FinishedFrame finished_;
   std::vector<float> rgba_;
   std::vector<float> depth_;
@@ -380,6 +382,7 @@ Status Capture::run() {
 
   uint32_t rendered = 0;
   uint32_t written = 0;
+  started_ = std::chrono::steady_clock::now();
   for (uint32_t frame = options_.first_frame; frame < options_.end_frame; ++frame) {
     const double time = static_cast<double>(frame) / options_.fps;
     if (!render[frame - options_.first_frame]) {  // complete already: only its simulation
@@ -584,15 +587,27 @@ Status Capture::write_particles_csv(const std::string& path) const {
 
 void Capture::report_progress(uint32_t done_count) {
   const uint32_t total = frames_to_write_;
+  // Frames per second over the frames written so far, and the time the rest take at that pace.
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+  const double fps = seconds > 0.0 ? done_count / seconds : 0.0;
+  const double left = fps > 0.0 ? (total - done_count) / fps : 0.0;
+  const long whole = std::lround(left);
+  const std::string time_left =
+      whole >= 3600 ? text_format("%ld h %02ld min", whole / 3600, whole / 60 % 60)
+      : whole >= 60 ? text_format("%ld min %02ld s", whole / 60, whole % 60)
+                    : text_format("%ld s", whole);
   if (isatty(STDOUT_FILENO)) {
     constexpr int kBarWidth = 40;
     const int filled = static_cast<int>(kBarWidth * done_count / total);
-    std::printf("\r[%s%s] %u/%u", std::string(filled, '#').c_str(),
-                std::string(kBarWidth - filled, ' ').c_str(), done_count, total);
+    std::printf("\r[%s%s] %u/%u %.2f frames/s, %s left   ", std::string(filled, '#').c_str(),
+                std::string(kBarWidth - filled, ' ').c_str(), done_count, total, fps,
+                time_left.c_str());
     if (done_count == total) std::printf("\n");
     std::fflush(stdout);
   } else if (done_count % 10 == 0 || done_count == total) {
-    std::printf("captured %u/%u frames\n", done_count, total);
+    std::printf("captured %u/%u frames, %.2f frames/s, %s left\n", done_count, total, fps,
+                time_left.c_str());
   }
 }
 

@@ -27,11 +27,12 @@ namespace {
 constexpr int64_t kMaxReadPixels = int64_t{1} << 28;
 constexpr int64_t kMaxReadSamples = int64_t{1} << 30;
 // The most float-plane bytes one byte of a file can expand to. Deflate (zip, zips, pxr24) gives
-// at most 1032:1, and a half widens to a float: 4096 bounds every lossless codec with room to
-// spare; DWA keeps one DC value per 8x8 block before deflate, so it gets 64 times that. A header
-// asking for more than this (beyond a free 64 MiB) describes a file that cannot exist.
-constexpr int64_t kMaxLosslessExpansion = 4096;
-constexpr int64_t kMaxDwaExpansion = kMaxLosslessExpansion * 64;
+// at most 1032:1, and a half widens to a float: 4096 bounds every codec but DWA with room to
+// spare (a constant 8192x8192 image: zip 1786, piz 790, rle 120); DWA keeps one DC value per 8x8
+// block before deflate, so it gets 64 times that (dwab 21752). A header asking for more than
+// this (beyond a free 64 MiB) describes a file that cannot exist.
+constexpr int64_t kMaxExpansion = 4096;
+constexpr int64_t kMaxDwaExpansion = kMaxExpansion * 64;
 constexpr int64_t kFreeReadBytes = int64_t{64} << 20;
 
 const char* compression_name(Imf::Compression compression) {
@@ -127,9 +128,9 @@ Status check_attribute_sizes(const std::string& path, const std::string& what, i
 Status check_plausible_size(const std::string& what, int64_t file_bytes, int64_t samples,
                             Imf::Compression compression) {
   const bool dwa = compression == Imf::DWAA_COMPRESSION || compression == Imf::DWAB_COMPRESSION;
-  const int64_t expansion = dwa ? kMaxDwaExpansion : kMaxLosslessExpansion;
+  const int64_t expansion = dwa ? kMaxDwaExpansion : kMaxExpansion;
   const int64_t plane_bytes = samples * int64_t{sizeof(float)};
-  if (plane_bytes <= kFreeReadBytes + file_bytes * expansion) return Status::success();
+  if ((plane_bytes - kFreeReadBytes) / expansion <= file_bytes) return Status::success();
   return Status::error(what + text_format(": the header asks for %lld MiB of pixels, more than "
                                           "a %lld-byte %s file can hold (corrupt or truncated)",
                                           static_cast<long long>(plane_bytes >> 20),

@@ -1,5 +1,4 @@
-// The EXR reader: every channel of the file read back as floats; then, for a file it accepted,
-// OpenEXR's own deep check as the tests run it on captured frames.
+// The EXR reader: the header checks, then every channel of the file read back as floats.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -11,6 +10,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static siviflow::fuzzing::FuzzInputFile input("input.exr");
   const std::string& path = input.write(data, size);
   siviflow::ExrImage image;
-  if (siviflow::read_exr(path, &image).ok()) (void)siviflow::check_exr_file(path);
+  (void)siviflow::read_exr(path, &image);
   return 0;
 }

@@ -1,8 +1,9 @@
-// The scene file: the JSON text checked field by field; relative paths resolve against an empty
-// folder (the scene loader does not open the glTF files it names).
+// The scene file: the JSON text checked field by field; relative paths are only joined to the
+// temporary folder as text (the scene loader does not open the glTF files it names).
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 #include "siviflow/scene_file.h"

@@ -35,7 +35,8 @@ class CliTest : public ::testing::Test {
   // The same for a folder that holds files already.
   void expect_error_only(const RunResult& r, const std::string& needle) {
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find(needle), std::string::npos) << "expected '" << needle << "' in:\n" << r.output;
+    EXPECT_NE(r.output.find(needle), std::string::npos)
+        << "expected '" << needle << "' in:\n" << r.output;
   }
   fs::path dir_;
 };
@@ -354,6 +355,8 @@ TEST_F(CliTest, ResumeRendersOnlyMissingOrIncompleteFrames) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("wrote 2 of frames 0..5"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("4 were complete"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("captured 2/2 frames, "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find(" frames/s, 0 s left"), std::string::npos) << run.output;
   for (int frame = 0; frame < 6; ++frame) {
     const std::string name = "frame_0000" + std::to_string(frame) + ".exr";
     EXPECT_EQ(read_file(full / name), read_file(resumed / name)) << name;
@@ -378,7 +381,8 @@ TEST_F(CliTest, ResumeRendersOnlyMissingOrIncompleteFrames) {
   for (const char* kept : {"frame_00000.exr", "frame_00003.exr"}) {
     EXPECT_EQ(fs::last_write_time(resumed / kept), old_time) << kept;
   }
-  expect_error_only(run_siviflow(args + resumed.string() + " --force"), "--force goes with --resume");
+  expect_error_only(run_siviflow(args + resumed.string() + " --force"),
+                    "--force goes with --resume");
 
   // --force re-renders them.
   run = run_siviflow(args + resumed.string() + " --seed 5 --resume --force");

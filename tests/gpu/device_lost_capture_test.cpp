@@ -32,15 +32,17 @@ std::string frame_name(int frame) {
 int capture_losing_device(const std::string& kind, int at) {
   const fs::path dir = fresh_test_dir("device_lost") / (kind + std::to_string(at));
   fs::create_directories(dir);
-  // The validation layer (from the system's folder) above ours: what the tool does after the loss
-  // is validated too.
+  // The validation layer (from the system's folder) sits below ours, between it and the driver:
+  // it checks every call that reaches the real device, before and after the loss. (Above ours it
+  // would take the device for lost while it is idle, and 1.3.239 then reports the host's
+  // destruction of objects the lost device was using.)
   const std::string env = "VK_LAYER_PATH=/usr/share/vulkan/explicit_layer.d:"
                           SIVIFLOW_LOSE_DEVICE_LAYER_DIR
                           " VK_INSTANCE_LAYERS=VK_LAYER_SIVIFLOW_lose_device"
                           " SIVIFLOW_TEST_LOSE_DEVICE=" + kind + ":" + std::to_string(at);
   const RunResult run = run_siviflow(
-      "capture --range 0:" + std::to_string(kFrames) + " --size 64x36 --aov depth --validation --out " +
-          dir.string(),
+      "capture --range 0:" + std::to_string(kFrames) +
+          " --size 64x36 --aov depth --validation --out " + dir.string(),
       env);
   const std::string where = kind + ":" + std::to_string(at) + "\n" + run.output;
   EXPECT_EQ(run.exit_code, 1) << where;
