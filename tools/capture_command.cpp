@@ -8,24 +8,20 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
 
-#include <glm/gtc/packing.hpp>
-
+#include "capture_options.h"
 #include "cli.h"
 #include "commands.h"
-#include "shaders/shared.h"
-#include "siviflow/atomic_file.h"
+#include "frame_writer.h"
 #include "siviflow/frame_folder.h"
 #include "siviflow/headless_context.h"
 #include "renderer_inspect.h"
 #include "siviflow/host_frame.h"
-#include "siviflow/image_files.h"
 #include "sim/text_format.h"
 #include "siviflow/renderer.h"
 #include "siviflow/scene_file.h"
@@ -44,28 +40,6 @@ constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr uint64_t kHostBytesPerPixel = 8 + 4;
 constexpr uint64_t kMaxCaptureBytes = 2ull << 30;
 
-struct CaptureOptions {
-  std::string scene_path;  // empty: the built-in default scene
-  bool size_given = false;  // flags win over the scene file's render settings
-  bool fps_given = false;
-  bool seed_given = false;
-  uint32_t first_frame = 0;
-  uint32_t end_frame = 1;
-  cli::Size size{1280, 720};
-  std::string out_dir;
-  uint32_t seed = 1;
-  float fps = 30.0f;
-  bool preview = false;
-  bool validation = false;
-  bool resume = false;  // render only the frames of the range not already complete
-  bool force = false;   // with resume: re-render frames of another capture instead of refusing
-  bool depth_aov = false;
-  bool flow_aov = false;       // flow.X/Y/Z and water.mask
-  bool particles_aov = false;  // particle.id and frame_NNNNN.particles.csv
-  bool normal_aov = false;     // normal.X/Y/Z
-  bool reflection_aov = false; // reflection.R/G/B
-  bool foam_aov = false;       // foam.Y
-};
 
 void print_help() {
   std::printf(
@@ -188,10 +162,6 @@ Status check_output_dir(const std::string& dir) {
 
 constexpr uint32_t index_of(ReadbackImage image) { return static_cast<uint32_t>(image); }
 
-// The EXR channels of the AOVs made of three planes.
-constexpr const char* kFlowChannels[3] = {"flow.X", "flow.Y", "flow.Z"};
-constexpr const char* kNormalChannels[3] = {"normal.X", "normal.Y", "normal.Z"};
-constexpr const char* kReflectionChannels[3] = {"reflection.R", "reflection.G", "reflection.B"};
 
 // What every frame of this capture carries: what a resumed capture trusts a frame by.
 FrameExpectation frame_expectation(const CaptureOptions& options) {
@@ -237,13 +207,6 @@ Status frames_to_render(const CaptureOptions& options, std::vector<bool>* render
   return Status::success();
 }
 
-// Window depth (0 near .. 1 far, glm::perspectiveRH_ZO) to distance along the view axis.
-float linear_depth(float window_depth, float near_plane, float far_plane) {
-  if (window_depth >= 1.0f) return std::numeric_limits<float>::infinity();
-  const float a = far_plane / (near_plane - far_plane);
-  const float b = far_plane * near_plane / (near_plane - far_plane);
-  return b / (window_depth + a);
-}
 
 struct SlotTargets {
   HostTargets targets;
@@ -254,20 +217,6 @@ struct SlotTargets {
   std::vector<Particle> particles;  // as simulated for this frame
 };
 
-// A finished frame copied out of its readback buffers, so that the buffers can take the next
-// frame while this one is encoded and written.
-struct FinishedFrame {
-  uint32_t frame = 0;
-  Camera camera;
-  std::vector<uint16_t> color_halves;
-  std::vector<float> window_depth;
-  std::vector<float> water_mask;
-  std::vector<std::byte> flow_texture;  // as uploaded: shaders/shared.h FlowTexel per texel
-  std::vector<float> normal;            // RGBA per pixel
-  std::vector<float> reflection;        // RGBA per pixel
-  std::vector<float> foam;
-  std::vector<Particle> particles;
-};
 
 class Capture {
  public:
@@ -287,8 +236,7 @@ class Capture {
   // Refuses, before anything is allocated, a size and AOV set over the memory budget, with the
   // figure it would need.
   Status check_memory_budget(CreateInfo info, size_t river_count) const;
-  void copy_out(const SlotTargets& slot);
-  Status write_frame();
+  FinishedFrame copy_out(const SlotTargets& slot) const;
   void report_progress(uint32_t done_count);
 
   CaptureOptions options_;
@@ -302,13 +250,6 @@ class Capture {
 
   uint32_t frames_to_write_ = 0;  // the range, less the complete frames a resume keeps
   std::chrono::steady_clock::time_point started_;  // of the first rendered frame
-  FinishedFrame finished_;
-  std::vector<float> rgba_;
-  std::vector<float> depth_;
-  std::vector<float> flow_[3];
-  std::vector<float> particle_id_;
-  std::vector<float> normal_[3];
-  std::vector<float> reflection_[3];
 };
 
 Status Capture::run() {
@@ -381,8 +322,9 @@ Status Capture::run() {
   }
 
   uint32_t rendered = 0;
-  uint32_t written = 0;
   started_ = std::chrono::steady_clock::now();
+  FrameWriter writer(options_, flow_texture_layout(*renderer_),
+                     [this](uint32_t written) { report_progress(written); });
   for (uint32_t frame = options_.first_frame; frame < options_.end_frame; ++frame) {
     const double time = static_cast<double>(frame) / options_.fps;
     if (!render[frame - options_.first_frame]) {  // complete already: only its simulation
@@ -397,7 +339,8 @@ Status Capture::run() {
     // Pipelined readback: the slot's previous frame is copied out, this frame is submitted, and
     // only then is the previous frame encoded and written, while the GPU renders.
     const bool have_finished = slot.pending;
-    if (have_finished) copy_out(slot);
+    FinishedFrame finished;
+    if (have_finished) finished = copy_out(slot);
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->begin_frame(index));
     slot.camera = world_->scene_camera(time);
     const View view = camera_view(slot.camera, extent);
@@ -411,21 +354,17 @@ Status Capture::run() {
     SIVIFLOW_TRY(context_->end_slot_and_submit(index));
     slot.pending = true;
     slot.frame = frame;
-    if (have_finished) {
-      SIVIFLOW_TRY(write_frame());
-      report_progress(++written);
-    }
+    if (have_finished) SIVIFLOW_TRY(writer.push(std::move(finished)));
   }
   // Drain: the last frames, at most one per slot, in submission order.
   for (uint32_t i = rendered > kFramesInFlight ? rendered - kFramesInFlight : 0; i < rendered;
        ++i) {
     SlotTargets& slot = slots[i % kFramesInFlight];
     SIVIFLOW_TRY(context_->wait_slot(i % kFramesInFlight));
-    copy_out(slot);
+    SIVIFLOW_TRY(writer.push(copy_out(slot)));
     slot.pending = false;
-    SIVIFLOW_TRY(write_frame());
-    report_progress(++written);
   }
+  SIVIFLOW_TRY(writer.finish());
   if (context_->report().validation_enabled && context_->validation_error_count() > 0) {
     return Status::error(std::to_string(context_->validation_error_count()) +
                          " Vulkan validation error(s); the first: " +
@@ -465,10 +404,11 @@ uint32_t Capture::readback_images() const {
   return images;
 }
 
-void Capture::copy_out(const SlotTargets& slot) {
+FinishedFrame Capture::copy_out(const SlotTargets& slot) const {
   const size_t pixels = size_t{options_.size.width} * options_.size.height;
-  finished_.frame = slot.frame;
-  finished_.camera = slot.camera;
+  FinishedFrame finished;
+  finished.frame = slot.frame;
+  finished.camera = slot.camera;
   // Each read-back image's bytes; the images not read back are left empty.
   const auto copy = [&slot](ReadbackImage kind, size_t count, auto* out) {
     using T = typename std::remove_reference_t<decltype(*out)>::value_type;
@@ -476,114 +416,19 @@ void Capture::copy_out(const SlotTargets& slot) {
     if (data == nullptr) return;
     out->assign(data, data + count);
   };
-  copy(ReadbackImage::kColor, pixels * 4, &finished_.color_halves);
-  copy(ReadbackImage::kDepth, pixels, &finished_.window_depth);
-  copy(ReadbackImage::kWaterMask, pixels, &finished_.water_mask);
+  copy(ReadbackImage::kColor, pixels * 4, &finished.color_halves);
+  copy(ReadbackImage::kDepth, pixels, &finished.window_depth);
+  copy(ReadbackImage::kWaterMask, pixels, &finished.water_mask);
   copy(ReadbackImage::kFlowTexture, renderer_->readback_bytes(ReadbackImage::kFlowTexture),
-       &finished_.flow_texture);
-  copy(ReadbackImage::kNormal, pixels * 4, &finished_.normal);
-  copy(ReadbackImage::kReflection, pixels * 4, &finished_.reflection);
-  copy(ReadbackImage::kFoam, pixels, &finished_.foam);
-  finished_.particles = slot.particles;
+       &finished.flow_texture);
+  copy(ReadbackImage::kNormal, pixels * 4, &finished.normal);
+  copy(ReadbackImage::kReflection, pixels * 4, &finished.reflection);
+  copy(ReadbackImage::kFoam, pixels, &finished.foam);
+  finished.particles = slot.particles;
+  return finished;
 }
 
-Status Capture::write_frame() {
-  const uint32_t width = options_.size.width;
-  const uint32_t height = options_.size.height;
-  const size_t pixels = size_t{width} * height;
-  rgba_.resize(pixels * 4);
-  for (size_t i = 0; i < pixels * 4; ++i) rgba_[i] = glm::unpackHalf1x16(finished_.color_halves[i]);
 
-  ExrFrame frame;
-  frame.width = static_cast<int>(width);
-  frame.height = static_cast<int>(height);
-  frame.rgba = rgba_.data();
-  if (options_.depth_aov) {
-    depth_.resize(pixels);
-    const Camera& camera = finished_.camera;
-    for (size_t i = 0; i < pixels; ++i) {
-      depth_[i] = linear_depth(finished_.window_depth[i], camera.near_plane, camera.far_plane);
-    }
-    frame.channels.push_back({"depth.Z", depth_.data()});
-  }
-  const FlowTextureLayout& layout = flow_texture_layout(*renderer_);
-  const auto texel_at = [&](size_t pixel) {
-    const uint32_t x = static_cast<uint32_t>(pixel % width) / layout.texel_px;
-    const uint32_t y = static_cast<uint32_t>(pixel / width) / layout.texel_px;
-    gpu::FlowTexel texel{};
-    std::memcpy(&texel, finished_.flow_texture.data() + (size_t{y} * layout.flow_extent.x + x) * sizeof(texel),
-                sizeof(texel));
-    return texel;
-  };
-  if (options_.flow_aov) {
-    for (std::vector<float>& plane : flow_) plane.resize(pixels);
-    for (size_t i = 0; i < pixels; ++i) {
-      const gpu::FlowTexel texel = texel_at(i);
-      const glm::vec3 flow = texel.id == SIVIFLOW_PARTICLE_NONE ? glm::vec3(0.0f) : decode_flow(texel);
-      flow_[0][i] = flow.x;
-      flow_[1][i] = flow.y;
-      flow_[2][i] = flow.z;
-    }
-    for (int c = 0; c < 3; ++c) frame.channels.push_back({kFlowChannels[c], flow_[c].data()});
-    frame.channels.push_back({"water.mask", finished_.water_mask.data()});
-  }
-  if (options_.particles_aov) {
-    // The flow texture holds GPU slots; the layer and the CSV use the ids unique over the run.
-    std::vector<float> id_of_slot(size_t{layout.slot_count} + 1, -1.0f);
-    for (const Particle& particle : finished_.particles) id_of_slot[particle.slot] = static_cast<float>(particle.id);
-    particle_id_.resize(pixels);
-    for (size_t i = 0; i < pixels; ++i) {
-      const gpu::FlowTexel texel = texel_at(i);
-      const bool on_water = finished_.water_mask[i] > 0.5f;
-      particle_id_[i] = on_water && texel.id <= layout.slot_count ? id_of_slot[texel.id] : -1.0f;
-    }
-    frame.channels.push_back({"particle.id", particle_id_.data()});
-  }
-  // RGBA planes of the read-back AOV images, split into the EXR's named channels.
-  const auto add_planes = [&](const std::vector<float>& rgba, std::vector<float>* planes,
-                              const char* const names[3]) {
-    for (int c = 0; c < 3; ++c) {
-      planes[c].resize(pixels);
-      for (size_t i = 0; i < pixels; ++i) planes[c][i] = rgba[i * 4 + c];
-      frame.channels.push_back({names[c], planes[c].data()});
-    }
-  };
-  if (options_.normal_aov) add_planes(finished_.normal, normal_, kNormalChannels);
-  if (options_.reflection_aov) add_planes(finished_.reflection, reflection_, kReflectionChannels);
-  if (options_.foam_aov) frame.channels.push_back({"foam.Y", finished_.foam.data()});
-  frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
-  frame.metadata.frame = static_cast<int>(finished_.frame);
-  frame.metadata.time_seconds = static_cast<float>(finished_.frame / options_.fps);
-  frame.metadata.seed = static_cast<int>(options_.seed);
-  frame.metadata.software_version = version_string();
-
-  const std::string exr = options_.out_dir + "/" + frame_file_name(finished_.frame);
-  const std::string base = exr.substr(0, exr.size() - 4);
-  SIVIFLOW_TRY(write_exr(exr, frame));
-  if (options_.particles_aov) {
-    const Status csv = write_particles_csv(base + ".particles.csv");
-    if (!csv.ok()) {
-      std::remove(exr.c_str());  // a frame is its EXR and its CSV, or nothing
-      return csv;
-    }
-  }
-  if (options_.preview) {
-    SIVIFLOW_TRY(write_png(base + ".png", frame.width, frame.height, rgba_.data(), PngChannels::kRgb));
-  }
-  return Status::success();
-}
-
-Status Capture::write_particles_csv(const std::string& path) const {
-  std::string csv = "id,state,sx,sy,wx,wy,wz,fx,fy,fz,speed,depth,slope,fade\n";
-  char row[512];
-  for (const Particle& p : finished_.particles) {
-    std::snprintf(row, sizeof(row), "%u,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
-                  p.id, to_string(p.state), p.screen.x, p.screen.y, p.world.x, p.world.y, p.world.z,
-                  p.flow.x, p.flow.y, p.flow.z, p.speed, p.depth, p.slope, p.fade);
-    csv += row;
-  }
-  return write_file_atomically(path, csv.data(), csv.size());
-}
 
 void Capture::report_progress(uint32_t done_count) {
   const uint32_t total = frames_to_write_;

@@ -74,6 +74,16 @@ TEST_F(CliTest, BadOutputFolder) {
   expect_error(run_siviflow("capture --out " + file.string()), "is not a folder");
 }
 
+// A frame the writer thread cannot write (the file-size limit here, a full disk on a farm)
+// stops the capture with exit 1 naming the file; no frame and no temporary is left.
+TEST_F(CliTest, FailedFrameWriteStopsTheCapture) {
+  const RunResult r = run_siviflow(
+      "capture --frames 8 --size 160x90 --out " + dir_.string(),
+      "ulimit -f 8; trap '' XFSZ;");  // 8 KiB per file: EFBIG instead of the signal
+  expect_error(r, (dir_ / "frame_00000.exr").string());
+  EXPECT_NE(r.output.find("File too large"), std::string::npos) << r.output;
+}
+
 TEST_F(CliTest, UnwritableOutputFolder) {
   // As root every folder is writable, so when the tests run as root the tool runs as nobody.
   const bool root = geteuid() == 0;

@@ -1,0 +1,40 @@
+// What `siviflow capture` was asked for: shared by the capture loop and the frame writer.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "cli.h"
+
+namespace siviflow {
+
+struct CaptureOptions {
+  std::string scene_path;  // empty: the built-in default scene
+  bool size_given = false;  // flags win over the scene file's render settings
+  bool fps_given = false;
+  bool seed_given = false;
+  uint32_t first_frame = 0;
+  uint32_t end_frame = 1;
+  cli::Size size{1280, 720};
+  std::string out_dir;
+  uint32_t seed = 1;
+  float fps = 30.0f;
+  bool preview = false;
+  bool validation = false;
+  bool resume = false;  // render only the frames of the range not already complete
+  bool force = false;   // with resume: re-render frames of another capture instead of refusing
+  bool depth_aov = false;
+  bool flow_aov = false;       // flow.X/Y/Z and water.mask
+  bool particles_aov = false;  // particle.id and frame_NNNNN.particles.csv
+  bool normal_aov = false;     // normal.X/Y/Z
+  bool reflection_aov = false; // reflection.R/G/B
+  bool foam_aov = false;       // foam.Y
+};
+
+// The EXR channels of the AOVs made of three planes.
+inline constexpr const char* kFlowChannels[3] = {"flow.X", "flow.Y", "flow.Z"};
+inline constexpr const char* kNormalChannels[3] = {"normal.X", "normal.Y", "normal.Z"};
+inline constexpr const char* kReflectionChannels[3] = {"reflection.R", "reflection.G",
+                                                       "reflection.B"};
+
+}  // namespace siviflow

@@ -1,0 +1,183 @@
+#include "frame_writer.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include <glm/gtc/packing.hpp>
+
+#include "renderer_inspect.h"
+#include "shaders/shared.h"
+#include "siviflow/atomic_file.h"
+#include "siviflow/frame_folder.h"
+#include "siviflow/image_files.h"
+
+namespace siviflow {
+namespace {
+
+// Window depth (0 near .. 1 far, glm::perspectiveRH_ZO) to distance along the view axis.
+float linear_depth(float window_depth, float near_plane, float far_plane) {
+  if (window_depth >= 1.0f) return std::numeric_limits<float>::infinity();
+  const float a = far_plane / (near_plane - far_plane);
+  const float b = far_plane * near_plane / (near_plane - far_plane);
+  return b / (window_depth + a);
+}
+
+}  // namespace
+
+FrameWriter::FrameWriter(const CaptureOptions& options, const FlowTextureLayout& layout,
+                         std::function<void(uint32_t)> on_written)
+    : options_(options), layout_(layout), on_written_(std::move(on_written)),
+      thread_([this] { loop(); }) {}
+
+FrameWriter::~FrameWriter() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  changed_.notify_all();
+  thread_.join();
+}
+
+Status FrameWriter::push(FinishedFrame frame) {
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [this] { return !failure_.ok() || queue_.size() < kQueueDepth; });
+  if (!failure_.ok()) return failure_;
+  queue_.push_back(std::move(frame));
+  changed_.notify_all();
+  return Status::success();
+}
+
+Status FrameWriter::finish() {
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [this] { return !failure_.ok() || (queue_.empty() && !writing_); });
+  return failure_;
+}
+
+void FrameWriter::loop() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    changed_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+    if (queue_.empty() || !failure_.ok()) return;  // stopped, or nothing more is written
+    FinishedFrame frame = std::move(queue_.front());
+    queue_.pop_front();
+    writing_ = true;
+    lock.unlock();
+    Status status;
+    try {
+      status = write(frame);
+    } catch (const std::exception& e) {  // std::bad_alloc from a plane: the frame is not written
+      status = Status::error(std::string("cannot write frame: ") + e.what());
+    }
+    if (status.ok() && on_written_) on_written_(++written_);
+    lock.lock();
+    writing_ = false;
+    if (!status.ok()) failure_ = std::move(status);
+    changed_.notify_all();
+  }
+}
+
+Status FrameWriter::write(const FinishedFrame& finished_) {
+  const uint32_t width = options_.size.width;
+  const uint32_t height = options_.size.height;
+  const size_t pixels = size_t{width} * height;
+  rgba_.resize(pixels * 4);
+  for (size_t i = 0; i < pixels * 4; ++i) rgba_[i] = glm::unpackHalf1x16(finished_.color_halves[i]);
+
+  ExrFrame frame;
+  frame.width = static_cast<int>(width);
+  frame.height = static_cast<int>(height);
+  frame.rgba = rgba_.data();
+  if (options_.depth_aov) {
+    depth_.resize(pixels);
+    const Camera& camera = finished_.camera;
+    for (size_t i = 0; i < pixels; ++i) {
+      depth_[i] = linear_depth(finished_.window_depth[i], camera.near_plane, camera.far_plane);
+    }
+    frame.channels.push_back({"depth.Z", depth_.data()});
+  }
+  const FlowTextureLayout& layout = layout_;
+  const auto texel_at = [&](size_t pixel) {
+    const uint32_t x = static_cast<uint32_t>(pixel % width) / layout.texel_px;
+    const uint32_t y = static_cast<uint32_t>(pixel / width) / layout.texel_px;
+    gpu::FlowTexel texel{};
+    std::memcpy(&texel, finished_.flow_texture.data() + (size_t{y} * layout.flow_extent.x + x) * sizeof(texel),
+                sizeof(texel));
+    return texel;
+  };
+  if (options_.flow_aov) {
+    for (std::vector<float>& plane : flow_) plane.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      const gpu::FlowTexel texel = texel_at(i);
+      const glm::vec3 flow = texel.id == SIVIFLOW_PARTICLE_NONE ? glm::vec3(0.0f) : decode_flow(texel);
+      flow_[0][i] = flow.x;
+      flow_[1][i] = flow.y;
+      flow_[2][i] = flow.z;
+    }
+    for (int c = 0; c < 3; ++c) frame.channels.push_back({kFlowChannels[c], flow_[c].data()});
+    frame.channels.push_back({"water.mask", finished_.water_mask.data()});
+  }
+  if (options_.particles_aov) {
+    // The flow texture holds GPU slots; the layer and the CSV use the ids unique over the run.
+    std::vector<float> id_of_slot(size_t{layout.slot_count} + 1, -1.0f);
+    for (const Particle& particle : finished_.particles) id_of_slot[particle.slot] = static_cast<float>(particle.id);
+    particle_id_.resize(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+      const gpu::FlowTexel texel = texel_at(i);
+      const bool on_water = finished_.water_mask[i] > 0.5f;
+      particle_id_[i] = on_water && texel.id <= layout.slot_count ? id_of_slot[texel.id] : -1.0f;
+    }
+    frame.channels.push_back({"particle.id", particle_id_.data()});
+  }
+  // RGBA planes of the read-back AOV images, split into the EXR's named channels.
+  const auto add_planes = [&](const std::vector<float>& rgba, std::vector<float>* planes,
+                              const char* const names[3]) {
+    for (int c = 0; c < 3; ++c) {
+      planes[c].resize(pixels);
+      for (size_t i = 0; i < pixels; ++i) planes[c][i] = rgba[i * 4 + c];
+      frame.channels.push_back({names[c], planes[c].data()});
+    }
+  };
+  if (options_.normal_aov) add_planes(finished_.normal, normal_, kNormalChannels);
+  if (options_.reflection_aov) add_planes(finished_.reflection, reflection_, kReflectionChannels);
+  if (options_.foam_aov) frame.channels.push_back({"foam.Y", finished_.foam.data()});
+  frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
+  frame.metadata.frame = static_cast<int>(finished_.frame);
+  frame.metadata.time_seconds = static_cast<float>(finished_.frame / options_.fps);
+  frame.metadata.seed = static_cast<int>(options_.seed);
+  frame.metadata.software_version = version_string();
+
+  const std::string exr = options_.out_dir + "/" + frame_file_name(finished_.frame);
+  const std::string base = exr.substr(0, exr.size() - 4);
+  SIVIFLOW_TRY(write_exr(exr, frame));
+  if (options_.particles_aov) {
+    const Status csv = write_particles_csv(finished_, base + ".particles.csv");
+    if (!csv.ok()) {
+      std::remove(exr.c_str());  // a frame is its EXR and its CSV, or nothing
+      return csv;
+    }
+  }
+  if (options_.preview) {
+    SIVIFLOW_TRY(write_png(base + ".png", frame.width, frame.height, rgba_.data(), PngChannels::kRgb));
+  }
+  return Status::success();
+}
+
+Status FrameWriter::write_particles_csv(const FinishedFrame& finished_,
+                                        const std::string& path) const {
+  std::string csv = "id,state,sx,sy,wx,wy,wz,fx,fy,fz,speed,depth,slope,fade\n";
+  char row[512];
+  for (const Particle& p : finished_.particles) {
+    std::snprintf(row, sizeof(row), "%u,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
+                  p.id, to_string(p.state), p.screen.x, p.screen.y, p.world.x, p.world.y, p.world.z,
+                  p.flow.x, p.flow.y, p.flow.z, p.speed, p.depth, p.slope, p.fade);
+    csv += row;
+  }
+  return write_file_atomically(path, csv.data(), csv.size());
+}
+
+}  // namespace siviflow
