@@ -17,12 +17,10 @@ struct RunResult {
   std::string output;  // stdout and stderr
 };
 
-// `env` is prepended as shell assignments, e.g. "VK_DRIVER_FILES=/x.json".
-inline RunResult run_siviflow(const std::string& args, const std::string& env = "") {
-  const std::string command =
-      env + " " + std::string(SIVIFLOW_BINARY_DIR) + "/tools/siviflow " + args + " 2>&1";
+// Runs `command` through the shell, stderr into the output.
+inline RunResult run_shell(const std::string& command) {
   RunResult result;
-  FILE* pipe = popen(command.c_str(), "r");
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
   if (pipe == nullptr) return result;
   char buffer[4096];
   size_t n = 0;
@@ -30,6 +28,11 @@ inline RunResult run_siviflow(const std::string& args, const std::string& env = 
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// `env` is prepended as shell assignments, e.g. "VK_DRIVER_FILES=/x.json".
+inline RunResult run_siviflow(const std::string& args, const std::string& env = "") {
+  return run_shell(env + " " + std::string(SIVIFLOW_BINARY_DIR) + "/tools/siviflow " + args);
 }
 
 // An empty folder for the running test's files: <build>/tests/<group>/<test name>.

@@ -45,7 +45,7 @@ void print_help() {
   std::printf(
       "usage: siviflow capture [SCENE.json] [--frames N | --range A:B] [--size WxH] --out DIR\n"
       "                        [--seed S] [--fps F] [--aov LIST] [--preview] [--validation]\n"
-      "                        [--resume [--force]]\n"
+      "                        [--resume [--force]] [--dry-run]\n"
       "  Renders the scene file (its render settings unless a flag says otherwise), or the\n"
       "  built-in default scene, into DIR/frame_NNNNN.exr.\n"
       "  --frames N     frames 0..N-1 (same as --range 0:N; default 1)\n"
@@ -71,7 +71,9 @@ void print_help() {
       "  --resume       render only the frames of the range that are missing or cannot be read\n"
       "                 whole; complete ones are left untouched. A complete frame of another\n"
       "                 capture (scene, seed, size, AOVs, software version) is refused, naming it\n"
-      "  --force        with --resume: re-render such frames instead\n");
+      "  --force        with --resume: re-render such frames instead\n"
+      "  --dry-run      check the options, the scene file and the output folder without a\n"
+      "                 device, print the frames it would render, and render nothing\n");
 }
 
 Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help) {
@@ -131,6 +133,8 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
       options->preview = true;
     } else if (arg == "--validation") {
       options->validation = true;
+    } else if (arg == "--dry-run") {
+      options->dry_run = true;
     } else if (arg == "--resume") {
       options->resume = true;
     } else if (arg == "--force") {
@@ -478,6 +482,13 @@ int run_capture(int argc, char** argv) {
     if (!options.size_given) options.size = {scene->render.width, scene->render.height};
     if (!options.fps_given) options.fps = static_cast<float>(scene->render.fps);
     if (!options.seed_given) options.seed = scene->render.seed;
+  }
+  if (options.dry_run) {
+    std::printf("would render frames %u..%u of %s at %ux%u to %s/frame_NNNNN.exr\n",
+                options.first_frame, options.end_frame - 1,
+                options.scene_path.empty() ? "the default scene" : options.scene_path.c_str(),
+                options.size.width, options.size.height, options.out_dir.c_str());
+    return cli::kExitOk;
   }
   Capture capture(options, std::move(scene));
   status = capture.run();

@@ -21,6 +21,7 @@ struct CaptureOptions {
   float fps = 30.0f;
   bool preview = false;
   bool validation = false;
+  bool dry_run = false;  // check everything that needs no device, say what would be rendered
   bool resume = false;  // render only the frames of the range not already complete
   bool force = false;   // with resume: re-render frames of another capture instead of refusing
   bool depth_aov = false;
