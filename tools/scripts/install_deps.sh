@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libbenchmark-dev
   libglfw3-dev libimgui-dev xvfb
   clang-15 libfuzzer-15-dev llvm-15
+  munge slurmctld slurmd slurm-client
 )
 missing=()
 for p in "${packages[@]}"; do
