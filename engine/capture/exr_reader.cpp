@@ -7,8 +7,10 @@
 #include <ImfInputFile.h>
 #include <ImfIntAttribute.h>
 #include <ImfStringAttribute.h>
+#include <ImfTileDescriptionAttribute.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -124,6 +126,25 @@ Status check_attribute_sizes(const std::string& path, const std::string& what, i
   }
 }
 
+// Found by fuzz_exr: reading a tiled file, OpenEXR sizes its buffers from the tile description
+// (a row of tiles across the data window, and one tile) before reading any: a 534-byte file whose
+// tiles were 4x16777220 made it allocate 4 GiB. Those buffers must fit what the file could hold,
+// as the planes must.
+Status check_tile_buffers(const std::string& what, int64_t file_bytes, const Imf::Header& header,
+                          int64_t width, int64_t channel_count) {
+  if (!header.hasTileDescription()) return Status::success();
+  const Imf::TileDescription& tiles = header.tileDescription();
+  const int64_t row_of_tiles = std::max<int64_t>(tiles.xSize, width) * tiles.ySize;
+  if ((row_of_tiles * channel_count * int64_t{sizeof(float)} - kFreeReadBytes) / kMaxDwaExpansion <=
+      file_bytes) {
+    return Status::success();
+  }
+  return Status::error(what + text_format(": its %ux%u tiles need buffers larger than a "
+                                          "%lld-byte file can fill (corrupt or truncated)",
+                                          tiles.xSize, tiles.ySize,
+                                          static_cast<long long>(file_bytes)));
+}
+
 // Refuses a header whose planes could not come from a file of this size, before allocating them.
 Status check_plausible_size(const std::string& what, int64_t file_bytes, int64_t samples,
                             Imf::Compression compression) {
@@ -162,7 +183,9 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
   image.compression = compression_name(header.compression());
 
   int64_t samples = 0;
+  int64_t channel_count = 0;
   for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+    ++channel_count;
     const Imf::Channel& channel = it.channel();
     if (channel.xSampling != 1 || channel.ySampling != 1) {
       return Status::error(what + ": channel '" + it.name() + "' is subsampled (unsupported)");
@@ -171,6 +194,7 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
     if (samples > kMaxReadSamples) return Status::error(what + ": too many samples");
   }
   SIVIFLOW_TRY(check_plausible_size(what, file_bytes, samples, header.compression()));
+  SIVIFLOW_TRY(check_tile_buffers(what, file_bytes, header, width, channel_count));
 
   Imf::FrameBuffer frame_buffer;
   for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {

@@ -1,7 +1,9 @@
 // Capture file writers: EXR/PNG round trips and the atomic-write guarantees.
 #include <ImfChannelList.h>
 #include <ImfHeader.h>
+#include <ImfFrameBuffer.h>
 #include <ImfInputFile.h>
+#include <ImfTiledOutputFile.h>
 #include <ImfStandardAttributes.h>
 #include <Imath/half.h>
 #include <fcntl.h>
@@ -310,6 +312,35 @@ TEST_F(ImageFilesExr, ReadRefusesDataWindowTheFileCannotHold) {
             std::string::npos)
       << read.message();
   EXPECT_NE(read.message().find("(corrupt or truncated)"), std::string::npos) << read.message();
+}
+
+// Found by the hour-long fuzz_exr run: a tiled file whose tiles were 4x16777220 made OpenEXR
+// allocate 4 GiB of tile buffers before reading a pixel.
+TEST_F(ImageFilesExr, ReadRefusesTilesTheFileCannotFill) {
+  const std::string file = path("tiled.exr");
+  {
+    Imf::Header header(8, 4);
+    header.channels().insert("R", Imf::Channel(Imf::FLOAT));
+    header.setTileDescription(Imf::TileDescription(4, 4, Imf::ONE_LEVEL));
+    std::vector<float> pixels(32, 0.5f);
+    Imf::FrameBuffer frame_buffer;
+    frame_buffer.insert("R", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(pixels.data()),
+                                        sizeof(float), sizeof(float) * 8));
+    Imf::TiledOutputFile out(file.c_str(), header);
+    out.setFrameBuffer(frame_buffer);
+    out.writeTiles(0, out.numXTiles() - 1, 0, out.numYTiles() - 1);
+  }
+  ExrImage image;
+  ASSERT_TRUE(read_exr(file, &image).ok()) << "the file as written reads";
+  std::string bytes = read_text(file);
+  patch_attribute_int(&bytes, "tiles", "tiledesc", 2, 16777220);  // ySize
+  const std::string bad = path("huge_tiles.exr");
+  write_text(bad, bytes);
+  const Status read = read_exr(bad, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("its 4x16777220 tiles need buffers larger than a"),
+            std::string::npos)
+      << read.message();
 }
 
 TEST_F(ImageFilesExr, ReadRefusesFifoWithoutBlocking) {
