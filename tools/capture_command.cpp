@@ -326,6 +326,7 @@ Status Capture::run() {
   }
 
   uint32_t rendered = 0;
+  SIVIFLOW_TRY(FrameWriter::start_encoding_threads());
   started_ = std::chrono::steady_clock::now();
   FrameWriter writer(options_, flow_texture_layout(*renderer_),
                      [this](uint32_t written) { report_progress(written); });

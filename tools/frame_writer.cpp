@@ -1,5 +1,6 @@
 #include "frame_writer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -33,6 +34,12 @@ FrameWriter::FrameWriter(const CaptureOptions& options, const FlowTextureLayout&
                          std::function<void(uint32_t)> on_written)
     : options_(options), layout_(layout), on_written_(std::move(on_written)),
       thread_([this] { loop(); }) {}
+
+Status FrameWriter::start_encoding_threads() {
+  // The GPU side waits on its fences most of a frame with every AOV: OpenEXR compresses the line
+  // blocks of a frame on every core meanwhile.
+  return set_exr_threads(static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+}
 
 FrameWriter::~FrameWriter() {
   {

@@ -49,6 +49,9 @@ class FrameWriter {
   FrameWriter(const FrameWriter&) = delete;
   FrameWriter& operator=(const FrameWriter&) = delete;
 
+  // Lets OpenEXR compress on every core (process-wide; the capture tool owns its process).
+  static Status start_encoding_threads();
+
   // Queues `frame`, waiting for room; the writer's first failure instead, after which nothing
   // more is written.
   Status push(FinishedFrame frame);

@@ -42,6 +42,11 @@ struct ExrFrame {
   ExrMetadata metadata;
 };
 
+// How many threads OpenEXR compresses a frame's line blocks on (0: the calling thread alone, the
+// default). OpenEXR keeps one pool for the whole process, so this is process-wide: a host that
+// writes frames while its cores would otherwise idle (the capture tool) sets it once.
+Status set_exr_threads(int count);
+
 // Encodes `frame` as a single-part scanline ZIP-compressed EXR into `bytes` (replaced).
 Status encode_exr(const ExrFrame& frame, std::vector<char>* bytes);
 
