@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "run_command.h"
+#include "siviflow/frame_folder.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow::testing {
@@ -27,16 +28,16 @@ class CliTest : public ::testing::Test {
   void SetUp() override {
     dir_ = fresh_test_dir("cli_out");
   }
-  void expect_error(const RunResult& r, const std::string& needle) {
-    EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find(needle), std::string::npos) << "expected '" << needle << "' in:\n" << r.output;
-    EXPECT_TRUE(fs::is_empty(dir_)) << "a failed run left files behind";
-  }
-  // The same for a folder that holds files already.
+  // A failed run: exit 1 and a message with `needle`.
   void expect_error_only(const RunResult& r, const std::string& needle) {
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find(needle), std::string::npos)
         << "expected '" << needle << "' in:\n" << r.output;
+  }
+  // The same, in a folder that it must leave empty.
+  void expect_error(const RunResult& r, const std::string& needle) {
+    expect_error_only(r, needle);
+    EXPECT_TRUE(fs::is_empty(dir_)) << "a failed run left files behind";
   }
   fs::path dir_;
 };
@@ -367,8 +368,8 @@ TEST_F(CliTest, ResumeRendersOnlyMissingOrIncompleteFrames) {
   EXPECT_NE(run.output.find("4 were complete"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("captured 2/2 frames, "), std::string::npos) << run.output;
   EXPECT_NE(run.output.find(" frames/s, 0 s left"), std::string::npos) << run.output;
-  for (int frame = 0; frame < 6; ++frame) {
-    const std::string name = "frame_0000" + std::to_string(frame) + ".exr";
+  for (uint32_t frame = 0; frame < 6; ++frame) {
+    const std::string name = frame_file_name(frame);
     EXPECT_EQ(read_file(full / name), read_file(resumed / name)) << name;
     const bool kept = frame != 2 && frame != 4;
     EXPECT_EQ(fs::last_write_time(resumed / name) == old_time, kept) << name;

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "run_command.h"
+#include "siviflow/frame_folder.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow::testing {
@@ -20,12 +21,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int kFrames = 6;
-
-std::string frame_name(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "frame_%05d.exr", frame);
-  return name;
-}
 
 // Captures frames 0..kFrames-1 with the device lost at the `at`-th call of `kind`; returns how
 // many frames were written, after checking all of the above.
@@ -58,7 +53,7 @@ int capture_losing_device(const std::string& kind, int at) {
   }
   std::sort(names.begin(), names.end());
   for (size_t i = 0; i < names.size(); ++i) {
-    EXPECT_EQ(names[i], frame_name(static_cast<int>(i))) << "not consecutive, or not a frame; "
+    EXPECT_EQ(names[i], frame_file_name(static_cast<uint32_t>(i))) << "not consecutive, or not a frame; "
                                                          << where;
     const std::string file = (dir / names[i]).string();
     ExrImage image;
@@ -72,12 +67,18 @@ int capture_losing_device(const std::string& kind, int at) {
   return static_cast<int>(names.size());
 }
 
-TEST(DeviceLostCapture, LostAtEachSubmitLeavesOnlyCompleteFrames) {
+// The frames written when the device is lost at each call of `kind` in turn, printed.
+std::vector<int> sweep(const std::string& kind) {
   std::vector<int> written;
-  for (int at = 1; at <= kFrames; ++at) written.push_back(capture_losing_device("submit", at));
-  std::printf("frames written when the device is lost at submit 1..%d:", kFrames);
+  for (int at = 1; at <= kFrames; ++at) written.push_back(capture_losing_device(kind, at));
+  std::printf("frames written when the device is lost at %s 1..%d:", kind.c_str(), kFrames);
   for (int count : written) std::printf(" %d", count);
   std::printf("\n");
+  return written;
+}
+
+TEST(DeviceLostCapture, LostAtEachSubmitLeavesOnlyCompleteFrames) {
+  const std::vector<int> written = sweep("submit");
   // Frames submitted before the loss and waited for are written: more as the loss comes later.
   EXPECT_EQ(written.front(), 0);
   EXPECT_TRUE(std::is_sorted(written.begin(), written.end()));
@@ -85,11 +86,7 @@ TEST(DeviceLostCapture, LostAtEachSubmitLeavesOnlyCompleteFrames) {
 }
 
 TEST(DeviceLostCapture, LostAtEachFenceWaitLeavesOnlyCompleteFrames) {
-  std::vector<int> written;
-  for (int at = 1; at <= kFrames; ++at) written.push_back(capture_losing_device("wait", at));
-  std::printf("frames written when the device is lost at fence wait 1..%d:", kFrames);
-  for (int count : written) std::printf(" %d", count);
-  std::printf("\n");
+  const std::vector<int> written = sweep("wait");
   EXPECT_TRUE(std::is_sorted(written.begin(), written.end()));
   EXPECT_GT(written.back(), 0);
 }
