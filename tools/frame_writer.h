@@ -61,18 +61,21 @@ class FrameWriter {
  private:
   void loop();
   Status write(const FinishedFrame& finished);
+  // Each texel of the flow texture, decoded once: its flow and its particle slot.
+  void decode_flow_texture(const std::vector<std::byte>& flow_texture);
   Status write_particles_csv(const FinishedFrame& finished, const std::string& path) const;
 
   const CaptureOptions options_;
   const FlowTextureLayout layout_;
   const std::function<void(uint32_t)> on_written_;
+  const std::vector<uint32_t> texel_column_;  // the flow texel column under each pixel column
   // The writer's scratch planes, reused from frame to frame.
-  std::vector<float> rgba_;
+  std::vector<float> rgba_;  // the preview's
   std::vector<float> depth_;
   std::vector<float> flow_[3];
   std::vector<float> particle_id_;
-  std::vector<float> normal_[3];
-  std::vector<float> reflection_[3];
+  std::vector<glm::vec3> texel_flow_;
+  std::vector<uint32_t> texel_slot_;
 
   std::mutex mutex_;
   std::condition_variable changed_;

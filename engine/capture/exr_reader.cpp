@@ -1,11 +1,14 @@
-// EXR read-back for tests and golden comparisons: every channel as a float plane.
+// EXR read-back for tests, golden comparisons and frame checks: every channel of every part as a
+// float plane.
 #include <ImfChannelList.h>
 #include <ImfCheckFile.h>
 #include <ImfFloatAttribute.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
-#include <ImfInputFile.h>
+#include <ImfInputPart.h>
 #include <ImfIntAttribute.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfPartType.h>
 #include <ImfStringAttribute.h>
 #include <ImfTileDescriptionAttribute.h>
 #include <sys/stat.h>
@@ -31,8 +34,8 @@ constexpr int64_t kMaxReadSamples = int64_t{1} << 30;
 // The most float-plane bytes one byte of a file can expand to. Deflate (zip, zips, pxr24) gives
 // at most 1032:1, and a half widens to a float: 4096 bounds every codec but DWA with room to
 // spare (a constant 8192x8192 image: zip 1786, piz 790, rle 120); DWA keeps one DC value per 8x8
-// block before deflate, so it gets 64 times that (dwab 21752). A header asking for more than
-// this (beyond a free 64 MiB) describes a file that cannot exist.
+// block before deflate, so it gets 64 times that (dwab 21752). Headers asking for more than
+// this, past a free 64 MiB of planes, describe a file that cannot exist.
 constexpr int64_t kMaxExpansion = 4096;
 constexpr int64_t kMaxDwaExpansion = kMaxExpansion * 64;
 constexpr int64_t kFreeReadBytes = int64_t{64} << 20;
@@ -145,18 +148,51 @@ Status check_tile_buffers(const std::string& what, int64_t file_bytes, const Imf
                                           static_cast<long long>(file_bytes)));
 }
 
-// Refuses a header whose planes could not come from a file of this size, before allocating them.
-Status check_plausible_size(const std::string& what, int64_t file_bytes, int64_t samples,
-                            Imf::Compression compression) {
+// The fewest bytes of a file that could expand to `samples` float samples of this compression.
+int64_t least_file_bytes(int64_t samples, Imf::Compression compression) {
   const bool dwa = compression == Imf::DWAA_COMPRESSION || compression == Imf::DWAB_COMPRESSION;
-  const int64_t expansion = dwa ? kMaxDwaExpansion : kMaxExpansion;
+  return samples * int64_t{sizeof(float)} / (dwa ? kMaxDwaExpansion : kMaxExpansion);
+}
+
+// Refuses headers whose planes could not come from a file of this size, before allocating them.
+Status check_plausible_size(const std::string& what, int64_t file_bytes, int64_t samples,
+                            int64_t least_bytes) {
   const int64_t plane_bytes = samples * int64_t{sizeof(float)};
-  if ((plane_bytes - kFreeReadBytes) / expansion <= file_bytes) return Status::success();
+  if (plane_bytes <= kFreeReadBytes || least_bytes <= file_bytes) return Status::success();
   return Status::error(what + text_format(": the header asks for %lld MiB of pixels, more than "
-                                          "a %lld-byte %s file can hold (corrupt or truncated)",
+                                          "a %lld-byte file can hold (corrupt or truncated)",
                                           static_cast<long long>(plane_bytes >> 20),
-                                          static_cast<long long>(file_bytes),
-                                          compression_name(compression)));
+                                          static_cast<long long>(file_bytes)));
+}
+
+// The string, int and float attributes of `header`, and the siviflow/* metadata among them.
+void read_attributes(const Imf::Header& header, ExrImage* image) {
+  for (auto it = header.begin(); it != header.end(); ++it) {
+    const Imf::Attribute& attribute = it.attribute();
+    if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&attribute)) {
+      image->string_attributes[it.name()] = s->value();
+    } else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&attribute)) {
+      image->int_attributes[it.name()] = i->value();
+    } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&attribute)) {
+      image->float_attributes[it.name()] = f->value();
+    }
+  }
+  if (auto s = image->string_attributes.find(kExrAttrScene); s != image->string_attributes.end()) {
+    image->metadata.scene = s->second;
+  }
+  if (auto s = image->string_attributes.find(kExrAttrSoftware);
+      s != image->string_attributes.end()) {
+    image->metadata.software_version = s->second;
+  }
+  if (auto i = image->int_attributes.find(kExrAttrFrame); i != image->int_attributes.end()) {
+    image->metadata.frame = i->second;
+  }
+  if (auto i = image->int_attributes.find(kExrAttrSeed); i != image->int_attributes.end()) {
+    image->metadata.seed = i->second;
+  }
+  if (auto f = image->float_attributes.find(kExrAttrTime); f != image->float_attributes.end()) {
+    image->metadata.time_seconds = f->second;
+  }
 }
 
 Status read_exr_impl(const std::string& path, ExrImage* out) {
@@ -166,9 +202,8 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
   SIVIFLOW_TRY(check_regular_file(path, what, &file_bytes));
   SIVIFLOW_TRY(check_attribute_sizes(path, what, file_bytes));
 
-  Imf::InputFile file(path.c_str());
-  const Imf::Header& header = file.header();
-  const Imath::Box2i window = header.dataWindow();
+  Imf::MultiPartInputFile file(path.c_str());
+  const Imath::Box2i window = file.header(0).dataWindow();
   const int64_t width = int64_t{window.max.x} - window.min.x + 1;
   const int64_t height = int64_t{window.max.y} - window.min.y + 1;
   if (width <= 0 || height <= 0 || width * height > kMaxReadPixels) {
@@ -180,61 +215,57 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
   ExrImage image;
   image.width = static_cast<int>(width);
   image.height = static_cast<int>(height);
-  image.compression = compression_name(header.compression());
 
+  // Every part's header is checked before any plane is allocated.
   int64_t samples = 0;
-  int64_t channel_count = 0;
-  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-    ++channel_count;
-    const Imf::Channel& channel = it.channel();
-    if (channel.xSampling != 1 || channel.ySampling != 1) {
-      return Status::error(what + ": channel '" + it.name() + "' is subsampled (unsupported)");
+  int64_t least_bytes = 0;
+  for (int p = 0; p < file.parts(); ++p) {
+    const Imf::Header& header = file.header(p);
+    const std::string part = header.hasName() ? header.name() : "";
+    const std::string where = file.parts() > 1 ? what + ": part '" + part + "'" : what;
+    if (header.hasType() && Imf::isDeepData(header.type())) {
+      return Status::error(where + " holds deep data (unsupported)");
     }
-    samples += pixel_count;
-    if (samples > kMaxReadSamples) return Status::error(what + ": too many samples");
-  }
-  SIVIFLOW_TRY(check_plausible_size(what, file_bytes, samples, header.compression()));
-  SIVIFLOW_TRY(check_tile_buffers(what, file_bytes, header, width, channel_count));
-
-  Imf::FrameBuffer frame_buffer;
-  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-    const Imf::Channel& channel = it.channel();
-    ExrPlane& plane = image.channels[it.name()];
-    plane.type = pixel_type(channel.type);
-    plane.pixels.assign(static_cast<size_t>(pixel_count), 0.0f);
-    frame_buffer.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, plane.pixels.data(), window,
-                                                    sizeof(float),
-                                                    sizeof(float) * static_cast<size_t>(width)));
-  }
-  file.setFrameBuffer(frame_buffer);
-  file.readPixels(window.min.y, window.max.y);
-
-  for (auto it = header.begin(); it != header.end(); ++it) {
-    const Imf::Attribute& attribute = it.attribute();
-    if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&attribute)) {
-      image.string_attributes[it.name()] = s->value();
-    } else if (const auto* i = dynamic_cast<const Imf::IntAttribute*>(&attribute)) {
-      image.int_attributes[it.name()] = i->value();
-    } else if (const auto* f = dynamic_cast<const Imf::FloatAttribute*>(&attribute)) {
-      image.float_attributes[it.name()] = f->value();
+    if (header.dataWindow() != window) {
+      return Status::error(where + " has another data window than the first part (unsupported)");
     }
+    image.parts.push_back(part);
+    int64_t channel_count = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      ++channel_count;
+      const Imf::Channel& channel = it.channel();
+      if (channel.xSampling != 1 || channel.ySampling != 1) {
+        return Status::error(where + ": channel '" + it.name() + "' is subsampled (unsupported)");
+      }
+      samples += pixel_count;
+      if (samples > kMaxReadSamples) return Status::error(what + ": too many samples");
+    }
+    least_bytes += least_file_bytes(channel_count * pixel_count, header.compression());
+    SIVIFLOW_TRY(check_tile_buffers(where, file_bytes, header, width, channel_count));
   }
-  if (auto s = image.string_attributes.find(kExrAttrScene); s != image.string_attributes.end()) {
-    image.metadata.scene = s->second;
+  SIVIFLOW_TRY(check_plausible_size(what, file_bytes, samples, least_bytes));
+
+  for (int p = 0; p < file.parts(); ++p) {
+    const Imf::Header& header = file.header(p);
+    Imf::FrameBuffer frame_buffer;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      const auto [entry, added] = image.channels.try_emplace(it.name());
+      if (!added) {
+        return Status::error(what + ": channel '" + it.name() + "' is in two parts (unsupported)");
+      }
+      ExrPlane& plane = entry->second;
+      plane.type = pixel_type(it.channel().type);
+      plane.compression = compression_name(header.compression());
+      plane.pixels.assign(static_cast<size_t>(pixel_count), 0.0f);
+      frame_buffer.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, plane.pixels.data(), window,
+                                                      sizeof(float),
+                                                      sizeof(float) * static_cast<size_t>(width)));
+    }
+    Imf::InputPart part(file, p);
+    part.setFrameBuffer(frame_buffer);
+    part.readPixels(window.min.y, window.max.y);
   }
-  if (auto s = image.string_attributes.find(kExrAttrSoftware);
-      s != image.string_attributes.end()) {
-    image.metadata.software_version = s->second;
-  }
-  if (auto i = image.int_attributes.find(kExrAttrFrame); i != image.int_attributes.end()) {
-    image.metadata.frame = i->second;
-  }
-  if (auto i = image.int_attributes.find(kExrAttrSeed); i != image.int_attributes.end()) {
-    image.metadata.seed = i->second;
-  }
-  if (auto f = image.float_attributes.find(kExrAttrTime); f != image.float_attributes.end()) {
-    image.metadata.time_seconds = f->second;
-  }
+  read_attributes(file.header(0), &image);
 
   *out = std::move(image);
   return Status::success();

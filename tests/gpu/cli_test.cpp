@@ -153,7 +153,10 @@ TEST_F(CliTest, CaptureWritesExrFramesAndPreviews) {
     }
     ASSERT_NE(image.find("depth.Z"), nullptr);
     EXPECT_EQ(image.channels.at("depth.Z").type, ExrPixelType::kFloat);
-    EXPECT_EQ(image.compression, "zip");
+    // The beauty's part, then one per layer, each compressed as suits it.
+    EXPECT_EQ(image.parts, (std::vector<std::string>{"rgba", "depth"}));
+    EXPECT_EQ(image.channels.at("R").compression, "piz");
+    EXPECT_EQ(image.channels.at("depth.Z").compression, "zip");
     EXPECT_EQ(image.metadata.frame, frame);
     EXPECT_EQ(image.metadata.seed, 9);
     EXPECT_EQ(image.metadata.scene, "default");

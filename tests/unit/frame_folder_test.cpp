@@ -37,7 +37,7 @@ void write_frame(const fs::path& dir, uint32_t frame, const FrameSpec& spec = {}
   exr.width = spec.width;
   exr.height = spec.height;
   exr.rgba = rgba.data();
-  if (spec.depth) exr.channels.push_back({"depth.Z", depth.data()});
+  if (spec.depth) exr.layers.push_back({"depth", ExrCompression::kZip, {{"depth.Z", depth.data()}}});
   exr.metadata.scene = spec.scene;
   exr.metadata.frame = spec.frame_attribute >= 0 ? spec.frame_attribute : static_cast<int>(frame);
   exr.metadata.seed = spec.seed;

@@ -3,6 +3,11 @@
 #include <ImfHeader.h>
 #include <ImfFrameBuffer.h>
 #include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
 #include <ImfTiledOutputFile.h>
 #include <ImfStandardAttributes.h>
 #include <Imath/half.h>
@@ -88,7 +93,8 @@ struct TestFrame {
     f.width = width;
     f.height = height;
     f.rgba = rgba.data();
-    f.channels = {{"depth.Z", depth.data()}, {"flow.X", flow_x.data()}};
+    f.layers = {{"depth", ExrCompression::kZip, {{"depth.Z", depth.data()}}},
+                {"flow", ExrCompression::kRle, {{"flow.X", flow_x.data()}}}};
     f.metadata.scene = "straight_river";
     f.metadata.frame = 42;
     f.metadata.time_seconds = 1.75f;
@@ -176,28 +182,90 @@ TEST_F(ImageFilesExr, RoundTripKeepsPixelsChannelsAndMetadata) {
   EXPECT_TRUE(checked.ok()) << checked.message();
 }
 
-TEST_F(ImageFilesExr, HeaderHasZipHalfBeautyFloatDataAndTopLeftWindow) {
+TEST_F(ImageFilesExr, PartsHaveTheirLayersCompressionAndTopLeftWindow) {
   TestFrame data(16, 9);
+  ExrFrame frame = data.frame();
+  frame.rgba_compression = ExrCompression::kPiz;
   const std::string file = path("frame.exr");
-  ASSERT_TRUE(write_exr(file, data.frame()).ok());
+  ASSERT_TRUE(write_exr(file, frame).ok());
 
-  Imf::InputFile input(file.c_str());
-  const Imf::Header& header = input.header();
-  EXPECT_EQ(header.compression(), Imf::ZIP_COMPRESSION);
-  EXPECT_EQ(header.lineOrder(), Imf::INCREASING_Y);
-  EXPECT_EQ(header.dataWindow().min, Imath::V2i(0, 0));
-  EXPECT_EQ(header.dataWindow().max, Imath::V2i(15, 8));
-  EXPECT_EQ(header.displayWindow(), header.dataWindow());
-  EXPECT_EQ(header.channels().findChannel("G")->type, Imf::HALF);
-  EXPECT_EQ(header.channels().findChannel("depth.Z")->type, Imf::FLOAT);
-  EXPECT_FALSE(Imf::hasChromaticities(header));  // sRGB primaries are the spec default
+  Imf::MultiPartInputFile input(file.c_str());
+  ASSERT_EQ(input.parts(), 3);
+  const char* names[3] = {"rgba", "depth", "flow"};
+  const Imf::Compression compressions[3] = {Imf::PIZ_COMPRESSION, Imf::ZIP_COMPRESSION,
+                                            Imf::RLE_COMPRESSION};
+  for (int p = 0; p < 3; ++p) {
+    const Imf::Header& header = input.header(p);
+    EXPECT_EQ(header.name(), names[p]);
+    EXPECT_EQ(header.type(), Imf::SCANLINEIMAGE);
+    EXPECT_EQ(header.compression(), compressions[p]) << names[p];
+    EXPECT_EQ(header.lineOrder(), Imf::INCREASING_Y);
+    EXPECT_EQ(header.dataWindow().min, Imath::V2i(0, 0));
+    EXPECT_EQ(header.dataWindow().max, Imath::V2i(15, 8));
+    EXPECT_EQ(header.displayWindow(), header.dataWindow());
+    EXPECT_FALSE(Imf::hasChromaticities(header));  // sRGB primaries are the spec default
+    // Every part carries the metadata, for tools that read one part.
+    EXPECT_EQ(header.typedAttribute<Imf::IntAttribute>(kExrAttrFrame).value(), 42) << names[p];
+  }
+  EXPECT_EQ(input.header(0).channels().findChannel("G")->type, Imf::HALF);
+  EXPECT_EQ(input.header(1).channels().findChannel("depth.Z")->type, Imf::FLOAT);
+  EXPECT_EQ(input.header(0).channels().findChannel("depth.Z"), nullptr);
 
   ExrImage image;
   ASSERT_TRUE(read_exr(file, &image).ok());
-  EXPECT_EQ(image.compression, "zip");
+  EXPECT_EQ(image.parts, (std::vector<std::string>{"rgba", "depth", "flow"}));
+  EXPECT_EQ(image.channels.at("G").compression, "piz");
+  EXPECT_EQ(image.channels.at("depth.Z").compression, "zip");
+  EXPECT_EQ(image.channels.at("flow.X").compression, "rle");
   // Row-major, top-left origin: pixel (x=3, y=2) of the input is pixel (3, 2) of the file.
   const size_t index = 2 * 16 + 3;
   EXPECT_EQ((*image.find("depth.Z"))[index], data.depth[index]);
+  EXPECT_EQ((*image.find("flow.X"))[index], data.flow_x[index]);
+}
+
+TEST_F(ImageFilesExr, BeautyAloneIsASinglePartFile) {
+  TestFrame data(8, 4);
+  ExrFrame frame = data.frame();
+  frame.layers.clear();
+  const std::string file = path("frame.exr");
+  ASSERT_TRUE(write_exr(file, frame).ok());
+  const std::string bytes = read_text(file);
+  ASSERT_GE(bytes.size(), 8u);
+  EXPECT_EQ(static_cast<unsigned char>(bytes[5]) & 0x10, 0);  // no multi-part bit in the version
+  Imf::InputFile input(file.c_str());  // the single-part interface reads it
+  EXPECT_EQ(input.header().compression(), Imf::ZIP_COMPRESSION);
+  EXPECT_NE(input.header().channels().findChannel("A"), nullptr);
+}
+
+TEST_F(ImageFilesExr, HalfBeautyIsWrittenBitForBitAndStridedChannelsAreGathered) {
+  TestFrame data(6, 3);
+  const size_t pixels = 6 * 3;
+  std::vector<uint16_t> halves(pixels * 4);
+  for (size_t i = 0; i < halves.size(); ++i) halves[i] = half(data.rgba[i]).bits();
+  halves[0] = half(std::numeric_limits<float>::infinity()).bits();
+  std::vector<float> normal(pixels * 4);  // RGBA interleaved, as the GPU reads it back
+  for (size_t i = 0; i < normal.size(); ++i) normal[i] = static_cast<float>(i) * 0.25f;
+  ExrFrame frame = data.frame();
+  frame.rgba = nullptr;
+  frame.rgba_half = halves.data();
+  frame.layers = {{"normal", ExrCompression::kRle,
+                   {{"normal.X", normal.data(), 4}, {"normal.Z", normal.data() + 2, 4}}}};
+  const std::string file = path("frame.exr");
+  ASSERT_TRUE(write_exr(file, frame).ok());
+
+  ExrImage image;
+  ASSERT_TRUE(read_exr(file, &image).ok());
+  const char* rgba_names[4] = {"R", "G", "B", "A"};
+  for (size_t c = 0; c < 4; ++c) {
+    for (size_t i = 0; i < pixels; ++i) {
+      EXPECT_EQ(half(image.channels.at(rgba_names[c]).pixels[i]).bits(), halves[i * 4 + c]);
+    }
+  }
+  EXPECT_TRUE(std::isinf(image.channels.at("R").pixels[0]));
+  for (size_t i = 0; i < pixels; ++i) {
+    EXPECT_EQ(image.channels.at("normal.X").pixels[i], normal[i * 4]);
+    EXPECT_EQ(image.channels.at("normal.Z").pixels[i], normal[i * 4 + 2]);
+  }
 }
 
 TEST_F(ImageFilesExr, FileBytesEqualInMemoryEncoding) {
@@ -225,18 +293,40 @@ TEST_F(ImageFilesExr, InvalidFramesAreRejectedWithoutFiles) {
   no_pixels.rgba = nullptr;
   EXPECT_FALSE(write_exr(file, no_pixels).ok());
 
+  ExrFrame both_beauties = data.frame();
+  const std::vector<uint16_t> halves(4 * 4 * 4);
+  both_beauties.rgba_half = halves.data();
+  s = write_exr(file, both_beauties);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("one of the two"), std::string::npos) << s.message();
+
   ExrFrame duplicate = data.frame();
-  duplicate.channels.push_back({"depth.Z", data.depth.data()});
+  duplicate.layers[1].channels.push_back({"depth.Z", data.depth.data()});
   s = write_exr(file, duplicate);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("'depth.Z' is used twice"), std::string::npos) << s.message();
 
   ExrFrame clashes_with_beauty = data.frame();
-  clashes_with_beauty.channels.push_back({"A", data.depth.data()});
+  clashes_with_beauty.layers[0].channels.push_back({"A", data.depth.data()});
   EXPECT_FALSE(write_exr(file, clashes_with_beauty).ok());
 
+  for (const char* layer_name : {"rgba", "flow", ""}) {
+    ExrFrame bad_layer = data.frame();
+    bad_layer.layers.push_back({layer_name, ExrCompression::kZip, {{"foam.Y", data.depth.data()}}});
+    s = write_exr(file, bad_layer);
+    EXPECT_FALSE(s.ok()) << layer_name;
+    EXPECT_NE(s.message().find("layer name '" + std::string(layer_name) + "'"), std::string::npos)
+        << s.message();
+  }
+
+  ExrFrame empty_layer = data.frame();
+  empty_layer.layers.push_back({"foam", ExrCompression::kZip, {}});
+  s = write_exr(file, empty_layer);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("layer 'foam' has no channels"), std::string::npos) << s.message();
+
   ExrFrame null_channel = data.frame();
-  null_channel.channels.push_back({"water.mask", nullptr});
+  null_channel.layers[0].channels.push_back({"water.mask", nullptr});
   s = write_exr(file, null_channel);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find(file), std::string::npos) << s.message();
@@ -299,8 +389,10 @@ TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFile) {
 // its 400 MiB of planes before OpenEXR found the pixels missing.
 TEST_F(ImageFilesExr, ReadRefusesDataWindowTheFileCannotHold) {
   TestFrame data(16, 16);
+  ExrFrame beauty = data.frame();
+  beauty.layers.clear();
   const std::string file = path("frame.exr");
-  ASSERT_TRUE(write_exr(file, data.frame()).ok());
+  ASSERT_TRUE(write_exr(file, beauty).ok());
   std::string bytes = read_text(file);
   patch_attribute_int(&bytes, "dataWindow", "box2i", 3, 8000000);  // xMax
   const std::string bad = path("huge_window.exr");
@@ -341,6 +433,55 @@ TEST_F(ImageFilesExr, ReadRefusesTilesTheFileCannotFill) {
   EXPECT_NE(read.message().find("its 4x16777220 tiles need buffers larger than a"),
             std::string::npos)
       << read.message();
+}
+
+// A two-part file from another tool: part "a" holds channel `first` over 8x4 pixels, part "b"
+// holds `second` over `b_window`.
+void write_two_parts(const std::string& file, const char* first, const char* second,
+                     const Imath::Box2i& b_window) {
+  std::vector<Imf::Header> headers(2, Imf::Header(8, 4));
+  headers[1].dataWindow() = b_window;
+  const char* channels[2] = {first, second};
+  for (int p = 0; p < 2; ++p) {
+    headers[p].setName(p == 0 ? "a" : "b");
+    headers[p].setType(Imf::SCANLINEIMAGE);
+    headers[p].channels().insert(channels[p], Imf::Channel(Imf::FLOAT));
+  }
+  Imf::MultiPartOutputFile out(file.c_str(), headers.data(), 2);
+  std::vector<float> pixels(64, 0.5f);
+  for (int p = 0; p < 2; ++p) {
+    const Imath::Box2i window = headers[p].dataWindow();
+    Imf::FrameBuffer frame_buffer;
+    frame_buffer.insert(channels[p], Imf::Slice::Make(Imf::FLOAT, pixels.data(), window,
+                                                      sizeof(float), sizeof(float) * 8));
+    Imf::OutputPart part(out, p);
+    part.setFrameBuffer(frame_buffer);
+    part.writePixels(window.max.y - window.min.y + 1);
+  }
+}
+
+TEST_F(ImageFilesExr, ReadRefusesPartsItCannotMerge) {
+  const Imath::Box2i same(Imath::V2i(0, 0), Imath::V2i(7, 3));
+  const std::string twice = path("twice.exr");
+  write_two_parts(twice, "Z", "Z", same);
+  ExrImage image;
+  Status read = read_exr(twice, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("channel 'Z' is in two parts"), std::string::npos) << read.message();
+
+  const std::string windows = path("windows.exr");
+  write_two_parts(windows, "Y", "Z", Imath::Box2i(Imath::V2i(0, 0), Imath::V2i(3, 3)));
+  read = read_exr(windows, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("part 'b' has another data window"), std::string::npos)
+      << read.message();
+
+  const std::string good = path("good.exr");
+  write_two_parts(good, "Y", "Z", same);
+  read = read_exr(good, &image);
+  ASSERT_TRUE(read.ok()) << read.message();
+  EXPECT_EQ(image.parts, (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(image.channels.size(), 2u);
 }
 
 TEST_F(ImageFilesExr, ReadRefusesFifoWithoutBlocking) {

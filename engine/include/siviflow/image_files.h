@@ -19,10 +19,22 @@ inline constexpr const char* kExrAttrSeed = "siviflow/seed";                // i
 inline constexpr const char* kExrAttrSoftware = "siviflow/software_version";  // string
 
 // One data channel: width * height floats, row-major, top-left origin; written as FLOAT.
-// Names follow the single-part layer convention, e.g. "depth.Z", "flow.X", "water.mask".
+// Names follow the layer convention, e.g. "depth.Z", "flow.X", "water.mask".
 struct ExrChannel {
   std::string name;
   const float* pixels = nullptr;
+  int stride = 1;  // floats from one pixel's sample to the next (4: a channel of interleaved RGBA)
+};
+
+// The lossless compressions a part may use (OpenEXR's RLE, ZIP at deflate level 1, PIZ).
+enum class ExrCompression { kNone, kRle, kZip, kPiz };
+
+// Channels written together as one part of a multi-part EXR, under the compression that suits
+// their data.
+struct ExrLayer {
+  std::string name;  // the part's name, e.g. "depth"
+  ExrCompression compression = ExrCompression::kZip;
+  std::vector<ExrChannel> channels;
 };
 
 struct ExrMetadata {
@@ -33,12 +45,18 @@ struct ExrMetadata {
   std::string software_version;
 };
 
-// One frame to write. The caller keeps every pointed-to buffer alive during the call.
+// One frame to write. The caller keeps every pointed-to buffer alive during the call. The
+// beauty alone makes a single-part file; with layers, a multi-part file whose first part, "rgba",
+// is the beauty (what a viewer shows first), then one part per layer, each with the metadata.
 struct ExrFrame {
   int width = 0;
   int height = 0;
-  const float* rgba = nullptr;  // linear beauty, 4 interleaved floats per pixel; written as HALF
-  std::vector<ExrChannel> channels;
+  // The linear beauty, 4 interleaved samples per pixel, written as HALF: either floats (rounded
+  // to half) or IEEE half bits as rendered. Exactly one of the two.
+  const float* rgba = nullptr;
+  const uint16_t* rgba_half = nullptr;
+  ExrCompression rgba_compression = ExrCompression::kZip;
+  std::vector<ExrLayer> layers;
   ExrMetadata metadata;
 };
 
@@ -47,7 +65,7 @@ struct ExrFrame {
 // writes frames while its cores would otherwise idle (the capture tool) sets it once.
 Status set_exr_threads(int count);
 
-// Encodes `frame` as a single-part scanline ZIP-compressed EXR into `bytes` (replaced).
+// Encodes `frame` as a scanline EXR into `bytes` (replaced).
 Status encode_exr(const ExrFrame& frame, std::vector<char>* bytes);
 
 // Encodes and writes atomically: on success `path` holds the complete file; on failure the
@@ -70,15 +88,18 @@ enum class ExrPixelType { kUint, kHalf, kFloat };
 
 struct ExrPlane {
   ExrPixelType type = ExrPixelType::kFloat;  // as stored in the file
+  std::string compression;                   // its part's: "none", "zip", "piz", ...
   std::vector<float> pixels;                 // width * height, row-major, top-left origin
 };
 
 struct ExrImage {
   int width = 0;
   int height = 0;
-  std::map<std::string, ExrPlane> channels;  // every channel, e.g. "R", "A", "depth.Z"
-  std::string compression;                   // "none", "zip", "piz", ...
-  ExrMetadata metadata;  // from the siviflow/* attributes; defaults where one is absent
+  std::map<std::string, ExrPlane> channels;  // every channel of every part, e.g. "R", "depth.Z"
+  std::vector<std::string> parts;            // the parts' names in file order ("" unnamed)
+  // From the first part's header: the siviflow/* attributes (defaults where one is absent), and
+  // every string, int and float attribute.
+  ExrMetadata metadata;
   std::map<std::string, std::string> string_attributes;
   std::map<std::string, int> int_attributes;
   std::map<std::string, float> float_attributes;
@@ -87,7 +108,8 @@ struct ExrImage {
   const std::vector<float>* find(const std::string& name) const;
 };
 
-// Reads every channel of a single-part scanline or tiled EXR as float planes.
+// Reads every channel of every part of a scanline or tiled EXR (single- or multi-part; the
+// parts share one data window and no channel name) as float planes.
 Status read_exr(const std::string& path, ExrImage* image);
 
 // Deep structural check of an EXR file (OpenEXR's checkOpenEXRFile): ok, or what is wrong.
