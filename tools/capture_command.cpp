@@ -240,7 +240,8 @@ class Capture {
   // Refuses, before anything is allocated, a size and AOV set over the memory budget, with the
   // figure it would need.
   Status check_memory_budget(CreateInfo info, size_t river_count) const;
-  FinishedFrame copy_out(const SlotTargets& slot) const;
+  // Copies the slot's frame out of its readback buffers into `finished` (its buffers reused).
+  void copy_out(const SlotTargets& slot, FinishedFrame* finished) const;
   void report_progress(uint32_t done_count);
 
   CaptureOptions options_;
@@ -250,7 +251,6 @@ class Capture {
   std::vector<std::unique_ptr<Renderer>> rivers_;  // one water renderer per river of the scene
   std::vector<Renderer*> river_renderers_;
   Renderer* renderer_ = nullptr;  // the last river's: it reads the frame back
-  Status write_particles_csv(const std::string& path) const;
 
   uint32_t frames_to_write_ = 0;  // the range, less the complete frames a resume keeps
   std::chrono::steady_clock::time_point started_;  // of the first rendered frame
@@ -345,7 +345,10 @@ Status Capture::run() {
     // only then is the previous frame encoded and written, while the GPU renders.
     const bool have_finished = slot.pending;
     FinishedFrame finished;
-    if (have_finished) finished = copy_out(slot);
+    if (have_finished) {
+      finished = writer.spare_frame();
+      copy_out(slot, &finished);
+    }
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->begin_frame(index));
     slot.camera = world_->scene_camera(time);
     const View view = camera_view(slot.camera, extent);
@@ -366,7 +369,9 @@ Status Capture::run() {
        ++i) {
     SlotTargets& slot = slots[i % kFramesInFlight];
     SIVIFLOW_TRY(context_->wait_slot(i % kFramesInFlight));
-    SIVIFLOW_TRY(writer.push(copy_out(slot)));
+    FinishedFrame finished = writer.spare_frame();
+    copy_out(slot, &finished);
+    SIVIFLOW_TRY(writer.push(std::move(finished)));
     slot.pending = false;
   }
   SIVIFLOW_TRY(writer.finish());
@@ -409,11 +414,10 @@ uint32_t Capture::readback_images() const {
   return images;
 }
 
-FinishedFrame Capture::copy_out(const SlotTargets& slot) const {
+void Capture::copy_out(const SlotTargets& slot, FinishedFrame* finished) const {
   const size_t pixels = size_t{options_.size.width} * options_.size.height;
-  FinishedFrame finished;
-  finished.frame = slot.frame;
-  finished.camera = slot.camera;
+  finished->frame = slot.frame;
+  finished->camera = slot.camera;
   // Each read-back image's bytes; the images not read back are left empty.
   const auto copy = [&slot](ReadbackImage kind, size_t count, auto* out) {
     using T = typename std::remove_reference_t<decltype(*out)>::value_type;
@@ -421,16 +425,15 @@ FinishedFrame Capture::copy_out(const SlotTargets& slot) const {
     if (data == nullptr) return;
     out->assign(data, data + count);
   };
-  copy(ReadbackImage::kColor, pixels * 4, &finished.color_halves);
-  copy(ReadbackImage::kDepth, pixels, &finished.window_depth);
-  copy(ReadbackImage::kWaterMask, pixels, &finished.water_mask);
+  copy(ReadbackImage::kColor, pixels * 4, &finished->color_halves);
+  copy(ReadbackImage::kDepth, pixels, &finished->window_depth);
+  copy(ReadbackImage::kWaterMask, pixels, &finished->water_mask);
   copy(ReadbackImage::kFlowTexture, renderer_->readback_bytes(ReadbackImage::kFlowTexture),
-       &finished.flow_texture);
-  copy(ReadbackImage::kNormal, pixels * 4, &finished.normal);
-  copy(ReadbackImage::kReflection, pixels * 4, &finished.reflection);
-  copy(ReadbackImage::kFoam, pixels, &finished.foam);
-  finished.particles = slot.particles;
-  return finished;
+       &finished->flow_texture);
+  copy(ReadbackImage::kNormal, pixels * 4, &finished->normal);
+  copy(ReadbackImage::kReflection, pixels * 4, &finished->reflection);
+  copy(ReadbackImage::kFoam, pixels, &finished->foam);
+  finished->particles = slot.particles;
 }
 
 

@@ -1,46 +1,26 @@
 #include "frame_writer.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <exception>
-#include <limits>
 #include <string>
-#include <utility>
 
-#include <glm/gtc/packing.hpp>
-
-#include "renderer_inspect.h"
-#include "shaders/shared.h"
 #include "siviflow/atomic_file.h"
 #include "siviflow/frame_folder.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow {
-namespace {
-
-// Window depth (0 near .. 1 far, glm::perspectiveRH_ZO) to distance along the view axis.
-float linear_depth(float window_depth, float near_plane, float far_plane) {
-  if (window_depth >= 1.0f) return std::numeric_limits<float>::infinity();
-  const float a = far_plane / (near_plane - far_plane);
-  const float b = far_plane * near_plane / (near_plane - far_plane);
-  return b / (window_depth + a);
-}
-
-std::vector<uint32_t> texel_columns(uint32_t width, uint32_t texel_px) {
-  std::vector<uint32_t> columns(width);
-  for (uint32_t x = 0; x < width; ++x) columns[x] = x / texel_px;
-  return columns;
-}
-
-}  // namespace
 
 FrameWriter::FrameWriter(const CaptureOptions& options, const FlowTextureLayout& layout,
                          std::function<void(uint32_t)> on_written)
-    : options_(options), layout_(layout), on_written_(std::move(on_written)),
-      texel_column_(texel_columns(options.size.width, layout.texel_px)),
-      thread_([this] { loop(); }) {}
+    : options_(options), on_written_(std::move(on_written)) {
+  for (size_t i = 0; i < kEncoders; ++i) {
+    encoders_.push_back(std::make_unique<FrameEncoder>(options, layout));
+  }
+  for (const std::unique_ptr<FrameEncoder>& encoder : encoders_) {
+    threads_.emplace_back([this, encoder = encoder.get()] { encode_loop(encoder); });
+  }
+}
 
 Status FrameWriter::start_encoding_threads() {
   // The GPU side waits on its fences most of a frame with every AOV: OpenEXR compresses the line
@@ -54,152 +34,86 @@ FrameWriter::~FrameWriter() {
     stop_ = true;
   }
   changed_.notify_all();
-  thread_.join();
+  for (std::thread& thread : threads_) thread.join();
 }
 
 Status FrameWriter::push(FinishedFrame frame) {
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [this] { return !failure_.ok() || queue_.size() < kQueueDepth; });
   if (!failure_.ok()) return failure_;
-  queue_.push_back(std::move(frame));
+  queue_.emplace_back(next_ticket_++, std::move(frame));
   changed_.notify_all();
   return Status::success();
 }
 
 Status FrameWriter::finish() {
   std::unique_lock lock(mutex_);
-  changed_.wait(lock, [this] { return !failure_.ok() || (queue_.empty() && !writing_); });
+  changed_.wait(lock, [this] { return !failure_.ok() || (queue_.empty() && in_hand_ == 0); });
   return failure_;
 }
 
-void FrameWriter::loop() {
+FinishedFrame FrameWriter::spare_frame() {
+  std::lock_guard lock(mutex_);
+  if (spares_.empty()) return {};
+  FinishedFrame spare = std::move(spares_.back());
+  spares_.pop_back();
+  return spare;
+}
+
+void FrameWriter::encode_loop(FrameEncoder* encoder) {
+  EncodedFrame encoded;  // its buffers reused from frame to frame
   std::unique_lock lock(mutex_);
   for (;;) {
-    changed_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+    changed_.wait(lock, [this] { return stop_ || !failure_.ok() || !queue_.empty(); });
     if (queue_.empty() || !failure_.ok()) return;  // stopped, or nothing more is written
-    FinishedFrame frame = std::move(queue_.front());
+    const uint64_t ticket = queue_.front().first;
+    FinishedFrame frame = std::move(queue_.front().second);
     queue_.pop_front();
-    writing_ = true;
+    ++in_hand_;
+    changed_.notify_all();  // room in the queue
     lock.unlock();
     Status status;
     try {
-      status = write(frame);
+      status = encoder->encode(frame, &encoded);
     } catch (const std::exception& e) {  // std::bad_alloc from a plane: the frame is not written
-      status = Status::error(std::string("cannot write frame: ") + e.what());
+      status = Status::error(std::string("cannot encode: ") + e.what());
     }
-    if (status.ok() && on_written_) on_written_(++written_);
+    if (!status.ok()) status = Status::error(frame_file_name(frame.frame) + ": " + status.message());
     lock.lock();
-    writing_ = false;
-    if (!status.ok()) failure_ = std::move(status);
+    // Files are written, and failures reported, in frame order.
+    changed_.wait(lock, [&] { return next_write_ == ticket || !failure_.ok(); });
+    if (failure_.ok() && status.ok()) {
+      lock.unlock();
+      status = write(encoded);
+      if (status.ok() && on_written_) on_written_(written_ + 1);  // only this thread writes now
+      lock.lock();
+      if (status.ok()) ++written_;
+    }
+    if (failure_.ok() && !status.ok()) failure_ = std::move(status);
+    // At most one frame per place it can be (queue, encoders, the capture's hands) is kept.
+    if (spares_.size() < kQueueDepth + kEncoders) spares_.push_back(std::move(frame));
+    ++next_write_;
+    --in_hand_;
     changed_.notify_all();
   }
 }
 
-Status FrameWriter::write(const FinishedFrame& finished_) {
-  const uint32_t width = options_.size.width;
-  const uint32_t height = options_.size.height;
-  const size_t pixels = size_t{width} * height;
-  // Each layer's compression suits its data (1280x720, every AOV, one core: PIZ 36 ms vs ZIP 56 for
-  // the beauty, RLE 18 vs ZIP 53 per water layer, at most 6 % larger; see the README).
-  ExrFrame frame;
-  frame.width = static_cast<int>(width);
-  frame.height = static_cast<int>(height);
-  frame.rgba_half = finished_.color_halves.data();  // half as rendered: no rounding anywhere
-  frame.rgba_compression = ExrCompression::kPiz;
-  if (options_.depth_aov) {
-    depth_.resize(pixels);
-    const Camera& camera = finished_.camera;
-    for (size_t i = 0; i < pixels; ++i) {
-      depth_[i] = linear_depth(finished_.window_depth[i], camera.near_plane, camera.far_plane);
-    }
-    frame.layers.push_back({"depth", ExrCompression::kZip, {{"depth.Z", depth_.data()}}});
-  }
-  if (options_.flow_aov || options_.particles_aov) decode_flow_texture(finished_.flow_texture);
-  // The flow texture upsampled (nearest) to the output: the texel under each pixel.
-  const auto for_each_pixel = [&](auto&& visit) {
-    for (uint32_t y = 0; y < height; ++y) {
-      const size_t texel_row = size_t{y / layout_.texel_px} * layout_.flow_extent.x;
-      for (uint32_t x = 0; x < width; ++x) visit(size_t{y} * width + x, texel_row + texel_column_[x]);
-    }
-  };
-  // Flow, mask and ids are constant over texels and regions: deflate finds the repeated rows.
-  if (options_.flow_aov) {
-    for (std::vector<float>& plane : flow_) plane.resize(pixels);
-    for_each_pixel([&](size_t pixel, size_t texel) {
-      for (int c = 0; c < 3; ++c) flow_[c][pixel] = texel_flow_[texel][c];
-    });
-    ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"flow", ExrCompression::kZip, {}});
-    for (int c = 0; c < 3; ++c) layer.channels.push_back({kFlowChannels[c], flow_[c].data()});
-    frame.layers.push_back({"water", ExrCompression::kZip, {{"water.mask", finished_.water_mask.data()}}});
-  }
-  if (options_.particles_aov) {
-    // The flow texture holds GPU slots; the layer and the CSV use the ids unique over the run.
-    std::vector<float> id_of_slot(size_t{layout_.slot_count} + 1, -1.0f);
-    for (const Particle& particle : finished_.particles) id_of_slot[particle.slot] = static_cast<float>(particle.id);
-    particle_id_.resize(pixels);
-    for_each_pixel([&](size_t pixel, size_t texel) {
-      const uint32_t slot = texel_slot_[texel];
-      const bool on_water = finished_.water_mask[pixel] > 0.5f;
-      particle_id_[pixel] = on_water && slot <= layout_.slot_count ? id_of_slot[slot] : -1.0f;
-    });
-    frame.layers.push_back({"particle", ExrCompression::kZip, {{"particle.id", particle_id_.data()}}});
-  }
-  // The water's own layers are zero off the water, which RLE packs as well as deflate does, and
-  // their noisy low mantissa bytes on it defeat deflate: RLE at a third of its time.
-  const auto add_rgb = [&](const char* name, const std::vector<float>& rgba, const char* const channels[3]) {
-    ExrLayer& layer = frame.layers.emplace_back(ExrLayer{name, ExrCompression::kRle, {}});
-    for (int c = 0; c < 3; ++c) layer.channels.push_back({channels[c], rgba.data() + c, 4});
-  };
-  if (options_.normal_aov) add_rgb("normal", finished_.normal, kNormalChannels);
-  if (options_.reflection_aov) add_rgb("reflection", finished_.reflection, kReflectionChannels);
-  if (options_.foam_aov) frame.layers.push_back({"foam", ExrCompression::kZip, {{"foam.Y", finished_.foam.data()}}});
-  frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
-  frame.metadata.frame = static_cast<int>(finished_.frame);
-  frame.metadata.time_seconds = static_cast<float>(finished_.frame / options_.fps);
-  frame.metadata.seed = static_cast<int>(options_.seed);
-  frame.metadata.software_version = version_string();
-
-  const std::string exr = options_.out_dir + "/" + frame_file_name(finished_.frame);
+Status FrameWriter::write(const EncodedFrame& encoded) const {
+  const std::string exr = options_.out_dir + "/" + frame_file_name(encoded.frame);
   const std::string base = exr.substr(0, exr.size() - 4);
-  SIVIFLOW_TRY(write_exr(exr, frame));
+  SIVIFLOW_TRY(write_file_atomically(exr, encoded.exr.data(), encoded.exr.size()));
   if (options_.particles_aov) {
-    const Status csv = write_particles_csv(finished_, base + ".particles.csv");
+    const Status csv = write_file_atomically(base + ".particles.csv", encoded.particles_csv.data(),
+                                             encoded.particles_csv.size());
     if (!csv.ok()) {
       std::remove(exr.c_str());  // a frame is its EXR and its CSV, or nothing
       return csv;
     }
   }
   if (options_.preview) {
-    rgba_.resize(pixels * 4);
-    for (size_t i = 0; i < pixels * 4; ++i) rgba_[i] = glm::unpackHalf1x16(finished_.color_halves[i]);
-    SIVIFLOW_TRY(write_png(base + ".png", frame.width, frame.height, rgba_.data(), PngChannels::kRgb));
+    SIVIFLOW_TRY(write_file_atomically(base + ".png", encoded.preview.data(), encoded.preview.size()));
   }
   return Status::success();
-}
-
-void FrameWriter::decode_flow_texture(const std::vector<std::byte>& flow_texture) {
-  const size_t texels = size_t{layout_.flow_extent.x} * layout_.flow_extent.y;
-  texel_flow_.resize(texels);
-  texel_slot_.resize(texels);
-  for (size_t t = 0; t < texels; ++t) {
-    gpu::FlowTexel texel{};
-    std::memcpy(&texel, flow_texture.data() + t * sizeof(texel), sizeof(texel));
-    texel_slot_[t] = texel.id;
-    texel_flow_[t] = texel.id == SIVIFLOW_PARTICLE_NONE ? glm::vec3(0.0f) : decode_flow(texel);
-  }
-}
-
-Status FrameWriter::write_particles_csv(const FinishedFrame& finished_,
-                                        const std::string& path) const {
-  std::string csv = "id,state,sx,sy,wx,wy,wz,fx,fy,fz,speed,depth,slope,fade\n";
-  char row[512];
-  for (const Particle& p : finished_.particles) {
-    std::snprintf(row, sizeof(row), "%u,%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
-                  p.id, to_string(p.state), p.screen.x, p.screen.y, p.world.x, p.world.y, p.world.z,
-                  p.flow.x, p.flow.y, p.flow.z, p.speed, p.depth, p.slope, p.fade);
-    csv += row;
-  }
-  return write_file_atomically(path, csv.data(), csv.size());
 }
 
 }  // namespace siviflow

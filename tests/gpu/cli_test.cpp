@@ -85,6 +85,25 @@ TEST_F(CliTest, FailedFrameWriteStopsTheCapture) {
   EXPECT_NE(r.output.find("File too large"), std::string::npos) << r.output;
 }
 
+TEST_F(CliTest, FailedWriteMidCaptureKeepsEarlierFramesAndWritesNoLaterOne) {
+  // A folder where frame 3 would go: its write fails while later frames are being encoded.
+  fs::create_directory(dir_ / frame_file_name(3));
+  const RunResult r = run_siviflow("capture --frames 8 --size 96x54 --aov depth --out " + dir_.string());
+  expect_error_only(r, (dir_ / frame_file_name(3)).string());
+  for (uint32_t frame = 0; frame < 3; ++frame) {
+    ExrImage image;
+    const Status read = read_exr((dir_ / frame_file_name(frame)).string(), &image);
+    EXPECT_TRUE(read.ok()) << read.message();
+  }
+  EXPECT_TRUE(fs::is_directory(dir_ / frame_file_name(3)));
+  for (uint32_t frame = 4; frame < 8; ++frame) {
+    EXPECT_FALSE(fs::exists(dir_ / frame_file_name(frame))) << "written after the failure: " << frame;
+  }
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_NE(entry.path().filename().string()[0], '.') << "temporary left: " << entry.path();
+  }
+}
+
 TEST_F(CliTest, UnwritableOutputFolder) {
   // As root every folder is writable, so when the tests run as root the tool runs as nobody.
   const bool root = geteuid() == 0;
