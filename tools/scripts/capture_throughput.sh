@@ -1,29 +1,43 @@
 #!/usr/bin/env bash
 # Capture throughput against rendering, side by side in one sitting (issue 14's figure): the wall
 # time per frame of an N-frame capture over `siviflow bench`'s median whole-frame time for the same
-# scene and size, beauty only and with every AOV.
+# scene and size, beauty only and with every AOV. Each round runs bench and both captures back to
+# back; the medians over the rounds are what to quote (the machine is shared and noisy).
 #
-# usage: tools/scripts/capture_throughput.sh BUILD_DIR [WxH] [FRAMES]   (a Release build)
+# usage: tools/scripts/capture_throughput.sh BUILD_DIR [WxH] [FRAMES] [ROUNDS]   (a Release build)
 set -euo pipefail
-build="$1" size="${2:-1280x720}" frames="${3:-30}"
+build="$1" size="${2:-1280x720}" frames="${3:-30}" rounds="${4:-3}"
 siviflow="$build/tools/siviflow"
 export VK_DRIVER_FILES="${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}"
 export LP_NUM_THREADS="${LP_NUM_THREADS:-2}"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 
-frame_ms=$("$siviflow" bench --size "$size" --frames "$frames" --json |
-  python3 -c 'import json, sys; print(json.load(sys.stdin)["frame_ms"])')
-echo "bench: median frame $frame_ms ms at $size"
-for aovs in "" "depth,flow,particles,normal,reflection,foam"; do
+# Wall milliseconds per frame of one capture into the emptied output folder.
+capture_ms() {
   rm -f "$out"/*
-  start=$(date +%s.%N)
-  "$siviflow" capture --frames "$frames" --size "$size" ${aovs:+--aov "$aovs"} --out "$out" > /dev/null
-  end=$(date +%s.%N)
-  python3 - "$start" "$end" "$frames" "$frame_ms" "${aovs:-beauty only}" <<'PY'
-import sys
-start, end, frames, frame_ms, what = float(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4]), sys.argv[5]
-per_frame = (end - start) * 1000 / frames
-print(f"capture ({what}): {per_frame:.1f} ms per frame, {per_frame / frame_ms:.2f}x the bench frame")
-PY
+  local start end
+  start=$(date +%s%N)
+  "$siviflow" capture --frames "$frames" --size "$size" "$@" --out "$out" > /dev/null
+  end=$(date +%s%N)
+  awk -v ns=$((end - start)) -v frames="$frames" 'BEGIN { printf "%.1f", ns / frames / 1e6 }'
+}
+
+rows=""
+for round in $(seq "$rounds"); do
+  bench=$("$siviflow" bench --size "$size" --frames "$frames" --json |
+    python3 -c 'import json, sys; print(json.load(sys.stdin)["frame_ms"])')
+  beauty=$(capture_ms)
+  aovs=$(capture_ms --aov depth,flow,particles,normal,reflection,foam)
+  echo "round $round: bench $bench ms, capture beauty $beauty ms, every AOV $aovs ms per frame"
+  rows+="$bench $beauty $aovs"$'\n'
 done
+python3 - "$size" "$frames" <<PY
+import statistics, sys
+rows = [list(map(float, line.split())) for line in """$rows""".strip().splitlines()]
+median = lambda values: statistics.median(values)
+bench = median([r[0] for r in rows])
+print(f"{sys.argv[1]}, {sys.argv[2]} frames, medians of {len(rows)} rounds: bench frame {bench:.1f} ms;"
+      f" capture beauty {median([r[1] for r in rows]):.1f} ms ({median([r[1] / r[0] for r in rows]):.2f}x),"
+      f" every AOV {median([r[2] for r in rows]):.1f} ms ({median([r[2] / r[0] for r in rows]):.2f}x)")
+PY
