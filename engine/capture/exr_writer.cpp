@@ -163,7 +163,15 @@ Status encode_exr_named(const ExrFrame& frame, const std::string& name,
     }
   }
 
+  // OpenEXR stores a line block raw where compressing would grow it, so the raw planes (and room
+  // for headers and offset tables) bound the file: one allocation holds it, and a buffer reused
+  // from frame to frame is never copied into a larger one.
+  size_t samples_per_pixel = 0;
+  for (const ExrLayer& layer : frame.layers) samples_per_pixel += layer.channels.size();
+  const size_t raw_bytes = width * static_cast<size_t>(frame.height) *
+                           (4 * sizeof(half) + samples_per_pixel * sizeof(float));
   bytes->clear();
+  bytes->reserve(raw_bytes + raw_bytes / 16 + (size_t{1} << 20));
   MemoryOStream stream(bytes, name.c_str());
   {
     Imf::MultiPartOutputFile file(stream, headers.data(), static_cast<int>(headers.size()));
