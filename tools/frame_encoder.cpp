@@ -71,7 +71,9 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
   const auto for_each_pixel = [&](auto&& visit) {
     for (uint32_t y = 0; y < height; ++y) {
       const size_t texel_row = size_t{y / layout_.texel_px} * layout_.flow_extent.x;
-      for (uint32_t x = 0; x < width; ++x) visit(size_t{y} * width + x, texel_row + texel_column_[x]);
+      for (uint32_t x = 0; x < width; ++x) {
+        visit(size_t{y} * width + x, texel_row + texel_column_[x]);
+      }
     }
   };
   // Flow, mask and ids are constant over texels and regions: deflate finds the repeated rows.
@@ -82,29 +84,36 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
     });
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"flow", ExrCompression::kZip, {}});
     for (int c = 0; c < 3; ++c) layer.channels.push_back({kFlowChannels[c], flow_[c].data()});
-    frame.layers.push_back({"water", ExrCompression::kZip, {{"water.mask", finished.water_mask.data()}}});
+    frame.layers.push_back(
+        {"water", ExrCompression::kZip, {{"water.mask", finished.water_mask.data()}}});
   }
   if (options_.particles_aov) {
     // The flow texture holds GPU slots; the layer and the CSV use the ids unique over the run.
     std::vector<float> id_of_slot(size_t{layout_.slot_count} + 1, -1.0f);
-    for (const Particle& particle : finished.particles) id_of_slot[particle.slot] = static_cast<float>(particle.id);
+    for (const Particle& particle : finished.particles) {
+      id_of_slot[particle.slot] = static_cast<float>(particle.id);
+    }
     particle_id_.resize(pixels);
     for_each_pixel([&](size_t pixel, size_t texel) {
       const uint32_t slot = texel_slot_[texel];
       const bool on_water = finished.water_mask[pixel] > 0.5f;
       particle_id_[pixel] = on_water && slot <= layout_.slot_count ? id_of_slot[slot] : -1.0f;
     });
-    frame.layers.push_back({"particle", ExrCompression::kZip, {{"particle.id", particle_id_.data()}}});
+    frame.layers.push_back(
+        {"particle", ExrCompression::kZip, {{"particle.id", particle_id_.data()}}});
   }
   // The water's own layers are zero off the water, which RLE packs as well as deflate does, and
   // their noisy low mantissa bytes on it defeat deflate: RLE at a third of its time.
-  const auto add_rgb = [&](const char* name, const std::vector<float>& rgba, const char* const channels[3]) {
+  const auto add_rgb = [&](const char* name, const std::vector<float>& rgba,
+                           const char* const channels[3]) {
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{name, ExrCompression::kRle, {}});
     for (int c = 0; c < 3; ++c) layer.channels.push_back({channels[c], rgba.data() + c, 4});
   };
   if (options_.normal_aov) add_rgb("normal", finished.normal, kNormalChannels);
   if (options_.reflection_aov) add_rgb("reflection", finished.reflection, kReflectionChannels);
-  if (options_.foam_aov) frame.layers.push_back({"foam", ExrCompression::kZip, {{"foam.Y", finished.foam.data()}}});
+  if (options_.foam_aov) {
+    frame.layers.push_back({"foam", ExrCompression::kZip, {{"foam.Y", finished.foam.data()}}});
+  }
   frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
   frame.metadata.frame = static_cast<int>(finished.frame);
   frame.metadata.time_seconds = static_cast<float>(finished.frame / options_.fps);
@@ -118,8 +127,11 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
   out->preview.clear();
   if (options_.preview) {
     rgba_.resize(pixels * 4);
-    for (size_t i = 0; i < pixels * 4; ++i) rgba_[i] = glm::unpackHalf1x16(finished.color_halves[i]);
-    SIVIFLOW_TRY(encode_png(frame.width, frame.height, rgba_.data(), PngChannels::kRgb, &out->preview));
+    for (size_t i = 0; i < pixels * 4; ++i) {
+      rgba_[i] = glm::unpackHalf1x16(finished.color_halves[i]);
+    }
+    SIVIFLOW_TRY(
+        encode_png(frame.width, frame.height, rgba_.data(), PngChannels::kRgb, &out->preview));
   }
   return Status::success();
 }

@@ -78,7 +78,9 @@ void FrameWriter::encode_loop(FrameEncoder* encoder) {
     } catch (const std::exception& e) {  // std::bad_alloc from a plane: the frame is not written
       status = Status::error(std::string("cannot encode: ") + e.what());
     }
-    if (!status.ok()) status = Status::error(frame_file_name(frame.frame) + ": " + status.message());
+    if (!status.ok()) {
+      status = Status::error(frame_file_name(frame.frame) + ": " + status.message());
+    }
     lock.lock();
     // Files are written, and failures reported, in frame order.
     changed_.wait(lock, [&] { return next_write_ == ticket || !failure_.ok(); });
@@ -111,7 +113,8 @@ Status FrameWriter::write(const EncodedFrame& encoded) const {
     }
   }
   if (options_.preview) {
-    SIVIFLOW_TRY(write_file_atomically(base + ".png", encoded.preview.data(), encoded.preview.size()));
+    SIVIFLOW_TRY(
+        write_file_atomically(base + ".png", encoded.preview.data(), encoded.preview.size()));
   }
   return Status::success();
 }

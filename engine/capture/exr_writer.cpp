@@ -48,7 +48,7 @@ class MemoryOStream final : public Imf::OStream {
     try {
       if (end > bytes_->size()) bytes_->resize(end);
     } catch (...) {
-      // ~MultiPartOutputFile swallows exceptions while writing the offset table; remember the failure.
+      // ~MultiPartOutputFile swallows exceptions while writing the offset tables: remember.
       failed_ = true;
       throw;
     }
@@ -80,7 +80,9 @@ Status validate(const ExrFrame& frame, const std::string& what) {
     if (!parts.insert(layer.name).second || layer.name.empty()) {
       return Status::error(what + ": layer name '" + layer.name + "' is empty or used twice");
     }
-    if (layer.channels.empty()) return Status::error(what + ": layer '" + layer.name + "' has no channels");
+    if (layer.channels.empty()) {
+      return Status::error(what + ": layer '" + layer.name + "' has no channels");
+    }
     for (const ExrChannel& channel : layer.channels) {
       if (channel.name.empty()) return Status::error(what + ": a data channel has no name");
       if (channel.pixels == nullptr || channel.stride < 1) {
@@ -105,7 +107,8 @@ Imf::Compression openexr_compression(ExrCompression compression) {
 }
 
 // A part's header: the frame's size and metadata, the part's name and compression.
-Imf::Header part_header(const ExrFrame& frame, ExrCompression compression, const std::string& name) {
+Imf::Header part_header(const ExrFrame& frame, ExrCompression compression,
+                        const std::string& name) {
   Imf::Header header(frame.width, frame.height);  // display = data window, origin top-left
   header.compression() = openexr_compression(compression);
   // Deflate level 1 is as lossless as any: on a 1280x720 frame with every AOV it encodes in 78 %
