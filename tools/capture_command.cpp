@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <memory>
 #include <optional>
 #include <string>
@@ -495,7 +496,11 @@ int run_capture(int argc, char** argv) {
     return cli::kExitOk;
   }
   Capture capture(options, std::move(scene));
-  status = capture.run();
+  try {
+    status = capture.run();
+  } catch (const std::exception& e) {  // std::bad_alloc copying a frame out: stop, with why
+    status = Status::error(std::string("capture stopped: ") + e.what());
+  }
   if (!status.ok()) return cli::fail(kCommand, status.message());
   const uint32_t range = options.end_frame - options.first_frame;
   std::printf("wrote %u of frames %u..%u to %s/frame_NNNNN.exr%s", capture.frames_written(),

@@ -4,22 +4,49 @@
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <system_error>
 
 #include "siviflow/atomic_file.h"
 #include "siviflow/frame_folder.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow {
+namespace {
+
+// Runs `step` on `frame`, turning an exception out of it (std::bad_alloc from a plane or a path)
+// into an error status, so that a writer's thread stops the capture rather than the process.
+template <typename Step>
+Status guarded(const char* action, uint32_t frame, Step&& step) noexcept {
+  try {
+    return step();
+  } catch (const std::exception& e) {
+    try {
+      return Status::error(std::string("cannot ") + action + " " + frame_file_name(frame) + ": " +
+                           e.what());
+    } catch (...) {
+      return Status::error("out of memory");
+    }
+  }
+}
+
+}  // namespace
 
 FrameWriter::FrameWriter(const CaptureOptions& options, const FlowTextureLayout& layout,
                          std::function<void(uint32_t)> on_written)
     : options_(options), on_written_(std::move(on_written)) {
+  spares_.reserve(kSpareFrames);
   for (size_t i = 0; i < kEncoders; ++i) {
     encoders_.push_back(std::make_unique<FrameEncoder>(options, layout));
   }
-  for (const std::unique_ptr<FrameEncoder>& encoder : encoders_) {
-    threads_.emplace_back([this, encoder = encoder.get()] { encode_loop(encoder); });
+  try {
+    for (const std::unique_ptr<FrameEncoder>& encoder : encoders_) {
+      threads_.emplace_back([this, encoder = encoder.get()] { encode_loop(encoder); });
+    }
+  } catch (const std::system_error& e) {  // no thread to be had: push() reports why
+    std::lock_guard lock(mutex_);
+    failure_ = Status::error(std::string("cannot start an encoding thread: ") + e.what());
   }
+  changed_.notify_all();
 }
 
 Status FrameWriter::start_encoding_threads() {
@@ -72,28 +99,26 @@ void FrameWriter::encode_loop(FrameEncoder* encoder) {
     ++in_hand_;
     changed_.notify_all();  // room in the queue
     lock.unlock();
-    Status status;
-    try {
-      status = encoder->encode(frame, &encoded);
-    } catch (const std::exception& e) {  // std::bad_alloc from a plane: the frame is not written
-      status = Status::error(std::string("cannot encode: ") + e.what());
-    }
-    if (!status.ok()) {
-      status = Status::error(frame_file_name(frame.frame) + ": " + status.message());
-    }
+    Status status = guarded("encode", frame.frame, [&] {
+      const Status encoding = encoder->encode(frame, &encoded);
+      if (encoding.ok()) return encoding;
+      return Status::error(frame_file_name(frame.frame) + ": " + encoding.message());
+    });
     lock.lock();
     // Files are written, and failures reported, in frame order.
     changed_.wait(lock, [&] { return next_write_ == ticket || !failure_.ok(); });
     if (failure_.ok() && status.ok()) {
       lock.unlock();
-      status = write(encoded);
-      if (status.ok() && on_written_) on_written_(written_ + 1);  // only this thread writes now
+      status = guarded("write", frame.frame, [&] {
+        SIVIFLOW_TRY(write(encoded));
+        if (on_written_) on_written_(written_ + 1);  // only this thread writes now
+        return Status::success();
+      });
       lock.lock();
       if (status.ok()) ++written_;
     }
     if (failure_.ok() && !status.ok()) failure_ = std::move(status);
-    // At most one frame per place it can be (queue, encoders, the capture's hands) is kept.
-    if (spares_.size() < kQueueDepth + kEncoders) spares_.push_back(std::move(frame));
+    if (spares_.size() < kSpareFrames) spares_.push_back(std::move(frame));  // capacity reserved
     ++next_write_;
     --in_hand_;
     changed_.notify_all();

@@ -28,6 +28,9 @@ class FrameWriter {
   // Frames encoded at once: one encoder's serial work (its planes, its file writes) overlaps
   // the other's compression on OpenEXR's threads.
   static constexpr size_t kEncoders = 2;
+  // Frames kept for their buffers at most: one per place a frame can be (the queue, the
+  // encoders, the capture's hands).
+  static constexpr size_t kSpareFrames = kQueueDepth + kEncoders + 1;
 
   // `layout` is the renderer's flow texture layout (fixed for the capture); `on_written` runs on
   // a writer's thread after each frame, with the count written so far.

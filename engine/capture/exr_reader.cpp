@@ -20,6 +20,7 @@
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <set>
 
 #include "siviflow/atomic_file.h"
 #include "siviflow/image_files.h"
@@ -132,16 +133,15 @@ Status check_attribute_sizes(const std::string& path, const std::string& what, i
 // Found by fuzz_exr: reading a tiled file, OpenEXR sizes its buffers from the tile description
 // (a row of tiles across the data window, and one tile) before reading any: a 534-byte file whose
 // tiles were 4x16777220 made it allocate 4 GiB. Those buffers must fit what the file could hold,
-// as the planes must.
+// as the planes must: `tile_bytes` adds up every part's so far, since a multi-part file keeps each
+// part's buffers until it closes.
 Status check_tile_buffers(const std::string& what, int64_t file_bytes, const Imf::Header& header,
-                          int64_t width, int64_t channel_count) {
+                          int64_t width, int64_t channel_count, int64_t* tile_bytes) {
   if (!header.hasTileDescription()) return Status::success();
   const Imf::TileDescription& tiles = header.tileDescription();
   const int64_t row_of_tiles = std::max<int64_t>(tiles.xSize, width) * tiles.ySize;
-  if ((row_of_tiles * channel_count * int64_t{sizeof(float)} - kFreeReadBytes) / kMaxDwaExpansion <=
-      file_bytes) {
-    return Status::success();
-  }
+  *tile_bytes += row_of_tiles * channel_count * int64_t{sizeof(float)};
+  if ((*tile_bytes - kFreeReadBytes) / kMaxDwaExpansion <= file_bytes) return Status::success();
   return Status::error(what + text_format(": its %ux%u tiles need buffers larger than a "
                                           "%lld-byte file can fill (corrupt or truncated)",
                                           tiles.xSize, tiles.ySize,
@@ -219,11 +219,13 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
   // Every part's header is checked before any plane is allocated.
   int64_t samples = 0;
   int64_t least_bytes = 0;
+  int64_t tile_bytes = 0;
+  std::set<std::string> names;
   for (int p = 0; p < file.parts(); ++p) {
     const Imf::Header& header = file.header(p);
     const std::string part = header.hasName() ? header.name() : "";
     const std::string where = file.parts() > 1 ? what + ": part '" + part + "'" : what;
-    if (header.hasType() && Imf::isDeepData(header.type())) {
+    if (Imf::isDeepData(header.type())) {
       return Status::error(where + " holds deep data (unsupported)");
     }
     if (header.dataWindow() != window) {
@@ -237,11 +239,15 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
       if (channel.xSampling != 1 || channel.ySampling != 1) {
         return Status::error(where + ": channel '" + it.name() + "' is subsampled (unsupported)");
       }
+      if (!names.insert(it.name()).second) {
+        return Status::error(where + ": channel '" + it.name() +
+                             "' is in an earlier part too (unsupported)");
+      }
       samples += pixel_count;
-      if (samples > kMaxReadSamples) return Status::error(what + ": too many samples");
+      if (samples > kMaxReadSamples) return Status::error(where + ": too many samples");
     }
     least_bytes += least_file_bytes(channel_count * pixel_count, header.compression());
-    SIVIFLOW_TRY(check_tile_buffers(where, file_bytes, header, width, channel_count));
+    SIVIFLOW_TRY(check_tile_buffers(where, file_bytes, header, width, channel_count, &tile_bytes));
   }
   SIVIFLOW_TRY(check_plausible_size(what, file_bytes, samples, least_bytes));
 
@@ -249,11 +255,7 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
     const Imf::Header& header = file.header(p);
     Imf::FrameBuffer frame_buffer;
     for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-      const auto [entry, added] = image.channels.try_emplace(it.name());
-      if (!added) {
-        return Status::error(what + ": channel '" + it.name() + "' is in two parts (unsupported)");
-      }
-      ExrPlane& plane = entry->second;
+      ExrPlane& plane = image.channels[it.name()];
       plane.type = pixel_type(it.channel().type);
       plane.compression = compression_name(header.compression());
       plane.pixels.assign(static_cast<size_t>(pixel_count), 0.0f);
@@ -261,9 +263,12 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
                                                       sizeof(float),
                                                       sizeof(float) * static_cast<size_t>(width)));
     }
-    Imf::InputPart part(file, p);
-    part.setFrameBuffer(frame_buffer);
-    part.readPixels(window.min.y, window.max.y);
+    {
+      Imf::InputPart part(file, p);
+      part.setFrameBuffer(frame_buffer);
+      part.readPixels(window.min.y, window.max.y);
+    }
+    file.flushPartCache();  // this part's line or tile buffers go before the next part's come
   }
   read_attributes(file.header(0), &image);
 

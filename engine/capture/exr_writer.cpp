@@ -75,8 +75,11 @@ Status validate(const ExrFrame& frame, const std::string& what) {
     return Status::error(what + ": give the RGBA pixels as floats or as halves, one of the two");
   }
   std::set<std::string> names = {"R", "G", "B", "A"};
-  std::set<std::string> parts = {kBeautyPart};
+  std::set<std::string> parts;
   for (const ExrLayer& layer : frame.layers) {
+    if (layer.name == kBeautyPart) {
+      return Status::error(what + ": layer name '" + layer.name + "' is the beauty's part");
+    }
     if (!parts.insert(layer.name).second || layer.name.empty()) {
       return Status::error(what + ": layer name '" + layer.name + "' is empty or used twice");
     }
@@ -85,8 +88,12 @@ Status validate(const ExrFrame& frame, const std::string& what) {
     }
     for (const ExrChannel& channel : layer.channels) {
       if (channel.name.empty()) return Status::error(what + ": a data channel has no name");
-      if (channel.pixels == nullptr || channel.stride < 1) {
+      if (channel.pixels == nullptr) {
         return Status::error(what + ": data channel '" + channel.name + "' has no pixels");
+      }
+      if (channel.stride < 1) {
+        return Status::error(what + ": data channel '" + channel.name + "' has stride " +
+                             std::to_string(channel.stride) + " (at least 1)");
       }
       if (!names.insert(channel.name).second) {
         return Status::error(what + ": channel name '" + channel.name + "' is used twice");
@@ -98,7 +105,6 @@ Status validate(const ExrFrame& frame, const std::string& what) {
 
 Imf::Compression openexr_compression(ExrCompression compression) {
   switch (compression) {
-    case ExrCompression::kNone: return Imf::NO_COMPRESSION;
     case ExrCompression::kRle: return Imf::RLE_COMPRESSION;
     case ExrCompression::kPiz: return Imf::PIZ_COMPRESSION;
     case ExrCompression::kZip: break;

@@ -7,6 +7,7 @@
 #include <ImfMultiPartInputFile.h>
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputPart.h>
+#include <ImfTiledOutputPart.h>
 #include <ImfPartType.h>
 #include <ImfTiledOutputFile.h>
 #include <ImfStandardAttributes.h>
@@ -310,14 +311,23 @@ TEST_F(ImageFilesExr, InvalidFramesAreRejectedWithoutFiles) {
   clashes_with_beauty.layers[0].channels.push_back({"A", data.depth.data()});
   EXPECT_FALSE(write_exr(file, clashes_with_beauty).ok());
 
-  for (const char* layer_name : {"rgba", "flow", ""}) {
+  for (const auto& [layer_name, problem] :
+       {std::pair{"rgba", "is the beauty's part"}, {"flow", "is empty or used twice"},
+        {"", "is empty or used twice"}}) {
     ExrFrame bad_layer = data.frame();
     bad_layer.layers.push_back({layer_name, ExrCompression::kZip, {{"foam.Y", data.depth.data()}}});
     s = write_exr(file, bad_layer);
     EXPECT_FALSE(s.ok()) << layer_name;
-    EXPECT_NE(s.message().find("layer name '" + std::string(layer_name) + "'"), std::string::npos)
+    EXPECT_NE(s.message().find("layer name '" + std::string(layer_name) + "' " + problem),
+              std::string::npos)
         << s.message();
   }
+
+  ExrFrame no_stride = data.frame();
+  no_stride.layers[0].channels[0].stride = 0;
+  s = write_exr(file, no_stride);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("'depth.Z' has stride 0 (at least 1)"), std::string::npos) << s.message();
 
   ExrFrame empty_layer = data.frame();
   empty_layer.layers.push_back({"foam", ExrCompression::kZip, {}});
@@ -358,12 +368,17 @@ TEST_F(ImageFilesExr, ReadAndCheckReportTruncatedFiles) {
 
 // Overwrites the 4-byte little-endian int `index` places after the header attribute `name`'s
 // size field (0: the size itself) in `bytes`.
+// (Every part's header has the attribute: `which` picks the first, the last or every one.)
+enum class Which { kFirst, kLast, kEvery };
 void patch_attribute_int(std::string* bytes, const std::string& name, const std::string& type,
-                         int index, int32_t value) {
+                         int index, int32_t value, Which which = Which::kFirst) {
   const std::string key = name + std::string(1, '\0') + type + std::string(1, '\0');
-  const size_t at = bytes->find(key);
+  size_t at = which == Which::kLast ? bytes->rfind(key) : bytes->find(key);
   ASSERT_NE(at, std::string::npos) << name;
-  std::memcpy(bytes->data() + at + key.size() + 4 * index, &value, 4);
+  for (; at != std::string::npos; at = bytes->find(key, at + key.size())) {
+    std::memcpy(bytes->data() + at + key.size() + 4 * index, &value, 4);
+    if (which != Which::kEvery) break;
+  }
 }
 
 // Found by fuzz_exr: OpenEXR sizes an attribute from its size field before reading it, so a
@@ -383,6 +398,22 @@ TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFile) {
             std::string::npos)
       << read.message();
   EXPECT_NE(read.message().find(bad), std::string::npos) << read.message();
+}
+
+TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFileInTheLastPart) {
+  TestFrame data(16, 16);
+  const std::string file = path("frame.exr");
+  ASSERT_TRUE(write_exr(file, data.frame()).ok());  // three parts
+  std::string bytes = read_text(file);
+  patch_attribute_int(&bytes, "compression", "compression", 0, 0x7ffffff0, Which::kLast);
+  const std::string bad = path("huge_attribute.exr");
+  write_text(bad, bytes);
+  ExrImage image;
+  const Status read = read_exr(bad, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("attribute 'compression' claims 2147483632 bytes"),
+            std::string::npos)
+      << read.message();
 }
 
 // Found by fuzz_exr: a 460-byte file whose data window said 8454152x4 made the reader allocate
@@ -435,6 +466,44 @@ TEST_F(ImageFilesExr, ReadRefusesTilesTheFileCannotFill) {
       << read.message();
 }
 
+// Each part of a multi-part file keeps its tile buffers until the file closes: 40 parts whose
+// 1x33554432 tiles each pass alone (128 MiB of buffers) need 5 GiB together from 11 KiB.
+TEST_F(ImageFilesExr, ReadRefusesTilesThePartsTogetherCannotFill) {
+  constexpr int kParts = 40;
+  const std::string file = path("tiled_parts.exr");
+  {
+    std::vector<Imf::Header> headers(kParts, Imf::Header(1, 1));
+    for (int p = 0; p < kParts; ++p) {
+      headers[p].setName("part" + std::to_string(p));
+      headers[p].setType(Imf::TILEDIMAGE);
+      headers[p].channels().insert("C" + std::to_string(p), Imf::Channel(Imf::FLOAT));
+      headers[p].setTileDescription(Imf::TileDescription(1, 1, Imf::ONE_LEVEL));
+    }
+    Imf::MultiPartOutputFile out(file.c_str(), headers.data(), kParts);
+    float pixel = 0.5f;
+    for (int p = 0; p < kParts; ++p) {
+      Imf::FrameBuffer frame_buffer;
+      frame_buffer.insert("C" + std::to_string(p),
+                          Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(&pixel), 4, 4));
+      Imf::TiledOutputPart part(out, p);
+      part.setFrameBuffer(frame_buffer);
+      part.writeTile(0, 0);
+    }
+  }
+  ExrImage image;
+  ASSERT_TRUE(read_exr(file, &image).ok()) << "the file as written reads";
+  EXPECT_EQ(image.channels.size(), size_t{kParts});
+  std::string bytes = read_text(file);
+  patch_attribute_int(&bytes, "tiles", "tiledesc", 2, 1 << 25, Which::kEvery);  // ySize
+  const std::string bad = path("huge_tiled_parts.exr");
+  write_text(bad, bytes);
+  const Status read = read_exr(bad, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("tiles need buffers larger than a"), std::string::npos)
+      << read.message();
+  EXPECT_EQ(read.message().find("part 'part0'"), std::string::npos) << "part 0 alone passes";
+}
+
 // A two-part file from another tool: part "a" holds channel `first` over 8x4 pixels, part "b"
 // holds `second` over `b_window`.
 void write_two_parts(const std::string& file, const char* first, const char* second,
@@ -467,7 +536,9 @@ TEST_F(ImageFilesExr, ReadRefusesPartsItCannotMerge) {
   ExrImage image;
   Status read = read_exr(twice, &image);
   ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("channel 'Z' is in two parts"), std::string::npos) << read.message();
+  EXPECT_NE(read.message().find("part 'b': channel 'Z' is in an earlier part too"),
+            std::string::npos)
+      << read.message();
 
   const std::string windows = path("windows.exr");
   write_two_parts(windows, "Y", "Z", Imath::Box2i(Imath::V2i(0, 0), Imath::V2i(3, 3)));

@@ -27,7 +27,7 @@ struct ExrChannel {
 };
 
 // The lossless compressions a part may use (OpenEXR's RLE, ZIP at deflate level 1, PIZ).
-enum class ExrCompression { kNone, kRle, kZip, kPiz };
+enum class ExrCompression { kRle, kZip, kPiz };
 
 // Channels written together as one part of a multi-part EXR, under the compression that suits
 // their data.
