@@ -16,12 +16,10 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
 #include <exception>
-#include <memory>
 #include <set>
 
+#include "exr_header_check.h"
 #include "siviflow/atomic_file.h"
 #include "siviflow/image_files.h"
 #include "sim/text_format.h"
@@ -73,61 +71,6 @@ Status check_regular_file(const std::string& path, const std::string& what,
   if (!S_ISREG(st.st_mode)) return Status::error(what + ": not a regular file");
   if (bytes != nullptr) *bytes = st.st_size;
   return Status::success();
-}
-
-// OpenEXR sizes an attribute's value from the size field before reading it, so a few bytes that
-// claim 2 GiB make it allocate and clear 2 GiB. Walks every header of the file (name, type, size,
-// value; an empty name ends a header, and an empty header ends a multi-part file's headers) and
-// refuses a size that runs past the end of the file, before OpenEXR opens it.
-Status check_attribute_sizes(const std::string& path, const std::string& what, int64_t file_bytes) {
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                             &std::fclose);
-  if (!file) return Status::error(what + ": " + errno_message(errno));
-  std::FILE* f = file.get();
-  unsigned char magic_and_version[8];
-  if (std::fread(magic_and_version, 1, 8, f) != 8) {
-    return Status::error(what + ": too short for an EXR header");
-  }
-  constexpr unsigned char kMagic[4] = {0x76, 0x2f, 0x31, 0x01};
-  if (std::memcmp(magic_and_version, kMagic, 4) != 0) {
-    return Status::error(what + ": not an EXR file (no EXR magic number)");
-  }
-  const bool multi_part = (magic_and_version[5] & 0x10) != 0;  // version bit 12
-  const auto read_text = [&](std::string* text) {  // NUL-terminated, at most 255 characters
-    text->clear();
-    for (int c = std::fgetc(f); c != 0; c = std::fgetc(f)) {
-      if (c == EOF || text->size() == 255) return false;
-      text->push_back(static_cast<char>(c));
-    }
-    return true;
-  };
-  std::string name;
-  std::string type;
-  for (;;) {
-    if (!read_text(&name)) return Status::error(what + ": header ends inside an attribute name");
-    if (name.empty()) return Status::success();  // no attribute, or after the last header
-    for (;;) {
-      unsigned char size_bytes[4];
-      if (!read_text(&type) || std::fread(size_bytes, 1, 4, f) != 4) {
-        return Status::error(what + ": header ends inside attribute '" + name + "'");
-      }
-      const int64_t size = static_cast<int32_t>(uint32_t{size_bytes[0]} |
-                                                uint32_t{size_bytes[1]} << 8 |
-                                                uint32_t{size_bytes[2]} << 16 |
-                                                uint32_t{size_bytes[3]} << 24);
-      const int64_t at = std::ftell(f);
-      if (size < 0 || size > file_bytes - at) {
-        return Status::error(what + text_format(": attribute '%s' claims %lld bytes, but the "
-                                                "file has %lld left",
-                                                name.c_str(), static_cast<long long>(size),
-                                                static_cast<long long>(file_bytes - at)));
-      }
-      std::fseek(f, static_cast<long>(size), SEEK_CUR);
-      if (!read_text(&name)) return Status::error(what + ": header ends inside an attribute name");
-      if (name.empty()) break;
-    }
-    if (!multi_part) return Status::success();
-  }
 }
 
 // Found by fuzz_exr: reading a tiled file, OpenEXR sizes its buffers from the tile description
@@ -200,7 +143,7 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
   if (out == nullptr) return Status::error(what + ": no output image");
   int64_t file_bytes = 0;
   SIVIFLOW_TRY(check_regular_file(path, what, &file_bytes));
-  SIVIFLOW_TRY(check_attribute_sizes(path, what, file_bytes));
+  SIVIFLOW_TRY(check_exr_headers(path, what, file_bytes));
 
   Imf::MultiPartInputFile file(path.c_str());
   const Imath::Box2i window = file.header(0).dataWindow();

@@ -388,16 +388,23 @@ TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFile) {
   const std::string file = path("frame.exr");
   ASSERT_TRUE(write_exr(file, data.frame()).ok());
   std::string bytes = read_text(file);
-  patch_attribute_int(&bytes, "compression", "compression", 0, 0x7ffffff0);
+  patch_attribute_int(&bytes, kExrAttrScene, "string", 0, 0x7ffffff0);
   const std::string bad = path("huge_attribute.exr");
   write_text(bad, bytes);
   ExrImage image;
   const Status read = read_exr(bad, &image);
   ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("attribute 'compression' claims 2147483632 bytes"),
+  EXPECT_NE(read.message().find("attribute 'siviflow/scene' claims 2147483632 bytes"),
             std::string::npos)
       << read.message();
   EXPECT_NE(read.message().find(bad), std::string::npos) << read.message();
+
+  // A fixed-size type is read whole whatever its size field says, as OpenEXR reads it.
+  std::string compression = read_text(file);
+  patch_attribute_int(&compression, "compression", "compression", 0, 0x7ffffff0);
+  write_text(bad, compression);
+  const Status fixed = read_exr(bad, &image);
+  EXPECT_TRUE(fixed.ok()) << fixed.message();
 }
 
 TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFileInTheLastPart) {
@@ -405,15 +412,37 @@ TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFileInTheLastPart) {
   const std::string file = path("frame.exr");
   ASSERT_TRUE(write_exr(file, data.frame()).ok());  // three parts
   std::string bytes = read_text(file);
-  patch_attribute_int(&bytes, "compression", "compression", 0, 0x7ffffff0, Which::kLast);
+  patch_attribute_int(&bytes, kExrAttrScene, "string", 0, 0x7ffffff0, Which::kLast);
   const std::string bad = path("huge_attribute.exr");
   write_text(bad, bytes);
   ExrImage image;
   const Status read = read_exr(bad, &image);
   ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("attribute 'compression' claims 2147483632 bytes"),
+  EXPECT_NE(read.message().find("attribute 'siviflow/scene' claims 2147483632 bytes"),
             std::string::npos)
       << read.message();
+}
+
+// Found by fuzz_exr: OpenEXR reads a channel list up to its empty name, not by its size field, so
+// a walk that skipped by the size found this file's headers ending early, while OpenEXR went on
+// to an attribute of an unknown type claiming 1.8 GB, and allocated it.
+TEST_F(ImageFilesExr, ReadWalksChannelListsAsOpenExrReadsThem) {
+  const unsigned char file[] = {
+      0x76, 0x2f, 0x31, 0x01, 0x02, 0x10, 0x00, 0x00, 0x63, 0x68, 0x61, 0x6e, 0x6e, 0x65, 0x6c,
+      0x73, 0x00, 0x63, 0x68, 0x6c, 0x69, 0x73, 0x74, 0x00, 0x49, 0x00, 0x00, 0x00, 0x41, 0x00,
+      0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x47, 0x00, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00,
+      0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x52, 0x00, 0x01, 0x00, 0x00, 0x00,
+      0x00, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x6f, 0x6e, 0x00, 0x01, 0x00, 0x00, 0x00, 0x04,
+      0x64, 0x61, 0x74, 0x61, 0x57, 0x69, 0x6e, 0x64, 0x6f, 0x77, 0x00, 0x62, 0x6f, 0x78, 0x32,
+      0x69, 0x00, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1f,
+      0x00, 0x00, 0x00, 0x11, 0x70, 0x6c, 0x61, 0x79, 0x57, 0x69, 0x6e, 0x64, 0x6f, 0x77, 0x00,
+      0x62, 0xff, 0xff, 0xff, 0xff, 0xff, 0x2f, 0x31, 0xff, 0x01};
+  const std::string bad = path("channel_list.exr");
+  write_text(bad, std::string(reinterpret_cast<const char*>(file), sizeof(file)));
+  ExrImage image;
+  const Status read = read_exr(bad, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("claims"), std::string::npos) << read.message();
 }
 
 // Found by fuzz_exr: a 460-byte file whose data window said 8454152x4 made the reader allocate
