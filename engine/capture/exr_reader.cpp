@@ -10,6 +10,7 @@
 #include <ImfMultiPartInputFile.h>
 #include <ImfPartType.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 #include <ImfTileDescriptionAttribute.h>
 #include <sys/stat.h>
 
@@ -73,21 +74,50 @@ Status check_regular_file(const std::string& path, const std::string& what,
   return Status::success();
 }
 
-// Found by fuzz_exr: reading a tiled file, OpenEXR sizes its buffers from the tile description
-// (a row of tiles across the data window, and one tile) before reading any: a 534-byte file whose
-// tiles were 4x16777220 made it allocate 4 GiB. Those buffers must fit what the file could hold,
-// as the planes must: `tile_bytes` adds up every part's so far, since a multi-part file keeps each
-// part's buffers until it closes.
-Status check_tile_buffers(const std::string& what, int64_t file_bytes, const Imf::Header& header,
-                          int64_t width, int64_t channel_count, int64_t* tile_bytes) {
-  if (!header.hasTileDescription()) return Status::success();
-  const Imf::TileDescription& tiles = header.tileDescription();
-  const int64_t row_of_tiles = std::max<int64_t>(tiles.xSize, width) * tiles.ySize;
-  *tile_bytes += row_of_tiles * channel_count * int64_t{sizeof(float)};
-  if ((*tile_bytes - kFreeReadBytes) / kMaxDwaExpansion <= file_bytes) return Status::success();
-  return Status::error(what + text_format(": its %ux%u tiles need buffers larger than a "
-                                          "%lld-byte file can fill (corrupt or truncated)",
-                                          tiles.xSize, tiles.ySize,
+// Scan lines OpenEXR decodes together under a compression: its line buffers are this tall
+// whatever the image's height.
+int64_t lines_per_block(Imf::Compression compression) {
+  switch (compression) {
+    case Imf::NO_COMPRESSION:
+    case Imf::RLE_COMPRESSION:
+    case Imf::ZIPS_COMPRESSION: return 1;
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION: return 16;
+    case Imf::PIZ_COMPRESSION:
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION:
+    case Imf::DWAA_COMPRESSION: return 32;
+    default: return 256;  // DWAB, and the most any codec takes
+  }
+}
+
+// Found by fuzz_exr: OpenEXR sizes its read buffers from the header before reading any pixel. A
+// tiled part's hold a row of tiles across the data window (a 534-byte file whose tiles were
+// 4x16777220 made it allocate 4 GiB); a scan-line part's, a block of lines per thread (a 1-KiB
+// DWAA file 4194312 pixels wide and 4 high, 1 GiB). Those buffers must fit what the file could
+// hold, as the planes must: `buffer_bytes` adds up every part's so far, since a multi-part file
+// keeps each part's until it closes.
+Status check_read_buffers(const std::string& what, int64_t file_bytes, const Imf::Header& header,
+                          int64_t width, int64_t channel_count, int64_t* buffer_bytes) {
+  const int64_t sample_bytes = channel_count * int64_t{sizeof(float)};
+  if (header.hasTileDescription()) {
+    const Imf::TileDescription& tiles = header.tileDescription();
+    *buffer_bytes += std::max<int64_t>(tiles.xSize, width) * tiles.ySize * sample_bytes;
+    if ((*buffer_bytes - kFreeReadBytes) / kMaxDwaExpansion <= file_bytes) return Status::success();
+    return Status::error(what + text_format(": its %ux%u tiles need buffers larger than a "
+                                            "%lld-byte file can fill (corrupt or truncated)",
+                                            tiles.xSize, tiles.ySize,
+                                            static_cast<long long>(file_bytes)));
+  }
+  const int64_t line_buffers = std::max(1, 2 * Imf::globalThreadCount());
+  const int64_t lines = lines_per_block(header.compression());
+  *buffer_bytes += width * lines * sample_bytes * line_buffers;
+  if ((*buffer_bytes - kFreeReadBytes) / kMaxDwaExpansion <= file_bytes) return Status::success();
+  return Status::error(what + text_format(": its %lld-pixel rows in blocks of %lld lines need "
+                                          "buffers larger than a %lld-byte file can fill "
+                                          "(corrupt or truncated)",
+                                          static_cast<long long>(width),
+                                          static_cast<long long>(lines),
                                           static_cast<long long>(file_bytes)));
 }
 
@@ -97,7 +127,8 @@ int64_t least_file_bytes(int64_t samples, Imf::Compression compression) {
   return samples * int64_t{sizeof(float)} / (dwa ? kMaxDwaExpansion : kMaxExpansion);
 }
 
-// Refuses headers whose planes could not come from a file of this size, before allocating them.
+// Refuses headers whose planes (`samples` so far, which take `least_bytes` of file at the least)
+// could not come from a file of this size, before allocating them.
 Status check_plausible_size(const std::string& what, int64_t file_bytes, int64_t samples,
                             int64_t least_bytes) {
   const int64_t plane_bytes = samples * int64_t{sizeof(float)};
@@ -162,7 +193,7 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
   // Every part's header is checked before any plane is allocated.
   int64_t samples = 0;
   int64_t least_bytes = 0;
-  int64_t tile_bytes = 0;
+  int64_t buffer_bytes = 0;
   std::set<std::string> names;
   for (int p = 0; p < file.parts(); ++p) {
     const Imf::Header& header = file.header(p);
@@ -190,9 +221,10 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
       if (samples > kMaxReadSamples) return Status::error(where + ": too many samples");
     }
     least_bytes += least_file_bytes(channel_count * pixel_count, header.compression());
-    SIVIFLOW_TRY(check_tile_buffers(where, file_bytes, header, width, channel_count, &tile_bytes));
+    SIVIFLOW_TRY(check_plausible_size(where, file_bytes, samples, least_bytes));
+    SIVIFLOW_TRY(
+        check_read_buffers(where, file_bytes, header, width, channel_count, &buffer_bytes));
   }
-  SIVIFLOW_TRY(check_plausible_size(what, file_bytes, samples, least_bytes));
 
   for (int p = 0; p < file.parts(); ++p) {
     const Imf::Header& header = file.header(p);

@@ -6,6 +6,7 @@
 #include <ImfIntAttribute.h>
 #include <ImfMultiPartInputFile.h>
 #include <ImfMultiPartOutputFile.h>
+#include <ImfOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfTiledOutputPart.h>
 #include <ImfPartType.h>
@@ -491,6 +492,35 @@ TEST_F(ImageFilesExr, ReadRefusesTilesTheFileCannotFill) {
   const Status read = read_exr(bad, &image);
   ASSERT_FALSE(read.ok());
   EXPECT_NE(read.message().find("its 4x16777220 tiles need buffers larger than a"),
+            std::string::npos)
+      << read.message();
+}
+
+// Found by fuzz_exr: OpenEXR decodes DWAA in blocks of 32 lines, whatever the image's height, so
+// a short image of enormous width made it allocate 1 GiB of line buffers from a 1-KiB file.
+TEST_F(ImageFilesExr, ReadRefusesLineBuffersTheFileCannotFill) {
+  const std::string file = path("short.exr");
+  {
+    Imf::Header header(8, 4);
+    header.compression() = Imf::DWAA_COMPRESSION;
+    header.channels().insert("Y", Imf::Channel(Imf::HALF));
+    std::vector<half> pixels(32, half(0.5f));
+    Imf::FrameBuffer frame_buffer;
+    frame_buffer.insert("Y", Imf::Slice(Imf::HALF, reinterpret_cast<char*>(pixels.data()),
+                                        sizeof(half), sizeof(half) * 8));
+    Imf::OutputFile out(file.c_str(), header);
+    out.setFrameBuffer(frame_buffer);
+    out.writePixels(4);
+  }
+  ExrImage image;
+  ASSERT_TRUE(read_exr(file, &image).ok()) << "the file as written reads";
+  std::string bytes = read_text(file);
+  patch_attribute_int(&bytes, "dataWindow", "box2i", 3, 4194311);  // xMax: the block stays one
+  const std::string bad = path("wide.exr");
+  write_text(bad, bytes);
+  const Status read = read_exr(bad, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("its 4194312-pixel rows in blocks of 32 lines need buffers"),
             std::string::npos)
       << read.message();
 }
