@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string_view>
 
@@ -96,8 +97,11 @@ Status HeaderWalk::skip_value(const std::string& name, const std::string& type, 
     int64_t width = 0;
     int64_t height = 0;
     if (!read_int(&width) || !read_int(&height)) return ends_inside;
-    return skip(name, static_cast<int64_t>(static_cast<uint32_t>(width)) *
-                          static_cast<uint32_t>(height) * 4);
+    const uint64_t pixels =
+        uint64_t{static_cast<uint32_t>(width)} * static_cast<uint32_t>(height);
+    constexpr uint64_t kMostPixels = std::numeric_limits<int64_t>::max() / 4;
+    return skip(name, pixels > kMostPixels ? std::numeric_limits<int64_t>::max()
+                                           : static_cast<int64_t>(pixels * 4));
   }
   if (type == "stringvector") {  // strings, each after its length, until `size` is read
     for (int64_t read = 0; read < size;) {

@@ -496,6 +496,20 @@ TEST_F(ImageFilesExr, ReadRefusesTilesTheFileCannotFill) {
       << read.message();
 }
 
+// Found by fuzz_exr: a preview's size is its width times its height times 4, which overflowed.
+TEST_F(ImageFilesExr, ReadRefusesPreviewLargerThanTheFile) {
+  std::string bytes("v/1\x01\x02\0\0\0preview\0preview\0\x08\0\0\0", 28);
+  bytes += std::string(8, '\xff');  // 4294967295 x 4294967295
+  bytes += std::string(1, '\0');
+  const std::string bad = path("preview.exr");
+  write_text(bad, bytes);
+  ExrImage image;
+  const Status read = read_exr(bad, &image);
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("attribute 'preview' claims"), std::string::npos)
+      << read.message();
+}
+
 // Found by fuzz_exr: OpenEXR decodes DWAA in blocks of 32 lines, whatever the image's height, so
 // a short image of enormous width made it allocate 1 GiB of line buffers from a 1-KiB file.
 TEST_F(ImageFilesExr, ReadRefusesLineBuffersTheFileCannotFill) {
