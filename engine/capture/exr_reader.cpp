@@ -18,6 +18,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <exception>
+#include <limits>
 #include <set>
 
 #include "exr_header_check.h"
@@ -74,6 +75,12 @@ Status check_regular_file(const std::string& path, const std::string& what,
   return Status::success();
 }
 
+// a * b for sizes from an untrusted header (neither negative): INT64_MAX where it overflows.
+int64_t saturating_product(int64_t a, int64_t b) {
+  constexpr int64_t kMost = std::numeric_limits<int64_t>::max();
+  return a != 0 && b > kMost / a ? kMost : a * b;
+}
+
 // Scan lines OpenEXR decodes together under a compression: its line buffers are this tall
 // whatever the image's height.
 int64_t lines_per_block(Imf::Compression compression) {
@@ -100,9 +107,16 @@ int64_t lines_per_block(Imf::Compression compression) {
 Status check_read_buffers(const std::string& what, int64_t file_bytes, const Imf::Header& header,
                           int64_t width, int64_t channel_count, int64_t* buffer_bytes) {
   const int64_t sample_bytes = channel_count * int64_t{sizeof(float)};
+  // The sum saturates: it only has to be too large.
+  const auto add = [buffer_bytes](int64_t bytes) {
+    *buffer_bytes = bytes > std::numeric_limits<int64_t>::max() - *buffer_bytes
+                        ? std::numeric_limits<int64_t>::max()
+                        : *buffer_bytes + bytes;
+  };
   if (header.hasTileDescription()) {
     const Imf::TileDescription& tiles = header.tileDescription();
-    *buffer_bytes += std::max<int64_t>(tiles.xSize, width) * tiles.ySize * sample_bytes;
+    add(saturating_product(
+        saturating_product(std::max<int64_t>(tiles.xSize, width), tiles.ySize), sample_bytes));
     if ((*buffer_bytes - kFreeReadBytes) / kMaxDwaExpansion <= file_bytes) return Status::success();
     return Status::error(what + text_format(": its %ux%u tiles need buffers larger than a "
                                             "%lld-byte file can fill (corrupt or truncated)",
@@ -111,7 +125,7 @@ Status check_read_buffers(const std::string& what, int64_t file_bytes, const Imf
   }
   const int64_t line_buffers = std::max(1, 2 * Imf::globalThreadCount());
   const int64_t lines = lines_per_block(header.compression());
-  *buffer_bytes += width * lines * sample_bytes * line_buffers;
+  add(saturating_product(saturating_product(width * lines, sample_bytes), line_buffers));
   if ((*buffer_bytes - kFreeReadBytes) / kMaxDwaExpansion <= file_bytes) return Status::success();
   return Status::error(what + text_format(": its %lld-pixel rows in blocks of %lld lines need "
                                           "buffers larger than a %lld-byte file can fill "

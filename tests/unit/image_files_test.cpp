@@ -494,6 +494,16 @@ TEST_F(ImageFilesExr, ReadRefusesTilesTheFileCannotFill) {
   EXPECT_NE(read.message().find("its 4x16777220 tiles need buffers larger than a"),
             std::string::npos)
       << read.message();
+
+  // Found by fuzz_exr under UBSan: the buffers' size of such tiles overflowed.
+  patch_attribute_int(&bytes, "tiles", "tiledesc", 1, 0x7fffffff);  // xSize
+  patch_attribute_int(&bytes, "tiles", "tiledesc", 2, 0x7fffffff);  // ySize
+  write_text(bad, bytes);
+  const Status overflow = read_exr(bad, &image);
+  ASSERT_FALSE(overflow.ok());
+  EXPECT_NE(overflow.message().find("its 2147483647x2147483647 tiles need buffers"),
+            std::string::npos)
+      << overflow.message();
 }
 
 // Found by fuzz_exr: a preview's size is its width times its height times 4, which overflowed.
