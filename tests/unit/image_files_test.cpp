@@ -119,6 +119,21 @@ class ImageFilesTest : public ::testing::Test {
     fs::remove_all(dir_, ec);
   }
   std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  // read_exr must refuse `file` with a message naming it and holding `problem`; the message.
+  std::string expect_refused(const std::string& file, const std::string& problem) const {
+    ExrImage image;
+    const Status read = read_exr(file, &image);
+    EXPECT_FALSE(read.ok()) << file;
+    EXPECT_NE(read.message().find(problem), std::string::npos) << read.message();
+    EXPECT_NE(read.message().find(file), std::string::npos) << read.message();
+    return read.message();
+  }
+  // The same for `bytes`, written to `name` in the test's folder.
+  std::string expect_refused(const std::string& name, const std::string& bytes,
+                             const std::string& problem) const {
+    write_text(path(name), bytes);
+    return expect_refused(path(name), problem);
+  }
 
   std::string dir_;
 };
@@ -328,7 +343,8 @@ TEST_F(ImageFilesExr, InvalidFramesAreRejectedWithoutFiles) {
   no_stride.layers[0].channels[0].stride = 0;
   s = write_exr(file, no_stride);
   EXPECT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("'depth.Z' has stride 0 (at least 1)"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("'depth.Z' has stride 0 (at least 1)"), std::string::npos)
+      << s.message();
 
   ExrFrame empty_layer = data.frame();
   empty_layer.layers.push_back({"foam", ExrCompression::kZip, {}});
@@ -387,41 +403,22 @@ void patch_attribute_int(std::string* bytes, const std::string& name, const std:
 TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFile) {
   TestFrame data(16, 16);
   const std::string file = path("frame.exr");
-  ASSERT_TRUE(write_exr(file, data.frame()).ok());
-  std::string bytes = read_text(file);
-  patch_attribute_int(&bytes, kExrAttrScene, "string", 0, 0x7ffffff0);
-  const std::string bad = path("huge_attribute.exr");
-  write_text(bad, bytes);
-  ExrImage image;
-  const Status read = read_exr(bad, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("attribute 'siviflow/scene' claims 2147483632 bytes"),
-            std::string::npos)
-      << read.message();
-  EXPECT_NE(read.message().find(bad), std::string::npos) << read.message();
+  ASSERT_TRUE(write_exr(file, data.frame()).ok());  // three parts, each with the metadata
+  for (const Which which : {Which::kFirst, Which::kLast}) {
+    std::string bytes = read_text(file);
+    patch_attribute_int(&bytes, kExrAttrScene, "string", 0, 0x7ffffff0, which);
+    expect_refused("huge_attribute.exr", bytes,
+                   "attribute 'siviflow/scene' claims 2147483632 bytes");
+  }
 
   // A fixed-size type is read whole whatever its size field says, as OpenEXR reads it.
   std::string compression = read_text(file);
   patch_attribute_int(&compression, "compression", "compression", 0, 0x7ffffff0);
-  write_text(bad, compression);
-  const Status fixed = read_exr(bad, &image);
-  EXPECT_TRUE(fixed.ok()) << fixed.message();
-}
-
-TEST_F(ImageFilesExr, ReadRefusesAttributeLargerThanTheFileInTheLastPart) {
-  TestFrame data(16, 16);
-  const std::string file = path("frame.exr");
-  ASSERT_TRUE(write_exr(file, data.frame()).ok());  // three parts
-  std::string bytes = read_text(file);
-  patch_attribute_int(&bytes, kExrAttrScene, "string", 0, 0x7ffffff0, Which::kLast);
-  const std::string bad = path("huge_attribute.exr");
-  write_text(bad, bytes);
+  const std::string fixed_file = path("fixed.exr");
+  write_text(fixed_file, compression);
   ExrImage image;
-  const Status read = read_exr(bad, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("attribute 'siviflow/scene' claims 2147483632 bytes"),
-            std::string::npos)
-      << read.message();
+  const Status fixed = read_exr(fixed_file, &image);
+  EXPECT_TRUE(fixed.ok()) << fixed.message();
 }
 
 // Found by fuzz_exr: OpenEXR reads a channel list up to its empty name, not by its size field, so
@@ -438,12 +435,8 @@ TEST_F(ImageFilesExr, ReadWalksChannelListsAsOpenExrReadsThem) {
       0x69, 0x00, 0x10, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1f,
       0x00, 0x00, 0x00, 0x11, 0x70, 0x6c, 0x61, 0x79, 0x57, 0x69, 0x6e, 0x64, 0x6f, 0x77, 0x00,
       0x62, 0xff, 0xff, 0xff, 0xff, 0xff, 0x2f, 0x31, 0xff, 0x01};
-  const std::string bad = path("channel_list.exr");
-  write_text(bad, std::string(reinterpret_cast<const char*>(file), sizeof(file)));
-  ExrImage image;
-  const Status read = read_exr(bad, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("claims"), std::string::npos) << read.message();
+  expect_refused("channel_list.exr", std::string(reinterpret_cast<const char*>(file), sizeof(file)),
+                 "claims");
 }
 
 // Found by fuzz_exr: a 460-byte file whose data window said 8454152x4 made the reader allocate
@@ -456,15 +449,9 @@ TEST_F(ImageFilesExr, ReadRefusesDataWindowTheFileCannotHold) {
   ASSERT_TRUE(write_exr(file, beauty).ok());
   std::string bytes = read_text(file);
   patch_attribute_int(&bytes, "dataWindow", "box2i", 3, 8000000);  // xMax
-  const std::string bad = path("huge_window.exr");
-  write_text(bad, bytes);
-  ExrImage image;
-  const Status read = read_exr(bad, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("more than a " + std::to_string(bytes.size()) + "-byte"),
-            std::string::npos)
-      << read.message();
-  EXPECT_NE(read.message().find("(corrupt or truncated)"), std::string::npos) << read.message();
+  const std::string message = expect_refused(
+      "huge_window.exr", bytes, "more than a " + std::to_string(bytes.size()) + "-byte");
+  EXPECT_NE(message.find("(corrupt or truncated)"), std::string::npos) << message;
 }
 
 // Found by the hour-long fuzz_exr run: a tiled file whose tiles were 4x16777220 made OpenEXR
@@ -487,23 +474,12 @@ TEST_F(ImageFilesExr, ReadRefusesTilesTheFileCannotFill) {
   ASSERT_TRUE(read_exr(file, &image).ok()) << "the file as written reads";
   std::string bytes = read_text(file);
   patch_attribute_int(&bytes, "tiles", "tiledesc", 2, 16777220);  // ySize
-  const std::string bad = path("huge_tiles.exr");
-  write_text(bad, bytes);
-  const Status read = read_exr(bad, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("its 4x16777220 tiles need buffers larger than a"),
-            std::string::npos)
-      << read.message();
+  expect_refused("huge_tiles.exr", bytes, "its 4x16777220 tiles need buffers larger than a");
 
   // Found by fuzz_exr under UBSan: the buffers' size of such tiles overflowed.
   patch_attribute_int(&bytes, "tiles", "tiledesc", 1, 0x7fffffff);  // xSize
   patch_attribute_int(&bytes, "tiles", "tiledesc", 2, 0x7fffffff);  // ySize
-  write_text(bad, bytes);
-  const Status overflow = read_exr(bad, &image);
-  ASSERT_FALSE(overflow.ok());
-  EXPECT_NE(overflow.message().find("its 2147483647x2147483647 tiles need buffers"),
-            std::string::npos)
-      << overflow.message();
+  expect_refused("huge_tiles.exr", bytes, "its 2147483647x2147483647 tiles need buffers");
 }
 
 // Found by fuzz_exr: a preview's size is its width times its height times 4, which overflowed.
@@ -511,13 +487,7 @@ TEST_F(ImageFilesExr, ReadRefusesPreviewLargerThanTheFile) {
   std::string bytes("v/1\x01\x02\0\0\0preview\0preview\0\x08\0\0\0", 28);
   bytes += std::string(8, '\xff');  // 4294967295 x 4294967295
   bytes += std::string(1, '\0');
-  const std::string bad = path("preview.exr");
-  write_text(bad, bytes);
-  ExrImage image;
-  const Status read = read_exr(bad, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("attribute 'preview' claims"), std::string::npos)
-      << read.message();
+  expect_refused("preview.exr", bytes, "attribute 'preview' claims");
 }
 
 // Found by fuzz_exr: OpenEXR decodes DWAA in blocks of 32 lines, whatever the image's height, so
@@ -540,13 +510,7 @@ TEST_F(ImageFilesExr, ReadRefusesLineBuffersTheFileCannotFill) {
   ASSERT_TRUE(read_exr(file, &image).ok()) << "the file as written reads";
   std::string bytes = read_text(file);
   patch_attribute_int(&bytes, "dataWindow", "box2i", 3, 4194311);  // xMax: the block stays one
-  const std::string bad = path("wide.exr");
-  write_text(bad, bytes);
-  const Status read = read_exr(bad, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("its 4194312-pixel rows in blocks of 32 lines need buffers"),
-            std::string::npos)
-      << read.message();
+  expect_refused("wide.exr", bytes, "its 4194312-pixel rows in blocks of 32 lines need buffers");
 }
 
 // Each part of a multi-part file keeps its tile buffers until the file closes: 40 parts whose
@@ -578,13 +542,9 @@ TEST_F(ImageFilesExr, ReadRefusesTilesThePartsTogetherCannotFill) {
   EXPECT_EQ(image.channels.size(), size_t{kParts});
   std::string bytes = read_text(file);
   patch_attribute_int(&bytes, "tiles", "tiledesc", 2, 1 << 25, Which::kEvery);  // ySize
-  const std::string bad = path("huge_tiled_parts.exr");
-  write_text(bad, bytes);
-  const Status read = read_exr(bad, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("tiles need buffers larger than a"), std::string::npos)
-      << read.message();
-  EXPECT_EQ(read.message().find("part 'part0'"), std::string::npos) << "part 0 alone passes";
+  const std::string message =
+      expect_refused("huge_tiled_parts.exr", bytes, "tiles need buffers larger than a");
+  EXPECT_EQ(message.find("part 'part0'"), std::string::npos) << "part 0 alone passes";
 }
 
 // A two-part file from another tool: part "a" holds channel `first` over 8x4 pixels, part "b"
@@ -616,23 +576,16 @@ TEST_F(ImageFilesExr, ReadRefusesPartsItCannotMerge) {
   const Imath::Box2i same(Imath::V2i(0, 0), Imath::V2i(7, 3));
   const std::string twice = path("twice.exr");
   write_two_parts(twice, "Z", "Z", same);
-  ExrImage image;
-  Status read = read_exr(twice, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("part 'b': channel 'Z' is in an earlier part too"),
-            std::string::npos)
-      << read.message();
+  expect_refused(twice, "part 'b': channel 'Z' is in an earlier part too");
 
   const std::string windows = path("windows.exr");
   write_two_parts(windows, "Y", "Z", Imath::Box2i(Imath::V2i(0, 0), Imath::V2i(3, 3)));
-  read = read_exr(windows, &image);
-  ASSERT_FALSE(read.ok());
-  EXPECT_NE(read.message().find("part 'b' has another data window"), std::string::npos)
-      << read.message();
+  expect_refused(windows, "part 'b' has another data window");
 
   const std::string good = path("good.exr");
   write_two_parts(good, "Y", "Z", same);
-  read = read_exr(good, &image);
+  ExrImage image;
+  const Status read = read_exr(good, &image);
   ASSERT_TRUE(read.ok()) << read.message();
   EXPECT_EQ(image.parts, (std::vector<std::string>{"a", "b"}));
   EXPECT_EQ(image.channels.size(), 2u);
