@@ -1,11 +1,14 @@
-# siviflow_add_shaders(TARGET <static lib> SOURCES <glsl files> INCLUDE_DIR <dir>)
+# siviflow_add_shaders(TARGET <static lib> SOURCES <glsl files> INCLUDE_DIR <dir>
+#                      [VARIANTS <name>=<source>:<MACRO>[,<MACRO>...] ...])
 #
 # Each shader is compiled twice by glslangValidator, both with a depfile so that editing an
 # included header rebuilds it: once into a C header holding a uint32_t array (embedded in the
 # binary: no shader files to ship or find at run time) and once into a raw .spv that the
 # `shaders` test tier runs spirv-val over. A generated registry maps "name.stage" to the words.
+# A variant is a source compiled again with macros defined, under a name of its own (e.g.
+# flow_motion.frag=flow.frag:SIVIFLOW_FLOW_MOTION): outputs that differ in location per variant.
 function(siviflow_add_shaders)
-  cmake_parse_arguments(S "" "TARGET;INCLUDE_DIR" "SOURCES" ${ARGN})
+  cmake_parse_arguments(S "" "TARGET;INCLUDE_DIR" "SOURCES;VARIANTS" ${ARGN})
   set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/spirv)
   file(MAKE_DIRECTORY ${out_dir})
   set(debug_flags "$<$<CONFIG:Debug>:-g>")
@@ -13,12 +16,34 @@ function(siviflow_add_shaders)
   set(spv_files "")
   set(includes "")
   set(entries "")
+  set(builds "")  # name|source|macros
   foreach(src IN LISTS S_SOURCES)
-    get_filename_component(file_name ${src} NAME)           # scene.vert
+    get_filename_component(file_name ${src} NAME)
+    list(APPEND builds "${file_name}|${src}|")
+  endforeach()
+  foreach(variant IN LISTS S_VARIANTS)
+    if(NOT variant MATCHES "^([^=]+)=([^:]+):(.+)$")
+      message(FATAL_ERROR "siviflow_add_shaders: variant '${variant}' is not name=source:MACROS")
+    endif()
+    list(APPEND builds "${CMAKE_MATCH_1}|${CMAKE_MATCH_2}|${CMAKE_MATCH_3}")
+  endforeach()
+  foreach(build IN LISTS builds)
+    string(REPLACE "|" ";" parts "${build}")
+    list(GET parts 0 file_name)                              # scene.vert
+    list(GET parts 1 src)
+    list(LENGTH parts part_count)
+    set(defines "")
+    if(part_count GREATER 2)
+      list(GET parts 2 macros)
+      string(REPLACE "," ";" macros "${macros}")
+      foreach(macro IN LISTS macros)
+        list(APPEND defines -D${macro}=1)
+      endforeach()
+    endif()
     string(REPLACE "." "_" symbol ${file_name})              # scene_vert
     set(header ${out_dir}/${file_name}.h)
     set(spv ${out_dir}/${file_name}.spv)
-    set(common_args -V --target-env vulkan1.3 -I${S_INCLUDE_DIR} ${debug_flags})
+    set(common_args -V --target-env vulkan1.3 -I${S_INCLUDE_DIR} ${defines} ${debug_flags})
     # SPIR-V 1.6 states a compute workgroup size with LocalSizeId, which needs maintenance4; 1.5
     # keeps the literal size and runs on every Vulkan 1.3 device.
     if(file_name MATCHES "\\.comp$")

@@ -25,6 +25,20 @@ Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFo
   return Status::success();
 }
 
+Status create_temporal_targets(HeadlessContext& context, VkFormat motion_format,
+                               VkFormat reactive_format, VkExtent2D extent, HostTargets* out) {
+  const auto create = [&](VkFormat format, ExternalImage* image) -> Status {
+    if (format == VK_FORMAT_UNDEFINED) return Status::success();
+    HostImage made;
+    SIVIFLOW_TRY(context.create_target_image(format, extent, &made));
+    *image = {made.image, made.view, format, extent, ImageState{},
+              image_state(Access::ColorAttachmentWrite, format), made.usage};
+    return Status::success();
+  };
+  SIVIFLOW_TRY(create(motion_format, &out->motion));
+  return create(reactive_format, &out->reactive);
+}
+
 Status record_view(VkCommandBuffer cmd, World& world, std::span<Renderer* const> renderers,
                    const View& view, double time_seconds, const ReadbackTargets& readback,
                    HostTargets* targets) {
@@ -43,6 +57,8 @@ Status record_view(VkCommandBuffer cmd, World& world, std::span<Renderer* const>
     FrameInputs inputs;
     inputs.color = targets->color;
     inputs.depth = targets->depth;
+    inputs.motion = targets->motion;
+    inputs.reactive = targets->reactive;
     inputs.color.current = color_now;
     inputs.depth.current = depth_now;
     if (!last) {
@@ -53,6 +69,8 @@ Status record_view(VkCommandBuffer cmd, World& world, std::span<Renderer* const>
     SIVIFLOW_TRY(renderers[i]->record(cmd, inputs));
     color_now = inputs.color.final;
     depth_now = inputs.depth.final;
+    targets->motion.current = targets->motion.final;
+    targets->reactive.current = targets->reactive.final;
   }
   targets->color.current = color_now;
   targets->depth.current = depth_now;

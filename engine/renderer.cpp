@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <optional>
 #include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -12,22 +14,73 @@
 #include "renderer_inspect.h"
 #include "sim/text_format.h"
 #include "vk/pipeline.h"
+#include "vk/vk_text.h"
 
 namespace siviflow {
 namespace {
 
-constexpr uint32_t kMaxFramesInFlight = 8;
 constexpr VkFormat kDefaultDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr float kTdfRepeatTiles = 3.5f;  // normal-map repeat in tiles at ripple scale 1 (van Hoesel 35/10)
 constexpr float kReflectionClipBias = 0.02f;      // metres below the water kept, so no seam shows
-
-bool is_host_depth_format(VkFormat format) {
-  return format == VK_FORMAT_D32_SFLOAT || format == VK_FORMAT_D24_UNORM_S8_UINT ||
-         format == VK_FORMAT_D32_SFLOAT_S8_UINT;
-}
+// A TAA or upscaler jitter is under a pixel; an upscaler's (in output pixels of a 3x upscale)
+// a few. Past this it is a mistake, not a jitter.
+constexpr float kMaxJitterPixels = 64.0f;
 
 std::string extent_text(VkExtent2D extent) {
   return std::to_string(extent.width) + "x" + std::to_string(extent.height);
+}
+
+std::string rect_text(const VkRect2D& rect) {
+  return "(" + std::to_string(rect.offset.x) + ", " + std::to_string(rect.offset.y) + ") + " +
+         extent_text(rect.extent);
+}
+
+bool rect_inside(const VkRect2D& inner, const VkRect2D& outer) {
+  const int64_t right = int64_t{inner.offset.x} + inner.extent.width;
+  const int64_t bottom = int64_t{inner.offset.y} + inner.extent.height;
+  return inner.offset.x >= outer.offset.x && inner.offset.y >= outer.offset.y &&
+         right <= int64_t{outer.offset.x} + outer.extent.width &&
+         bottom <= int64_t{outer.offset.y} + outer.extent.height && inner.extent.width > 0 &&
+         inner.extent.height > 0;
+}
+
+// `view_proj` without the jitter its projection carries: a clip-space shift of 2 jitter / size
+// per unit of clip w (x right, y down, as Vulkan's clip space and the pixels run).
+glm::mat4 unjittered(const glm::mat4& view_proj, glm::vec2 jitter, VkExtent2D extent) {
+  const glm::vec2 shift(2.0f * jitter.x / static_cast<float>(extent.width),
+                        2.0f * jitter.y / static_cast<float>(extent.height));
+  glm::mat4 out = view_proj;
+  for (int c = 0; c < 4; ++c) {
+    out[c][0] -= shift.x * view_proj[c][3];
+    out[c][1] -= shift.y * view_proj[c][3];
+  }
+  return out;
+}
+
+std::string api_version_text(uint32_t version) {
+  return std::to_string(VK_API_VERSION_MAJOR(version)) + "." +
+         std::to_string(VK_API_VERSION_MINOR(version));
+}
+
+// A command the table could not load. Vulkan 1.3 core commands are missing when the device or
+// the instance (VkApplicationInfo::apiVersion) is older: say which, not only the command.
+Status missing_function_error(const CreateInfo& info, const char* function, VkResult result) {
+  std::string message = std::string("cannot load ") + function;
+  const auto properties = reinterpret_cast<PFN_vkGetPhysicalDeviceProperties>(
+      info.get_instance_proc_addr(info.instance, "vkGetPhysicalDeviceProperties"));
+  if (properties != nullptr) {
+    VkPhysicalDeviceProperties props{};
+    properties(info.physical_device, &props);
+    if (props.apiVersion < VK_API_VERSION_1_3) {
+      message += ": the device supports Vulkan " + api_version_text(props.apiVersion) +
+                 " and SiViFlow needs 1.3";
+    } else {
+      message += ", a Vulkan 1.3 command: create the instance with VkApplicationInfo::apiVersion "
+                 "VK_API_VERSION_1_3 or later (the device supports " +
+                 api_version_text(props.apiVersion) + ")";
+    }
+  }
+  return Status::error(std::string(kRendererErrorPrefix) + message, result);
 }
 
 }  // namespace
@@ -56,38 +109,17 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
       info.device == VK_NULL_HANDLE || info.get_instance_proc_addr == nullptr) {
     return argument_error("CreateInfo needs instance, physical_device, device and get_instance_proc_addr");
   }
-  if (info.extent.width == 0 || info.extent.height == 0) {
-    return argument_error("CreateInfo::extent must be at least 1x1");
-  }
+  SIVIFLOW_TRY(check_create_info(info));
+  river_from_world = glm::inverse(info.world_from_river);
   if (info.frames_in_flight == 0) info.frames_in_flight = kDefaultFramesInFlight;
-  if (info.frames_in_flight > kMaxFramesInFlight) {
-    return argument_error("CreateInfo::frames_in_flight " + std::to_string(info.frames_in_flight) +
-                   " exceeds " + std::to_string(kMaxFramesInFlight));
-  }
-  if (info.color_format == VK_FORMAT_UNDEFINED) info.color_format = kDefaultColorFormat;
-  if (texel_bytes(info.color_format) == 0) {
-    return argument_error("CreateInfo::color_format " + std::to_string(info.color_format) +
-                   " is not an RGBA8, RGBA16F or RGBA32F format");
-  }
   if (info.depth_format == VK_FORMAT_UNDEFINED) info.depth_format = kDefaultDepthFormat;
-  if (!is_host_depth_format(info.depth_format)) {
-    return argument_error("CreateInfo::depth_format " + std::to_string(info.depth_format) +
-                   " is not D32_SFLOAT, D24_UNORM_S8_UINT or D32_SFLOAT_S8_UINT");
-  }
   if (info.staging_bytes_per_slot == 0) info.staging_bytes_per_slot = kDefaultStagingBytes;
-  if ((info.readback_images & ~kAllReadbackImages) != 0) {
-    return argument_error("CreateInfo::readback_images 0x" +
-                          text_format("%x", info.readback_images) + " has bits past the " +
-                          std::to_string(kReadbackImageCount) + " ReadbackImage values");
-  }
 
   const char* missing_function = nullptr;
   const VkResult loaded = load_device_table(info.instance, info.physical_device, info.device,
                                             info.get_instance_proc_addr, info.get_device_proc_addr,
                                             info.debug_utils, &table, &missing_function);
-  if (loaded != VK_SUCCESS) {
-    return Status::error(std::string("siviflow::Renderer: cannot load ") + missing_function, loaded);
-  }
+  if (loaded != VK_SUCCESS) return missing_function_error(info, missing_function, loaded);
   gpu = make_gpu_context(table, info.allocation_callbacks);
   if (info.enabled_features == nullptr) {
     return argument_error("CreateInfo::enabled_features must point to the feature chain the device was "
@@ -118,38 +150,57 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
                    std::to_string(info.extent.height) + " exceeds the device limit of " +
                    std::to_string(limit));
   }
-  // The water pass draws the AOVs it reads back beside the colour, unblended.
-  const uint32_t attachments = 1 + ((info.readback_images & kAovReadbackImages) != 0
-                                        ? FlowPass::kAovAttachmentCount : 0);
+  // The water pass draws its temporal outputs and the AOVs it reads back beside the colour.
+  const uint32_t attachments =
+      1 + (info.motion_format != VK_FORMAT_UNDEFINED ? 1 : 0) +
+      (info.reactive_format != VK_FORMAT_UNDEFINED ? 1 : 0) +
+      ((info.readback_images & kAovReadbackImages) != 0 ? FlowPass::kAovAttachmentCount : 0);
   if (props.properties.limits.maxColorAttachments < attachments) {
-    return Status::error("siviflow::Renderer: CreateInfo::readback_images asks for the water "
-                         "pass's AOVs, " + std::to_string(attachments) +
+    return Status::error("siviflow::Renderer: the motion and reactive outputs and the AOVs of "
+                         "CreateInfo::readback_images make the water pass draw " +
+                         std::to_string(attachments) +
                          " colour attachments, and this device draws at most " +
                          std::to_string(props.properties.limits.maxColorAttachments),
                          VK_ERROR_FEATURE_NOT_PRESENT);
   }
-  VkFormatProperties format_props;
-  table.vkGetPhysicalDeviceFormatProperties(info.physical_device, info.color_format, &format_props);
-  // Drawn to; and, as the refraction's copy, copied into, out of and sampled.
-  const VkFormatFeatureFlags color_needs =
-      VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT |
-      VK_FORMAT_FEATURE_TRANSFER_SRC_BIT | VK_FORMAT_FEATURE_TRANSFER_DST_BIT;
-  if ((format_props.optimalTilingFeatures & color_needs) != color_needs) {
-    return Status::error("siviflow::Renderer: CreateInfo::color_format " +
-                             std::to_string(info.color_format) +
-                             " cannot be drawn to, copied and sampled on this device",
-                         VK_ERROR_FORMAT_NOT_SUPPORTED);
+  // Drawn to with blending; and, as the refraction's copy, copied into, out of and sampled.
+  SIVIFLOW_TRY(check_format_features(
+      "color_format", info.color_format,
+      VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
+          VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT |
+          VK_FORMAT_FEATURE_TRANSFER_DST_BIT,
+      "the water blends into it, copies it and samples the copy"));
+  SIVIFLOW_TRY(check_format_features(
+      "color_format", reflection_format(info.color_format),
+      VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
+      "the reflection target is drawn to and sampled"));
+  SIVIFLOW_TRY(check_format_features(
+      "depth_format", info.depth_format,
+      VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
+      "the water tests against it and samples it"));
+  if (info.motion_format != VK_FORMAT_UNDEFINED) {
+    SIVIFLOW_TRY(check_format_features("motion_format", info.motion_format,
+                                       VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT,
+                                       "the water draws its motion into it"));
   }
-  table.vkGetPhysicalDeviceFormatProperties(info.physical_device, info.depth_format, &format_props);
-  const VkFormatFeatureFlags depth_needs =
-      VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
-  if ((format_props.optimalTilingFeatures & depth_needs) != depth_needs) {
-    return Status::error("siviflow::Renderer: CreateInfo::depth_format " +
-                             std::to_string(info.depth_format) +
-                             " cannot be both a depth attachment and sampled on this device",
-                         VK_ERROR_FORMAT_NOT_SUPPORTED);
+  if (info.reactive_format != VK_FORMAT_UNDEFINED) {
+    SIVIFLOW_TRY(check_format_features("reactive_format", info.reactive_format,
+                                       VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT,
+                                       "the water draws its reactive mask into it"));
   }
   return Status::success();
+}
+
+Status Renderer::Impl::check_format_features(const char* field, VkFormat format,
+                                             VkFormatFeatureFlags needs, const char* why) const {
+  VkFormatProperties props{};
+  table.vkGetPhysicalDeviceFormatProperties(info.physical_device, format, &props);
+  const VkFormatFeatureFlags missing = needs & ~props.optimalTilingFeatures;
+  if (missing == 0) return Status::success();
+  return Status::error(std::string(kRendererErrorPrefix) + "CreateInfo::" + field + " " +
+                           format_name(format) + " lacks " + format_feature_text(missing) +
+                           " on this device (" + why + ")",
+                       VK_ERROR_FORMAT_NOT_SUPPORTED);
 }
 
 // The starting look: the host's, else the scene's, else the defaults.
@@ -168,6 +219,10 @@ Status Renderer::Impl::create_river() {
     const Impl& other = *info.share_river_with->impl_;
     if (other.info.device != info.device) {
       return argument_error("CreateInfo::share_river_with renders on another device");
+    }
+    if (other.info.world_from_river != info.world_from_river) {
+      return argument_error("CreateInfo::world_from_river differs from that of the renderer in "
+                            "CreateInfo::share_river_with (one river lies in one place)");
     }
     river = other.river;
     return Status::success();
@@ -203,9 +258,16 @@ Status Renderer::Impl::create_view_resources() {
   info.staging_bytes_per_slot = std::max(info.staging_bytes_per_slot,
                                          VkDeviceSize{simulation.layout().total_bytes} + kStagingAlignment);
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, info.staging_bytes_per_slot));
-  return flow_pass.create(gpu, info.pipeline_cache, info.color_format, info.depth_format,
-                          info.frames_in_flight, (info.readback_images & kAovReadbackImages) != 0,
-                          info.enable_timing);
+  FlowPass::Config config;
+  config.color_format = info.color_format;
+  config.depth_format = info.depth_format;
+  config.motion_format = info.motion_format;
+  config.reactive_format = info.reactive_format;
+  config.slot_count = info.frames_in_flight;
+  config.with_aovs = (info.readback_images & kAovReadbackImages) != 0;
+  config.with_floor = info.enable_timing && info.measure_flow_floor;
+  config.with_depth = info.write_depth;
+  return flow_pass.create(gpu, info.pipeline_cache, config);
 }
 
 void Renderer::Impl::destroy() {
@@ -249,9 +311,26 @@ Status Renderer::begin_frame(uint32_t slot) {
   Impl& r = *impl_;
   return guarded(r.info, [&]() -> Status {
     if (r.unusable) return argument_error("a resize failed; resize again before rendering");
+    // An updated frame's particles moved on: skipping its record would drop a frame of them.
+    if (r.frame_updated && !r.record_failed) {
+      return argument_error("begin_frame called again before record: record the updated frame, "
+                            "or abandon_frame() it");
+    }
     SIVIFLOW_TRY(r.ring.begin_slot(slot));
+    r.frame_recorded = false;
+    r.record_failed = false;
     r.current_slot = slot;
     r.frame_begun = true;
+    r.frame_updated = false;
+    return Status::success();
+  });
+}
+
+Status Renderer::abandon_frame() {
+  Impl& r = *impl_;
+  return guarded(r.info, [&]() -> Status {
+    if (!r.frame_begun) return argument_error("abandon_frame called without a frame begun");
+    r.frame_begun = false;
     r.frame_updated = false;
     return Status::success();
   });
@@ -261,8 +340,18 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   if (!std::isfinite(time_seconds)) {
     return argument_error("time " + std::to_string(time_seconds) + " is not finite");
   }
+  const glm::vec2 jitter = host_view.jitter;
+  if (!std::isfinite(jitter.x) || !std::isfinite(jitter.y) ||
+      std::max(std::abs(jitter.x), std::abs(jitter.y)) > kMaxJitterPixels) {
+    return argument_error("View::jitter (" + text_format("%g, %g", jitter.x, jitter.y) +
+                          ") is not a finite offset within " +
+                          text_format("%g", kMaxJitterPixels) + " pixels");
+  }
+  // The renderer works in river space: the host's view of the river is its view of the world
+  // after world_from_river.
   ViewMath math;
-  SIVIFLOW_TRY(derive_view_math(host_view.view, host_view.projection, &math));
+  SIVIFLOW_TRY(
+      derive_view_math(host_view.view * info.world_from_river, host_view.projection, &math));
   VkRect2D rect = host_view.viewport;
   if (rect.extent.width == 0 && rect.extent.height == 0) rect.extent = info.extent;
   if (rect.extent.width != info.extent.width || rect.extent.height != info.extent.height) {
@@ -274,20 +363,36 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
     return argument_error("View::viewport offset (" + std::to_string(rect.offset.x) + ", " +
                           std::to_string(rect.offset.y) + ") is negative");
   }
+  VkRect2D clip = host_view.scissor;
+  if (clip.extent.width == 0 && clip.extent.height == 0) clip = rect;
+  if (!rect_inside(clip, rect)) {
+    return argument_error("View::scissor " + rect_text(clip) + " is not inside the viewport " +
+                          rect_text(rect));
+  }
   const float dt = simulation.next_frame() == 0 ? 0.0f : static_cast<float>(time_seconds - last_time);
   if (dt < 0.0f) return argument_error("time went backwards");
+  // Particles are placed and kept in the unjittered view: jitter churns none of them.
+  const glm::mat4 steady = unjittered(math.view_proj, jitter, info.extent);
   SIVIFLOW_TRY(river->flow.set_time(time_seconds));
-  SIVIFLOW_TRY(simulation.simulate(math.view_proj, dt));
+  SIVIFLOW_TRY(simulation.simulate(steady, dt));
   view = math;
   viewport = rect;
+  scissor = clip;
+  previous_view_proj = has_previous && !host_view.camera_cut ? steady_view_proj : steady;
+  steady_view_proj = steady;
+  has_previous = true;
 
-  // The reflection is the world mirrored about the water plane y = h, seen from the real
-  // camera, so the flow pass samples it at its own screen position; only what is above the
-  // water stays.
+  // The reflection is the world mirrored about the water plane y = h of river space, seen from
+  // the real camera, so the flow pass samples it at its own screen position; only what is above
+  // the water stays. The host draws it in its world: river space is left again on both sides.
   const float h = visible_water_level();
-  const glm::mat4 mirrored = mirrored_view_proj(view.view_proj, h);
-  const glm::vec3 mirrored_camera = mirrored_point(view.camera_position, h);
-  const glm::vec4 clip_plane(0.0f, 1.0f, 0.0f, -h + kReflectionClipBias);
+  const glm::mat4 mirrored =
+      mirrored_view_proj(host_view.jitter_reflection ? view.view_proj : steady, h) *
+      river_from_world;
+  const glm::vec3 mirrored_camera =
+      glm::vec3(info.world_from_river * glm::vec4(mirrored_point(view.camera_position, h), 1.0f));
+  const glm::vec4 clip_plane = glm::transpose(river_from_world) *
+                               glm::vec4(0.0f, 1.0f, 0.0f, -h + kReflectionClipBias);
   std::memcpy(reflection_view.view_proj, &mirrored[0][0], sizeof(reflection_view.view_proj));
   std::memcpy(reflection_view.clip_plane, &clip_plane[0], sizeof(reflection_view.clip_plane));
   std::memcpy(reflection_view.camera_position, &mirrored_camera[0],
@@ -313,6 +418,9 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   water_frame.debug_view = debug_view;
   water_frame.look.refraction =
       glm::vec4(look.opacity_per_metre * look.opacity_tint, look.refraction_distortion);
+  water_frame.look.temporal = glm::vec4(look.reactive_strength, 0.0f, 0.0f, 0.0f);
+  water_frame.look.motion_now = steady_view_proj;
+  water_frame.look.motion_before = previous_view_proj;
   tile_lattice.place(river->water_lo, river->water_hi, look.tile_size_m, view.camera_position,
                      view.forward);
   const TileTableLayout& tiles = tile_lattice.layout();
@@ -377,9 +485,11 @@ Status Renderer::update(const View& view, double time_seconds) {
 // value, before any command is recorded.
 Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
   const auto check = [this](const ExternalImage& image, const char* name, VkFormat format,
-                            VkImageUsageFlags needs, ReadbackImage copy) {
+                            VkImageUsageFlags needs, std::optional<ReadbackImage> copy) {
     const std::string field = std::string("FrameInputs::") + name;
-    if ((info.readback_images & readback_bit(copy)) != 0) needs |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    if (copy && (info.readback_images & readback_bit(*copy)) != 0) {
+      needs |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    }
     if (image.image == VK_NULL_HANDLE || image.view == VK_NULL_HANDLE) {
       return argument_error(field + " needs an image and a view");
     }
@@ -387,8 +497,8 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
       return argument_error(field + ".final.layout must not be UNDEFINED");
     }
     if (image.format != format) {
-      return argument_error(field + ".format " + std::to_string(image.format) +
-                            " differs from the configured " + std::to_string(format));
+      return argument_error(field + ".format " + format_name(image.format) +
+                            " differs from the configured " + format_name(format));
     }
     const uint64_t right = uint64_t{static_cast<uint32_t>(viewport.offset.x)} + viewport.extent.width;
     const uint64_t bottom = uint64_t{static_cast<uint32_t>(viewport.offset.y)} + viewport.extent.height;
@@ -400,9 +510,8 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
                             extent_text(viewport.extent));
     }
     if ((image.usage & needs) != needs) {
-      return argument_error(field + ".usage " + text_format("0x%x", image.usage) + " lacks " +
-                            text_format("0x%x", needs & ~image.usage) +
-                            " (VkImageUsageFlagBits the water needs of it)");
+      return argument_error(field + ".usage " + image_usage_text(image.usage) + " lacks " +
+                            image_usage_text(needs & ~image.usage));
     }
     return Status::success();
   };
@@ -418,6 +527,14 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
   SIVIFLOW_TRY(check(inputs.depth, "depth", info.depth_format,
                      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
                      ReadbackImage::kDepth));
+  if (info.motion_format != VK_FORMAT_UNDEFINED) {
+    SIVIFLOW_TRY(check(inputs.motion, "motion", info.motion_format,
+                       VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, std::nullopt));
+  }
+  if (info.reactive_format != VK_FORMAT_UNDEFINED) {
+    SIVIFLOW_TRY(check(inputs.reactive, "reactive", info.reactive_format,
+                       VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT, std::nullopt));
+  }
   for (const ReadbackImage kind : readback_kinds) {
     if (inputs.readback.buffers[static_cast<uint32_t>(kind)] == VK_NULL_HANDLE) {
       return argument_error(std::string("CreateInfo::readback_images asks for the ") +
@@ -429,8 +546,13 @@ Status Renderer::Impl::check_inputs(const FrameInputs& inputs) const {
 
 Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
   Impl& r = *impl_;
-  return guarded(r.info, [&]() -> Status {
-    if (!r.frame_updated) return argument_error("record called before begin_frame and update");
+  const Status status = guarded(r.info, [&]() -> Status {
+    if (r.frame_recorded) {
+      return argument_error("record called twice for one frame: begin_frame and update start "
+                            "the next");
+    }
+    if (!r.frame_begun) return argument_error("record called before begin_frame and update");
+    if (!r.frame_updated) return argument_error("record called before update");
     SIVIFLOW_TRY(r.check_inputs(inputs));
     StaticAssets& assets = r.river->assets;  // uploaded by the first view of the river to record
     if (!assets.uploaded()) {
@@ -448,8 +570,12 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
     r.frame_images_new = false;
     r.frame_begun = false;
     r.frame_updated = false;
+    r.frame_recorded = true;
     return Status::success();
   });
+  // The host may record again, or begin the next frame and drop this one.
+  if (!status.ok()) r.record_failed = true;
+  return status;
 }
 
 Status Renderer::resize(VkExtent2D extent) {
@@ -471,6 +597,7 @@ Status Renderer::Impl::resize(VkExtent2D extent) {
   // The particles live in screen space: a new viewport starts them afresh at frame 0. This can
   // fail (a size the particles cannot cover); nothing has changed then.
   SIVIFLOW_TRY(r.simulation.resize({extent.width, extent.height}));
+  r.has_previous = false;  // the particles start afresh: no motion from the old size
   // Past this point the old configuration is gone: a failure leaves nothing to record with,
   // until a resize succeeds.
   Status status = r.ring.ensure_staging_capacity(r.simulation.layout().total_bytes + kStagingAlignment);
@@ -483,6 +610,27 @@ Status Renderer::Impl::resize(VkExtent2D extent) {
   }
   r.unusable = !status.ok();
   return status;
+}
+
+Renderer::Bounds Renderer::river_bounds() const {
+  const Impl& r = *impl_;
+  glm::vec3 lo(std::numeric_limits<float>::max());
+  glm::vec3 hi(-std::numeric_limits<float>::max());
+  for (const glm::vec3& p : r.river->flow.mesh().positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  // The box of the river-space box's corners in the host's world.
+  Bounds bounds{glm::vec3(std::numeric_limits<float>::max()),
+                glm::vec3(-std::numeric_limits<float>::max())};
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 p((corner & 1) != 0 ? hi.x : lo.x, (corner & 2) != 0 ? hi.y : lo.y,
+                      (corner & 4) != 0 ? hi.z : lo.z);
+    const glm::vec3 world = glm::vec3(r.info.world_from_river * glm::vec4(p, 1.0f));
+    bounds.min = glm::min(bounds.min, world);
+    bounds.max = glm::max(bounds.max, world);
+  }
+  return bounds;
 }
 
 const TileTableLayout& Renderer::tile_table_layout() const { return impl_->tile_lattice.layout(); }

@@ -7,24 +7,9 @@
 
 #include "renderer_impl.h"
 #include "vk/pipeline.h"
+#include "vk/vk_text.h"
 
 namespace siviflow {
-uint32_t texel_bytes(VkFormat format) {
-  switch (format) {
-    case VK_FORMAT_R8G8B8A8_UNORM:
-    case VK_FORMAT_R8G8B8A8_SRGB:
-    case VK_FORMAT_B8G8R8A8_UNORM:
-    case VK_FORMAT_B8G8R8A8_SRGB:
-      return 4;
-    case VK_FORMAT_R16G16B16A16_SFLOAT:
-      return 8;
-    case VK_FORMAT_R32G32B32A32_SFLOAT:
-      return 16;
-    default:
-      return 0;
-  }
-}
-
 VkExtent2D reflection_extent(VkExtent2D extent) {
   return {std::max(1u, static_cast<uint32_t>(std::lround(extent.width * kDefaultReflectionScale))),
           std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
@@ -57,11 +42,13 @@ Status Renderer::Impl::declare_graph() {
 
   // reflection: the host's world mirrored about the water plane, clipped below it.
   ImageHandle reflection =
-      frame_image(graph.create_image({"reflection", info.color_format, reflection_size, transparent}));
+      frame_image(graph.create_image(
+          {"reflection", reflection_format(info.color_format), reflection_size, transparent}));
   reflection_depth = frame_image(
       graph.create_image({"reflection depth", kReflectionDepthFormat, reflection_size, {}}));
   reflection_data = add_reflection_pass(graph, &reflection, &reflection_depth, info.reflection,
                                         info.reflection_user);
+  reflection_view.format = reflection_format(info.color_format);
 
   // The host's images, in the states the host states per frame (record()); their declared
   // extent is the view's, the viewport is placed inside them when recording.
@@ -69,6 +56,15 @@ Status Renderer::Impl::declare_graph() {
                                   state_of(Access::SampledFragment));
   host_depth = graph.import_image({"host depth", info.depth_format, extent, {}}, ResourceState{},
                                   state_of(Access::DepthAttachmentRead));
+  host_motion = host_reactive = ImageHandle{};
+  if (info.motion_format != VK_FORMAT_UNDEFINED) {
+    host_motion = graph.import_image({"host motion", info.motion_format, extent, {}},
+                                     ResourceState{}, state_of(Access::ColorAttachmentWrite));
+  }
+  if (info.reactive_format != VK_FORMAT_UNDEFINED) {
+    host_reactive = graph.import_image({"host reactive", info.reactive_format, extent, {}},
+                                       ResourceState{}, state_of(Access::ColorAttachmentWrite));
+  }
 
   // refraction copy: what the host drew, for the water to see through.
   ImageHandle refraction =
@@ -85,6 +81,8 @@ Status Renderer::Impl::declare_graph() {
   water.normal_map = river_assets.images[SharedRiver::kNormalMap];
   water.vertices = river_assets.buffers[SharedRiver::kRiverVertices];
   water.indices = river_assets.buffers[SharedRiver::kRiverIndices];
+  water.motion = host_motion;
+  water.reactive = host_reactive;
   if ((info.readback_images & kAovReadbackImages) != 0) {
     water.mask = frame_image(graph.create_image({"water mask", FlowPass::kMaskFormat, extent, transparent}));
     water.normal = frame_image(graph.create_image({"water normal", FlowPass::kNormalFormat, extent, transparent}));
@@ -99,6 +97,7 @@ Status Renderer::Impl::declare_graph() {
        {tile_lattice.layout().width, tile_lattice.layout().height}, {}}));
   flow_pass.declare_tiles(graph, &water);
   flow_pass.declare(graph, river->index_count, &water);
+  if (info.write_depth) flow_pass.declare_depth(graph, river->index_count, &water);
   if (info.enable_timing && info.measure_flow_floor) {
     const ImageHandle floor =
         frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
@@ -107,7 +106,7 @@ Status Renderer::Impl::declare_graph() {
 
   if (info.readback_images != 0) {
     const ImageHandle images[kReadbackImageCount] = {water.color,
-                                                     host_depth,
+                                                     water.depth,
                                                      water.mask,
                                                      frame_uploads.images[0].destination,
                                                      frame_uploads.images[1].destination,
@@ -194,8 +193,11 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   };
   bind_host(host_color, inputs.color);
   bind_host(host_depth, inputs.depth);
+  if (host_motion.valid()) bind_host(host_motion, inputs.motion);
+  if (host_reactive.valid()) bind_host(host_reactive, inputs.reactive);
   // The water renders over the view's part of the host's images only.
   b.set_render_area(host_color, viewport);
+  b.set_render_area(host_depth, viewport);
   b.bind_buffer(frame_staging, ring.staging_buffer());
   for (size_t i = 0; i < readbacks.size(); ++i) {
     const ReadbackImage kind = readback_kinds[i];
@@ -230,6 +232,7 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   water_frame.host_depth = depth_view;
   water_frame.reverse_z = view.reverse_z;
   water_frame.viewport = viewport;
+  water_frame.scissor = scissor;
   flow_pass.prepare_frame(gpu, water_frame);
   // What the passes read as they record: this frame's, through the graph's data handles.
   b.bind_data(flow_pass.frame_data(), &water_frame);
@@ -244,7 +247,7 @@ VkDeviceSize Renderer::readback_bytes(ReadbackImage image) const {
   const VkDeviceSize pixels = VkDeviceSize{impl_->info.extent.width} * impl_->info.extent.height;
   switch (image) {
     case ReadbackImage::kColor:
-      return pixels * texel_bytes(impl_->info.color_format);
+      return pixels * color_texel_bytes(impl_->info.color_format);
     case ReadbackImage::kDepth:
     case ReadbackImage::kWaterMask:
     case ReadbackImage::kFoam:

@@ -27,6 +27,7 @@ namespace siviflow {
 
 struct Renderer::Impl {
   CreateInfo info;
+  glm::mat4 river_from_world{1.0f};  // the inverse of info.world_from_river
   DeviceTable table;
   GpuContext gpu;
   FrameRing ring;
@@ -54,6 +55,8 @@ struct Renderer::Impl {
   UploadList frame_uploads;    // flow texture and particle aux, every frame
   ImageHandle host_color;      // imported per frame: the host's colour and depth
   ImageHandle host_depth;
+  ImageHandle host_motion;     // and its temporal filter's inputs, where configured
+  ImageHandle host_reactive;
   ImageHandle reflection_depth;
   std::vector<ReadbackCopy> readbacks;  // one per image CreateInfo::readback_images asks for
   std::vector<ReadbackImage> readback_kinds;  // which image each of them copies
@@ -65,8 +68,12 @@ struct Renderer::Impl {
   DataHandle<std::vector<ReadbackCopy>> readbacks_data;
   DataHandle<ReflectionView> reflection_data;
   DataHandle<VkOffset2D> refraction_data;
-  ViewMath view;        // of the frame being prepared
+  ViewMath view;        // of the frame being prepared, in river space, as drawn (jittered)
+  glm::mat4 steady_view_proj{1.0f};  // river -> clip without the jitter: particles, motion
+  glm::mat4 previous_view_proj{1.0f};  // steady_view_proj of the frame before
+  bool has_previous = false;           // false after create(), resize() and a camera cut
   VkRect2D viewport{};  // in the host's images
+  VkRect2D scissor{};   // inside the viewport
   ReflectionView reflection_view{};
   TileLattice tile_lattice;  // the tile table's size and, per frame, its lattice and window
 
@@ -76,8 +83,14 @@ struct Renderer::Impl {
   bool unusable = false;  // a resize failed half-way
   bool frame_begun = false;
   bool frame_updated = false;
+  bool frame_recorded = false;  // since the last begin_frame
+  bool record_failed = false;   // the last record of this frame failed
 
   Status validate_info(const CreateInfo& create);
+  // An error naming the field, the format and the features it lacks (optimal tiling), and why
+  // the water needs them.
+  Status check_format_features(const char* field, VkFormat format, VkFormatFeatureFlags needs,
+                               const char* why) const;
   Status take_look();
   Status create_river();
   Status create_view_resources();
@@ -104,13 +117,12 @@ struct Renderer::Impl {
 // An error in what the caller passed: no Vulkan result stands behind it.
 Status argument_error(const std::string& message);
 
-// Bytes per texel of a host colour format we take (RGBA8, RGBA16F, RGBA32F); 0 for any other.
-uint32_t texel_bytes(VkFormat format);
+// What create() and view_memory() refuse of `info` without a device: sizes, formats, placement.
+Status check_create_info(const CreateInfo& info);
 inline constexpr VkDeviceSize kStagingAlignment = 16;  // covers every texel size we copy
 // What CreateInfo's zeros stand for.
 inline constexpr VkDeviceSize kDefaultStagingBytes = 8ull << 20;
 inline constexpr uint32_t kDefaultFramesInFlight = 2;
-inline constexpr VkFormat kDefaultColorFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 // The view's own images (renderer_graph.cpp; view_memory.cpp counts them). Layouts of the flow
 // texture and the particle aux data are documented in shaders/shared.h.
 inline constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;

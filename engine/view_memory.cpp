@@ -7,41 +7,23 @@
 #include "shaders/shared.h"
 #include "sim/flow_textures.h"
 #include "sim/particle_tuning.h"
-#include "sim/text_format.h"
+#include "vk/vk_text.h"
 
 namespace siviflow {
 namespace {
 
 // Bytes per texel of the view's own formats.
 VkDeviceSize format_bytes(VkFormat format) {
-  switch (format) {
-    case VK_FORMAT_R32_SFLOAT:
-    case VK_FORMAT_D32_SFLOAT:
-      return 4;
-    case VK_FORMAT_R16G16B16A16_UINT:
-      return 8;
-    case VK_FORMAT_R32G32B32A32_SFLOAT:
-    case VK_FORMAT_R32G32B32A32_UINT:
-      return 16;
-    default:
-      return texel_bytes(format);
-  }
+  return format == VK_FORMAT_D32_SFLOAT ? 4 : color_texel_bytes(format);
 }
 
 }  // namespace
 
 Status view_memory(const CreateInfo& info, ViewMemory* out) {
+  SIVIFLOW_TRY(check_create_info(info));
   const VkExtent2D extent = info.extent;
-  if (extent.width == 0 || extent.height == 0) {
-    return Status::error("view_memory: CreateInfo::extent must be at least 1x1");
-  }
-  const VkFormat color_format =
-      info.color_format == VK_FORMAT_UNDEFINED ? kDefaultColorFormat : info.color_format;
-  const VkDeviceSize color = texel_bytes(color_format);
-  if (color == 0) {
-    return Status::error(text_format("view_memory: CreateInfo::color_format %d is not one the "
-                                     "renderer takes", static_cast<int>(info.color_format)));
-  }
+  const VkDeviceSize color = color_texel_bytes(info.color_format);
+  const VkDeviceSize reflection = color_texel_bytes(reflection_format(info.color_format));
   // The flow texture and aux data at the most particle slots any view has.
   FlowTextureLayout flow;
   SIVIFLOW_TRY(make_flow_texture_layout({extent.width, extent.height}, kDefaultFlowTexelPx,
@@ -53,7 +35,7 @@ Status view_memory(const CreateInfo& info, ViewMemory* out) {
   const VkDeviceSize mirrored_pixels = VkDeviceSize{mirrored.width} * mirrored.height;
   const bool aovs = (info.readback_images & kAovReadbackImages) != 0;
 
-  VkDeviceSize bytes = mirrored_pixels * (color + format_bytes(kReflectionDepthFormat));
+  VkDeviceSize bytes = mirrored_pixels * (reflection + format_bytes(kReflectionDepthFormat));
   bytes += pixels * color;  // refraction copy
   if (aovs) {
     bytes += pixels * (format_bytes(FlowPass::kMaskFormat) + format_bytes(FlowPass::kNormalFormat) +

@@ -1,7 +1,10 @@
 // What a host changes on a running renderer: obstacles placed at runtime, the geometry that
 // hides the water, the water's look and its debug view.
 #include <cmath>
+#include <span>
 #include <string>
+#include <vector>
+
 
 #include "renderer_impl.h"
 #include "sim/text_format.h"
@@ -48,7 +51,17 @@ Status Renderer::set_look(const WaterLook& look) {
 
 Status Renderer::Impl::set_occluders(const OccluderMesh& mesh) {
   if (frame_begun) return argument_error("set_occluders called between begin_frame and record");
-  const Status built = river->flow.set_occluders(mesh.positions, mesh.indices);
+  // The host's world into river space, where the flow and the particles live.
+  std::vector<glm::vec3> in_river;
+  std::span<const glm::vec3> positions = mesh.positions;
+  if (info.world_from_river != glm::mat4(1.0f)) {
+    in_river.reserve(positions.size());
+    for (const glm::vec3& p : positions) {
+      in_river.push_back(glm::vec3(river_from_world * glm::vec4(p, 1.0f)));
+    }
+    positions = in_river;
+  }
+  const Status built = river->flow.set_occluders(positions, mesh.indices);
   if (!built.ok()) return argument_error("set_occluders: " + built.message());
   return Status::success();
 }

@@ -55,6 +55,7 @@ std::string water_look_error(const WaterLook& look, std::string* problem) {
       {"fresnel_f0", look.fresnel_f0, 0.0f, 1.0f},
       {"sun_glint", look.sun_glint, 0.0f, 10.0f},
       {"foam_amount", look.foam_amount, 0.0f, 4.0f},
+      {"reactive_strength", look.reactive_strength, 0.0f, 1.0f},
   };
   for (const auto& s : scalars) {
     if (!in_range(s.value, s.lo, s.hi)) {

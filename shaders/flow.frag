@@ -1,4 +1,5 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// The water material, beauty only (what an embedding host records).
+// The water material: beauty only here; with more outputs in the variants of
+// shaders/CMakeLists.txt.
 #include "flow_material.glsl"

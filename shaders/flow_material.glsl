@@ -1,6 +1,8 @@
 // The water material of Algorithm 3 (its ripples by Tiled Directional Flow, or by the flow-map
-// baseline when the look asks for it), shared by flow.frag (beauty only) and flow_aovs.frag
-// (beauty plus the water mask, normal, reflection and foam AOVs, with SIVIFLOW_FLOW_AOVS defined).
+// baseline when the look asks for it). flow.frag is compiled in variants (shaders/CMakeLists.txt)
+// that add outputs after the colour, in this order, each where its macro is defined:
+// SIVIFLOW_FLOW_MOTION the motion vectors and SIVIFLOW_FLOW_REACTIVE the reactive mask (for the
+// host's temporal filters), SIVIFLOW_FLOW_AOVS the water mask, normal, reflection and foam.
 #extension GL_GOOGLE_include_directive : require
 #include "shared.h"
 #include "sky_common.glsl"
@@ -21,11 +23,23 @@ layout(set = 0, binding = 7) uniform sampler2D refraction_map;  // the host's co
 
 layout(location = 0) in vec3 in_world;
 layout(location = 0) out vec4 out_color;
+#ifdef SIVIFLOW_FLOW_MOTION
+layout(location = 1) out vec2 out_motion;
+#define SIVIFLOW_AFTER_MOTION 2
+#else
+#define SIVIFLOW_AFTER_MOTION 1
+#endif
+#ifdef SIVIFLOW_FLOW_REACTIVE
+layout(location = SIVIFLOW_AFTER_MOTION) out float out_reactive;
+#define SIVIFLOW_FIRST_AOV (SIVIFLOW_AFTER_MOTION + 1)
+#else
+#define SIVIFLOW_FIRST_AOV SIVIFLOW_AFTER_MOTION
+#endif
 #ifdef SIVIFLOW_FLOW_AOVS
-layout(location = 1) out float out_mask;
-layout(location = 2) out vec4 out_normal;
-layout(location = 3) out vec4 out_reflection;
-layout(location = 4) out float out_foam;
+layout(location = SIVIFLOW_FIRST_AOV) out float out_mask;
+layout(location = SIVIFLOW_FIRST_AOV + 1) out vec4 out_normal;
+layout(location = SIVIFLOW_FIRST_AOV + 2) out vec4 out_reflection;
+layout(location = SIVIFLOW_FIRST_AOV + 3) out float out_foam;
 #endif
 
 // Tunables of the material that are not the artist's look (that comes in `look`).
@@ -160,6 +174,18 @@ void main() {
     out_color = debug_view_colour(int(look.surface.w), out_color, texel, fade, in_world,
                                   flow.water.z, look.surface.y, tile_table);
   }
+#ifdef SIVIFLOW_FLOW_MOTION
+  // Viewport uv of the surface point now and a frame ago, both without jitter: what a temporal
+  // filter needs to find the point in its history.
+  vec4 now = look.motion_now * vec4(in_world, 1.0);
+  vec4 before = look.motion_before * vec4(in_world, 1.0);
+  out_motion = 0.5 * (before.xy / before.w - now.xy / now.w);
+#endif
+#ifdef SIVIFLOW_FLOW_REACTIVE
+  // What moves over the surface rather than with it: the ripples as applied, the reflection's
+  // share and the foam; as opaque as the water is.
+  out_reactive = look.temporal.x * alpha * min(1.0, strength + fresnel + foam);
+#endif
 #ifdef SIVIFLOW_FLOW_AOVS
   out_mask = 1.0;
   out_normal = vec4(n, 1.0);

@@ -107,8 +107,8 @@ static_assert(offsetof(ParticleAux, foam) == 8);
 static_assert(offsetof(ParticleAux, fade) == 12);
 #endif
 
-// The water's look (siviflow/water_look.h), the flow material's uniform buffer (std140), one
-// per frame slot.
+// The flow material's uniform buffer (std140), one per frame slot: the water's look
+// (siviflow/water_look.h) and what the frame's temporal outputs need.
 struct WaterLookConstants {
   vec4 water_color;  // rgb linear colour of shallow water, w absorption per metre of view path
   vec4 deep_color;   // rgb linear colour of deep water, w unused
@@ -121,6 +121,9 @@ struct WaterLookConstants {
                      // phases; yzw unused
   vec4 refraction;   // rgb opacity per metre of view path per colour channel, w refraction
                      // distortion (uv per unit tilt per metre of water below, up to one)
+  vec4 temporal;     // x reactive strength (WaterLook::reactive_strength), yzw unused
+  mat4 motion_now;     // river -> clip of this frame's projection without its jitter
+  mat4 motion_before;  // the same of the previous frame (motion_now after a camera cut)
 };
 
 // Push constants of the flow pass (the water material).
@@ -173,7 +176,10 @@ struct FlowTileConstants {
 #ifdef __cplusplus
 static_assert(sizeof(FlowConstants) == 128);
 static_assert(sizeof(FlowTileConstants) == 128);
-static_assert(sizeof(WaterLookConstants) == 112);
+static_assert(sizeof(WaterLookConstants) == 256);
+static_assert(offsetof(WaterLookConstants, temporal) == 112);
+static_assert(offsetof(WaterLookConstants, motion_now) == 128);
+static_assert(offsetof(WaterLookConstants, motion_before) == 192);
 static_assert(offsetof(FlowTileConstants, lattice) == 64);
 static_assert(offsetof(FlowTileConstants, heights) == 80);
 static_assert(offsetof(FlowTileConstants, screen) == 96);

@@ -39,6 +39,7 @@ struct BenchOptions {
   uint32_t warmup = 10;
   bool json = false;
   bool second_view = false;  // also a second view of the same river (a probe 4 s ahead)
+  bool motion = false;       // the water writes motion vectors and a reactive mask too
 };
 
 constexpr double kSecondViewAhead = 4.0;  // seconds ahead on the camera path
@@ -57,10 +58,29 @@ Stats stats_of(std::vector<double> values) {
   return {median, values.front(), values.back()};
 }
 
+// The Halton(2,3) sub-pixel jitter a TAA host puts in its projection, frame by frame.
+float halton(uint32_t index, uint32_t base) {
+  float result = 0.0f;
+  float fraction = 1.0f / static_cast<float>(base);
+  for (uint32_t i = index + 1; i > 0; i /= base) {
+    result += fraction * static_cast<float>(i % base);
+    fraction /= static_cast<float>(base);
+  }
+  return result;
+}
+
+void jitter_view(uint32_t frame, VkExtent2D extent, View* view) {
+  const glm::vec2 jitter(halton(frame % 8, 2) - 0.5f, halton(frame % 8, 3) - 0.5f);
+  view->jitter = jitter;
+  // Clip x and y shift by 2 jitter / size per unit of clip w (= -view z).
+  view->projection[2][0] -= 2.0f * jitter.x / static_cast<float>(extent.width);
+  view->projection[2][1] -= 2.0f * jitter.y / static_cast<float>(extent.height);
+}
+
 void print_help() {
   std::printf(
       "usage: siviflow bench [SCENE.json] [--size WxH] [--frames N] [--warmup W] [--json]\n"
-      "                      [--second-view]\n"
+      "                      [--second-view] [--motion]\n"
       "  Renders the scene file (at its render size unless --size says otherwise) or the\n"
       "  default scene (1280x720): W warm-up frames (default 10), then N measured frames\n"
       "  (default 60), one at a time. Reports per pass the median, min and max GPU time\n"
@@ -70,8 +90,10 @@ void print_help() {
       "  apart as \"flow tiles\" and \"flow material\"). --json prints one JSON object.\n"
       "  --second-view also renders a second view of the same river (CreateInfo::\n"
       "  share_river_with; the camera 4 s further on) into images of its own, and reports its\n"
-      "  creation, CPU update and water span beside the first view's. The first river of a\n"
-      "  scene file is benchmarked.\n");
+      "  creation, CPU update and water span beside the first view's. --motion has the water\n"
+      "  write motion vectors (R16G16_SFLOAT) and a reactive mask (R8_UNORM) for a temporal\n"
+      "  filter as well, under a Halton(2,3) jitter. The first river of a scene file is\n"
+      "  benchmarked.\n");
 }
 
 Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
@@ -96,6 +118,8 @@ Status parse_options(int argc, char** argv, BenchOptions* options, bool* help) {
       options->json = true;
     } else if (arg == "--second-view") {
       options->second_view = true;
+    } else if (arg == "--motion") {
+      options->motion = true;
     } else if (!arg.empty() && arg[0] != '-' && options->scene_path.empty()) {
       options->scene_path = std::string(arg);
     } else {
@@ -146,6 +170,10 @@ int run_bench(int argc, char** argv) {
   info.frames_in_flight = 1;
   info.enable_timing = true;
   info.measure_flow_floor = true;
+  if (options.motion) {
+    info.motion_format = VK_FORMAT_R16G16_SFLOAT;
+    info.reactive_format = VK_FORMAT_R8_UNORM;
+  }
   const SceneFile* scene_file = scene.has_value() ? &*scene : nullptr;
   SceneRiverData river;  // the scene's first river
   status = scene_river_data(scene_file, 0, &river);
@@ -172,6 +200,10 @@ int run_bench(int argc, char** argv) {
                          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   HostTargets targets;
   status = create_host_targets(*context, kOutputFormat, kDepthFormat, extent, shown, &targets);
+  if (status.ok()) {
+    status = create_temporal_targets(*context, info.motion_format, info.reactive_format, extent,
+                                     &targets);
+  }
   if (!status.ok()) return cli::fail(kCommand, status.message());
   // The second view: the same river (no second solve), its own particles, passes and images.
   std::unique_ptr<Renderer> second;
@@ -185,6 +217,10 @@ int run_bench(int argc, char** argv) {
     if (status.ok()) {
       status = create_host_targets(*context, kOutputFormat, kDepthFormat, extent, shown,
                                    &second_targets);
+    }
+    if (status.ok()) {
+      status = create_temporal_targets(*context, info.motion_format, info.reactive_format, extent,
+                                       &second_targets);
     }
     if (!status.ok()) return cli::fail(kCommand, status.message());
   }
@@ -201,7 +237,8 @@ int run_bench(int argc, char** argv) {
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     status = context->begin_slot(0, &cmd);
     if (status.ok()) status = renderer->begin_frame(0);
-    const View view = camera_view(world->scene_camera(time), extent);
+    View view = camera_view(world->scene_camera(time), extent);
+    if (options.motion) jitter_view(frame, extent, &view);
     const auto update_start = std::chrono::steady_clock::now();
     if (status.ok()) status = renderer->update(view, time);
     const double update = ms_since(update_start);

@@ -32,13 +32,22 @@ constexpr std::array<VkDescriptorType, 4> kTileBindings = {
     VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
 constexpr uint32_t kTileGroupSide = 8;  // flow_tiles.comp's local size
 
+// The material's variant with the outputs a configuration asks for (shaders/CMakeLists.txt).
+const char* material_shader(const FlowPass::Config& config) {
+  const bool motion = config.motion_format != VK_FORMAT_UNDEFINED;
+  const bool reactive = config.reactive_format != VK_FORMAT_UNDEFINED;
+  const char* const names[2][4] = {
+      {"flow.frag", "flow_motion.frag", "flow_reactive.frag", "flow_temporal.frag"},
+      {"flow_aovs.frag", "flow_aovs_motion.frag", "flow_aovs_reactive.frag",
+       "flow_aovs_temporal.frag"}};
+  return names[config.with_aovs ? 1 : 0][(motion ? 1 : 0) + (reactive ? 2 : 0)];
+}
+
 }  // namespace
 
-Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
-                        VkFormat depth_format, uint32_t slot_count, bool with_aovs,
-                        bool with_floor) {
-  with_aovs_ = with_aovs;
-  slot_count_ = slot_count;
+Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, const Config& config) {
+  config_ = config;
+  const uint32_t slot_count = config.slot_count;
   SIVIFLOW_TRY(create_layouts(gpu, kMaterialBindings,
                               VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                               sizeof(gpu::FlowConstants), &set_layout_, &layout_));
@@ -51,11 +60,17 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
 
   GraphicsPipelineDesc desc;
   desc.vertex_shader = "flow.vert";
-  desc.fragment_shader = with_aovs ? "flow_aovs.frag" : "flow.frag";
+  desc.fragment_shader = material_shader(config);
   desc.layout = layout_;
-  desc.color_format = color_format;
-  if (with_aovs) desc.extra_color_formats = {kMaskFormat, kNormalFormat, kReflectionFormat, kFoamFormat};
-  desc.depth_format = depth_format;
+  desc.color_format = config.color_format;
+  for (VkFormat format : {config.motion_format, config.reactive_format}) {
+    if (format != VK_FORMAT_UNDEFINED) desc.extra_color_formats.push_back(format);
+  }
+  if (config.with_aovs) {
+    desc.extra_color_formats.insert(desc.extra_color_formats.end(),
+                                    {kMaskFormat, kNormalFormat, kReflectionFormat, kFoamFormat});
+  }
+  desc.depth_format = config.depth_format;
   desc.depth_write = false;
   desc.dynamic_depth_compare = true;  // the host's depth convention, per frame
   desc.alpha_blend = true;
@@ -71,7 +86,18 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat c
                               sizeof(gpu::FlowTileConstants), &tiles_set_layout_, &tiles_layout_));
   SIVIFLOW_TRY(
       create_compute_pipeline(gpu, cache, "flow_tiles.comp", tiles_layout_, &tiles_pipeline_));
-  if (!with_floor) return Status::success();
+  if (config.with_depth) {
+    // The material's geometry and depth test, writing depth alone.
+    GraphicsPipelineDesc depth = desc;
+    depth.fragment_shader = "flow_depth.frag";
+    depth.fragment_constants.clear();
+    depth.color_format = VK_FORMAT_UNDEFINED;
+    depth.extra_color_formats.clear();
+    depth.alpha_blend = false;
+    depth.depth_write = true;
+    SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, depth, &depth_pipeline_));
+  }
+  if (!config.with_floor) return Status::success();
   // The same geometry, depth test, colour format and blending as the water, so the floor shades
   // exactly its pixels and writes them as the water does.
   GraphicsPipelineDesc floor = desc;
@@ -89,7 +115,7 @@ void FlowPass::destroy(const GpuContext& gpu) {
       if (pipeline != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline, callbacks);
     }
   }
-  for (VkPipeline pipeline : {tiles_pipeline_, floor_pipeline_}) {
+  for (VkPipeline pipeline : {tiles_pipeline_, floor_pipeline_, depth_pipeline_}) {
     if (pipeline != VK_NULL_HANDLE) vk.vkDestroyPipeline(vk.device, pipeline, callbacks);
   }
   for (VkDescriptorPool pool : {pool_, tiles_pool_}) {
@@ -113,9 +139,9 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   const DeviceTable& vk = *gpu.table;
   // New sets first: on failure the current ones stay valid.
   std::array<VkDescriptorPool, 2> pools{};
-  std::vector<VkDescriptorSet> sets(slot_count_);
+  std::vector<VkDescriptorSet> sets(config_.slot_count);
   VkDescriptorSet tiles_set = VK_NULL_HANDLE;
-  Status allocated = allocate_sets(gpu, set_layout_, kMaterialBindings, slot_count_, &pools[0],
+  Status allocated = allocate_sets(gpu, set_layout_, kMaterialBindings, config_.slot_count, &pools[0],
                                    sets.data());
   if (allocated.ok())
     allocated = allocate_sets(gpu, tiles_set_layout_, kTileBindings, 1, &pools[1], &tiles_set);
@@ -167,8 +193,8 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
     write(set, kRefractionBinding, kMaterialBindings, {&refraction, 1});
   }
   write(tiles_set_, 0, kTileBindings, tiles);
-  std::vector<VkDescriptorBufferInfo> looks(slot_count_);
-  for (uint32_t slot = 0; slot < slot_count_; ++slot) {
+  std::vector<VkDescriptorBufferInfo> looks(config_.slot_count);
+  for (uint32_t slot = 0; slot < config_.slot_count; ++slot) {
     looks[slot] = {look_buffer_.buffer, kLookStride * slot, sizeof(gpu::WaterLookConstants)};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = sets_[slot];
@@ -202,7 +228,14 @@ void FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
 void FlowPass::declare(FrameGraph& graph, uint32_t index_count, Handles* handles) {
   PassBuilder pass = graph.add_pass("flow", PassKind::Graphics);
   handles->color = pass.color_write(handles->color, LoadOp::Load);
-  if (with_aovs_) {
+  // In the material's output order (flow_material.glsl): motion, reactive, then the AOVs.
+  if (config_.motion_format != VK_FORMAT_UNDEFINED) {
+    handles->motion = pass.color_write(handles->motion, LoadOp::Load);
+  }
+  if (config_.reactive_format != VK_FORMAT_UNDEFINED) {
+    handles->reactive = pass.color_write(handles->reactive, LoadOp::Load);
+  }
+  if (config_.with_aovs) {
     handles->mask = pass.color_write(handles->mask, LoadOp::Clear);
     handles->normal = pass.color_write(handles->normal, LoadOp::Clear);
     handles->reflection_sample = pass.color_write(handles->reflection_sample, LoadOp::Clear);
@@ -224,6 +257,18 @@ void FlowPass::declare(FrameGraph& graph, uint32_t index_count, Handles* handles
     const VkPipeline pipeline = pipelines_[static_cast<uint32_t>(frame.material)]
                                           [frame.debug_view != DebugView::kNone ? 1 : 0];
     draw_river(ctx, pipeline, h, index_count);
+    return Status::success();
+  });
+}
+
+void FlowPass::declare_depth(FrameGraph& graph, uint32_t index_count, Handles* handles) {
+  PassBuilder pass = graph.add_pass("water depth", PassKind::Graphics);
+  handles->depth = pass.depth_write(handles->depth, LoadOp::Load);
+  pass.vertex_read(handles->vertices);
+  pass.index_read(handles->indices);
+  const Handles h = *handles;
+  pass.record([this, h, index_count](const PassContext& ctx) {
+    draw_river(ctx, depth_pipeline_, h, index_count);
     return Status::success();
   });
 }
@@ -280,6 +325,7 @@ void FlowPass::draw_river(const PassContext& ctx, VkPipeline pipeline, const Han
   const VkCommandBuffer cmd = ctx.cmd();
   const Frame& frame = ctx.data(frame_data_);
   set_viewport(vk, cmd, frame.viewport);
+  vk.vkCmdSetScissor(cmd, 0, 1, &frame.scissor);
   vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1,
                              &sets_[frame.slot], 0, nullptr);
   vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,

@@ -73,8 +73,10 @@ DataHandle<VkOffset2D> add_refraction_copy_pass(FrameGraph& graph, ImageHandle c
 // Flow tile centre near the camera; then per fragment the particle (flow texture, aux data by
 // slot), the Tiled Directional Flow normal from the table, the reflection sampled with that
 // normal, what lies under the water (the refraction copy) sampled with it and absorbed per
-// colour channel, depth colour and shore fade, over the scene's colour. With AOVs it also writes
-// the water mask, the normal, the reflection sample and the foam coverage, unblended.
+// colour channel, depth colour and shore fade, over the scene's colour. It also writes, unblended,
+// where configured: the motion vectors and reactive mask into the host's images, and the water
+// mask, the normal, the reflection sample and the foam coverage (AOVs). A pass after it can write
+// the surface's depth into the host's depth.
 class FlowPass {
  public:
   static constexpr VkFormat kMaskFormat = VK_FORMAT_R32_SFLOAT;
@@ -86,10 +88,18 @@ class FlowPass {
   static constexpr VkFormat kTileTableFormat = VK_FORMAT_R32G32B32A32_UINT;  // shaders/shared.h
   static constexpr VkFormat kWaterHeightsFormat = VK_FORMAT_R32_SFLOAT;
 
-  // One material descriptor set per frame slot (the host's depth changes per frame); with_floor:
-  // also the bench's floor pipeline (declare_floor).
-  Status create(const GpuContext& gpu, VkPipelineCache cache, VkFormat color_format,
-                VkFormat depth_format, uint32_t slot_count, bool with_aovs, bool with_floor);
+  struct Config {
+    VkFormat color_format = VK_FORMAT_UNDEFINED;
+    VkFormat depth_format = VK_FORMAT_UNDEFINED;
+    VkFormat motion_format = VK_FORMAT_UNDEFINED;    // UNDEFINED: no motion output
+    VkFormat reactive_format = VK_FORMAT_UNDEFINED;  // UNDEFINED: no reactive output
+    uint32_t slot_count = 1;
+    bool with_aovs = false;
+    bool with_floor = false;  // the bench's floor pipeline (declare_floor)
+    bool with_depth = false;  // the surface's depth pipeline (declare_depth)
+  };
+  // One material descriptor set per frame slot (the host's depth changes per frame).
+  Status create(const GpuContext& gpu, VkPipelineCache cache, const Config& config);
   void destroy(const GpuContext& gpu);
 
   struct Textures {
@@ -115,6 +125,7 @@ class FlowPass {
     VkImageView host_depth = VK_NULL_HANDLE;
     bool reverse_z = false;
     VkRect2D viewport{};
+    VkRect2D scissor{};  // inside the viewport
     gpu::WaterLookConstants look{};
     WaterMaterial material = WaterMaterial::kTiledDirectionalFlow;  // which pipeline draws
     DebugView debug_view = DebugView::kNone;
@@ -139,6 +150,8 @@ class FlowPass {
     ImageHandle refraction;     // the host's colour before the water (add_refraction_copy_pass)
     BufferHandle vertices;   // river surface positions (vec3)
     BufferHandle indices;
+    ImageHandle motion;      // the host's, written where configured; loaded and kept elsewhere
+    ImageHandle reactive;
     ImageHandle mask;        // AOVs, written when created with_aovs
     ImageHandle normal;
     ImageHandle reflection_sample;
@@ -148,6 +161,9 @@ class FlowPass {
   // handles->tile_table goes back into `handles`.
   void declare_tiles(FrameGraph& graph, Handles* handles);
   void declare(FrameGraph& graph, uint32_t index_count, Handles* handles);
+  // After declare: the surface's depth into the host's depth where the water is in front (the
+  // new version of handles->depth goes back into `handles`).
+  void declare_depth(FrameGraph& graph, uint32_t index_count, Handles* handles);
   // The floor of the flow pass for benchmarks: the same pixels (river mesh, depth test) making
   // the same texture reads with next to no arithmetic, blended into `target` (of the colour
   // format); kept although nothing reads it.
@@ -158,10 +174,10 @@ class FlowPass {
   void draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h,
                   uint32_t index_count) const;
 
-  bool with_aovs_ = false;
-  uint32_t slot_count_ = 1;
+  Config config_;
   DataHandle<Frame> frame_data_;  // declared by declare_tiles, in the graph of the passes
   VkPipeline floor_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline depth_pipeline_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   // The material's pipelines: per WaterMaterial, without and with the debug views.

@@ -19,7 +19,7 @@ struct LookVectorField {
   glm::vec3 WaterLook::*member;
 };
 
-inline constexpr std::array<LookScalarField, 10> kLookScalarFields{{
+inline constexpr std::array<LookScalarField, 11> kLookScalarFields{{
     {"absorption_per_metre", &WaterLook::absorption_per_metre},
     {"opacity_per_metre", &WaterLook::opacity_per_metre},
     {"ripple_strength", &WaterLook::ripple_strength},
@@ -30,6 +30,7 @@ inline constexpr std::array<LookScalarField, 10> kLookScalarFields{{
     {"fresnel_f0", &WaterLook::fresnel_f0},
     {"sun_glint", &WaterLook::sun_glint},
     {"foam_amount", &WaterLook::foam_amount},
+    {"reactive_strength", &WaterLook::reactive_strength},
 }};
 inline constexpr std::array<LookVectorField, 6> kLookVectorFields{{
     {"water_color", &WaterLook::water_color},

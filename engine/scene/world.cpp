@@ -80,7 +80,7 @@ struct World::Impl {
   StaticAssets assets;
   StaticAssets::GraphHandles asset_handles;  // in `graph`
   ScenePass main_pass;        // host colour and depth formats
-  ScenePass reflection_pass;  // the renderer's reflection target, when its depth format differs
+  ScenePass reflection_pass;  // the renderer's reflection target, when its formats differ
   bool own_reflection_pass = false;
 
   // What the passes draw: the static scene, each obstacle's boulder with its own constants
@@ -217,9 +217,12 @@ Status World::Impl::create_resources() {
   }
   SIVIFLOW_TRY(main_pass.create(gpu, info.pipeline_cache, info.color_format, info.depth_format));
   SIVIFLOW_TRY(main_pass.set_textures(gpu, assets.image(kDetail).view, base_colors));
-  own_reflection_pass = info.depth_format != kReflectionDepthFormat;
+  // The reflection target has the renderer's formats, which may differ from the host's.
+  const VkFormat mirrored_format = reflection_format(info.color_format);
+  own_reflection_pass =
+      info.depth_format != kReflectionDepthFormat || mirrored_format != info.color_format;
   if (!own_reflection_pass) return Status::success();
-  SIVIFLOW_TRY(reflection_pass.create(gpu, info.pipeline_cache, info.color_format,
+  SIVIFLOW_TRY(reflection_pass.create(gpu, info.pipeline_cache, mirrored_format,
                                       kReflectionDepthFormat));
   return reflection_pass.set_textures(gpu, assets.image(kDetail).view, base_colors);
 }

@@ -763,10 +763,12 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
       VkRenderingAttachmentInfo depth{};
       if (step.depth) depth = attachment_info(*step.depth);
       VkRect2D area{{0, 0}, step.extent};
-      for (const Attachment& a : step.colors) {
+      const auto take_area = [&](const Attachment& a) {
         const FrameBindings::Bound* bound = bindings.find(a.resource);
         if (bound != nullptr && bound->render_area) area = *bound->render_area;
-      }
+      };
+      if (step.depth) take_area(*step.depth);  // a depth-only pass has no colour to take it from
+      for (const Attachment& a : step.colors) take_area(a);
       VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
       rendering.renderArea = area;
       rendering.layerCount = 1;

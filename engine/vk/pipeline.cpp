@@ -100,12 +100,16 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
       blend_attachment.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
       blend_attachment.alphaBlendOp = VK_BLEND_OP_ADD;
     }
+    std::vector<VkFormat> color_formats;
+    if (desc.color_format != VK_FORMAT_UNDEFINED) color_formats.push_back(desc.color_format);
+    color_formats.insert(color_formats.end(), desc.extra_color_formats.begin(),
+                         desc.extra_color_formats.end());
     std::vector<VkPipelineColorBlendAttachmentState> blend_attachments(
-        1 + desc.extra_color_formats.size(), VkPipelineColorBlendAttachmentState{});
-    blend_attachments[0] = blend_attachment;
-    for (size_t i = 1; i < blend_attachments.size(); ++i) {
+        color_formats.size(), VkPipelineColorBlendAttachmentState{});
+    for (size_t i = 0; i < blend_attachments.size(); ++i) {
       blend_attachments[i].colorWriteMask = blend_attachment.colorWriteMask;
     }
+    if (!blend_attachments.empty()) blend_attachments[0] = blend_attachment;
     VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = static_cast<uint32_t>(blend_attachments.size());
     blend.pAttachments = blend_attachments.data();
@@ -117,9 +121,6 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
     dynamic.pDynamicStates = dynamic_states;
 
     VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-    std::vector<VkFormat> color_formats{desc.color_format};
-    color_formats.insert(color_formats.end(), desc.extra_color_formats.begin(),
-                         desc.extra_color_formats.end());
     rendering.colorAttachmentCount = static_cast<uint32_t>(color_formats.size());
     rendering.pColorAttachmentFormats = color_formats.data();
     rendering.depthAttachmentFormat = desc.depth_format;

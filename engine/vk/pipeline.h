@@ -25,8 +25,9 @@ struct GraphicsPipelineDesc {
   std::vector<VkVertexInputBindingDescription> bindings;
   std::vector<VkVertexInputAttributeDescription> attributes;
   VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkFormat color_format = VK_FORMAT_UNDEFINED;        // colour attachment 0
-  std::vector<VkFormat> extra_color_formats;         // attachments 1.. (AOVs): never blended
+  VkFormat color_format = VK_FORMAT_UNDEFINED;  // colour attachment 0; UNDEFINED: depth only
+  // Attachments 1.. (motion, reactive, AOVs): never blended.
+  std::vector<VkFormat> extra_color_formats;
   VkFormat depth_format = VK_FORMAT_UNDEFINED;  // UNDEFINED: no depth attachment
   bool depth_test = true;
   bool depth_write = true;

@@ -38,11 +38,10 @@ class GpuTest : public ::testing::Test {
     EXPECT_EQ(context_->validation_error_count(), 0u) << messages;
   }
 
-  // Colour (RGBA16F) and depth (D32) images of `extent` for one host slot, the colour left
+  // Colour (color_format_) and depth (D32) images of `extent` for one host slot, the colour left
   // sampled after each frame.
   Status create_sampled_targets(VkExtent2D extent, HostTargets* out) {
-    return create_host_targets(*context_, VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT,
-                               extent,
+    return create_host_targets(*context_, color_format_, VK_FORMAT_D32_SFLOAT, extent,
                                {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
                                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
@@ -50,7 +49,7 @@ class GpuTest : public ::testing::Test {
   }
 
   CreateInfo make_create_info(uint32_t width, uint32_t height) const {
-    CreateInfo info = context_->renderer_create_info({width, height}, VK_FORMAT_R16G16B16A16_SFLOAT);
+    CreateInfo info = context_->renderer_create_info({width, height}, color_format_);
     info.depth_format = VK_FORMAT_D32_SFLOAT;
     info.frames_in_flight = 2;
     info.readback_images = kAllReadbackImages;
@@ -85,6 +84,7 @@ class GpuTest : public ::testing::Test {
   }
 
   std::unique_ptr<HeadlessContext> context_;
+  VkFormat color_format_ = VK_FORMAT_R16G16B16A16_SFLOAT;  // the host's colour images
   std::unique_ptr<World> world_;
   std::unique_ptr<Renderer> renderer_;
 };

@@ -6,9 +6,9 @@
 #include <functional>
 #include <vector>
 
-#include <glm/gtc/packing.hpp>
 #include <gtest/gtest.h>
 
+#include "color_texels.h"
 #include "gpu_test.h"
 #include "siviflow/host_frame.h"
 
@@ -19,7 +19,7 @@ constexpr uint32_t kHeight = 180;
 
 struct Frame {
   uint32_t width = 0;
-  std::vector<float> rgba;   // linear, 4 floats per pixel
+  std::vector<float> rgba;   // linear, 4 floats per pixel (decoded from the host's format)
   std::vector<float> depth;  // window depth, 0 near .. 1 far
   std::vector<float> water_mask;
   std::vector<std::byte> flow_texture;  // as uploaded and read back
@@ -89,9 +89,7 @@ class RenderTest : public GpuTest {
     const auto collect = [&](Slot& slot) {
       Frame out;
       out.width = width;
-      const auto* halves = static_cast<const uint16_t*>(slot.readback[0].data);
-      out.rgba.resize(size_t{width} * height * 4);
-      for (size_t i = 0; i < out.rgba.size(); ++i) out.rgba[i] = glm::unpackHalf1x16(halves[i]);
+      out.rgba = decode_color(color_format_, slot.readback[0].data, size_t{width} * height);
       const auto* depths = static_cast<const float*>(slot.readback[1].data);
       out.depth.assign(depths, depths + size_t{width} * height);
       const auto* mask = static_cast<const float*>(slot.readback[2].data);

@@ -595,7 +595,8 @@ TEST_F(RenderTest, BadHostImagesAndViewsAreRefusedByName) {
   refused(inputs, "FrameInputs::color.final.layout");
   inputs.color = targets.color;
   inputs.depth.format = VK_FORMAT_D24_UNORM_S8_UINT;
-  refused(inputs, "FrameInputs::depth.format 129");
+  refused(inputs, "siviflow::Renderer: FrameInputs::depth.format VK_FORMAT_D24_UNORM_S8_UINT "
+                  "differs from the configured VK_FORMAT_D32_SFLOAT");
   inputs.depth = targets.depth;
   inputs.color.extent = {kWidth - 1, kHeight};
   refused(inputs, "FrameInputs::color.extent 319x180 does not contain");
@@ -604,10 +605,11 @@ TEST_F(RenderTest, BadHostImagesAndViewsAreRefusedByName) {
   refused(inputs, "FrameInputs::depth needs an image and a view");
   inputs.depth = targets.depth;
   inputs.depth.usage &= ~VkImageUsageFlags{VK_IMAGE_USAGE_SAMPLED_BIT};  // the water reads it
-  refused(inputs, "FrameInputs::depth.usage 0x21 lacks 0x4");
+  refused(inputs, "siviflow::Renderer: FrameInputs::depth.usage VK_IMAGE_USAGE_TRANSFER_SRC_BIT | "
+                  "VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT lacks VK_IMAGE_USAGE_SAMPLED_BIT");
   inputs.depth = targets.depth;
   inputs.color.usage &= ~VkImageUsageFlags{VK_IMAGE_USAGE_TRANSFER_SRC_BIT};  // the refraction copy
-  refused(inputs, "lacks 0x1");
+  refused(inputs, "lacks VK_IMAGE_USAGE_TRANSFER_SRC_BIT");
   ASSERT_TRUE(context_->end_slot_and_submit(0).ok());  // an empty command buffer is fine
   ASSERT_TRUE(context_->wait_slot(0).ok());
 }

@@ -532,7 +532,7 @@ TEST(SceneFile, BadRiverListsAreNamed) {
 TEST(SceneFileSchema, LookKeysDefaultsAndRangesMatchWaterLook) {
   const Json schema = load_schema();
   const Json& look = schema["properties"]["look"]["properties"];
-  EXPECT_EQ(look.size(), 17u) << "WaterLook has 17 fields";
+  EXPECT_EQ(look.size(), 18u) << "WaterLook has 18 fields";
   // All the schema's defaults, written out, give WaterLook's defaults.
   Json defaults = Json::object();
   for (const auto& item : look.items()) defaults[item.key()] = item.value()["default"];

@@ -23,7 +23,7 @@ Range scalar_range(const char* name) {
   if (n == "tile_size_m") return {kMinTileSizeM, kMaxTileSizeM};
   if (n == "reflection_distortion" || n == "refraction_distortion") return {0.0f, 0.5f};
   if (n == "sun_glint") return {0.0f, 10.0f};
-  return {0.0f, 1.0f};  // fresnel_f0
+  return {0.0f, 1.0f};  // fresnel_f0, reactive_strength
 }
 
 void table(const char* title, const std::vector<std::pair<std::string, double>>& rows) {

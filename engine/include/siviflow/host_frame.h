@@ -19,12 +19,20 @@ namespace siviflow {
 struct HostTargets {
   ExternalImage color;  // current: where the last frame left it; final: what the host wants
   ExternalImage depth;
+  // For renderers with CreateInfo::motion_format / reactive_format (no image: none). The
+  // built-in world writes neither: off the water they keep what they held.
+  ExternalImage motion;
+  ExternalImage reactive;
 };
 
 // Colour (colour attachment, sampled, copy source) and depth images for one slot; the colour
 // ends each frame in `color_final`, the depth read-only.
 Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFormat depth_format,
                            VkExtent2D extent, ImageState color_final, HostTargets* out);
+
+// Motion and reactive images for one slot (VK_FORMAT_UNDEFINED: none), left as attachments.
+Status create_temporal_targets(HeadlessContext& context, VkFormat motion_format,
+                               VkFormat reactive_format, VkExtent2D extent, HostTargets* out);
 
 // Records into `cmd`: the world seen through `view` at `time_seconds`, then the water of each
 // renderer in turn (a scene's rivers; update() for this frame already called on each), the

@@ -64,9 +64,10 @@ struct ReflectionView {
   float camera_position[3];  // the mirrored camera, for view-dependent shading
   VkExtent2D extent;     // of the reflection target
   bool reverse_z;        // the host's projection maps near to 1 and far to 0 (depth cleared to 0)
+  VkFormat format;       // of the reflection target: reflection_format(CreateInfo::color_format)
 };
 // Records the host's world into the reflection target. Called inside the reflection pass, with
-// dynamic rendering begun (colour: CreateInfo::color_format, cleared to transparent black;
+// dynamic rendering begun (colour: ReflectionView::format, cleared to transparent black;
 // depth: VK_FORMAT_D32_SFLOAT, cleared to the far value of the view's depth convention) and
 // viewport and scissor set; the host binds its own pipelines (with that rendering format and
 // gl_ClipDistance against clip_plane) and must not end the rendering. Where the host leaves
@@ -85,10 +86,29 @@ struct CreateInfo {
   const VkPhysicalDeviceFeatures2* enabled_features = nullptr;
   uint32_t queue_family_index = 0;     // family of the queue that will run what we record (graphics)
   uint32_t frames_in_flight = 0;       // ring slots; 0 means 2
-  VkFormat color_format = VK_FORMAT_UNDEFINED;  // host colour image format; 0 means RGBA16F
+  // Host colour image format; required. Any colour format with red, green and blue that the
+  // device can blend into as a colour attachment, sample and copy (optimal tiling):
+  // B10G11R11_UFLOAT_PACK32, A2B10G10R10_UNORM_PACK32, R16G16B16A16_SFLOAT, R32G32B32A32_SFLOAT,
+  // R8G8B8A8 and B8G8R8A8 in UNORM and SRGB, ... create() names a missing format feature.
+  VkFormat color_format = VK_FORMAT_UNDEFINED;
   // Host depth image format: D32_SFLOAT (0 means this), D24_UNORM_S8_UINT or D32_SFLOAT_S8_UINT.
   VkFormat depth_format = VK_FORMAT_UNDEFINED;
   VkExtent2D extent = {0, 0};          // the view's size in pixels (its viewport); required
+  // Outputs for the host's temporal filters (TAA, FSR 2/3, DLSS, XeSS), written where the water
+  // is the nearest surface and kept elsewhere; VK_FORMAT_UNDEFINED: none, and FrameInputs::motion
+  // / ::reactive are not read. Motion: a two-channel float format (R16G16_SFLOAT,
+  // R32G32_SFLOAT); reactive: a colour format with red (R8_UNORM, R16_SFLOAT, ...).
+  VkFormat motion_format = VK_FORMAT_UNDEFINED;
+  VkFormat reactive_format = VK_FORMAT_UNDEFINED;
+  // The water writes its surface's depth into FrameInputs::depth once it has drawn (for the
+  // host's fog, depth of field and later transparent passes); its own reads of what lies behind
+  // it still see the host's depth. Off: the host's depth is only tested, never written.
+  bool write_depth = false;
+  // Places the river (its mesh, obstacles and their keys, all in river space: +Y up, metres) in
+  // the host's world: a rigid transform, a rotation and a translation (a uniform scale also
+  // works, the water's look then measuring river metres). Views, occluders and river_bounds()
+  // are in the host's world. A Z-up engine puts its rotation here instead of rotating its views.
+  glm::mat4 world_from_river{1.0f};
   // The images to copy into host buffers each frame (ReadbackImage bits, readback_bit()); 0,
   // the shipping path: no copies and no AOV attachments.
   uint32_t readback_images = 0;
@@ -143,12 +163,25 @@ struct OccluderMesh {
 struct View {
   glm::mat4 view{1.0f};  // world -> view space (right-handed, looking down -Z)
   // view -> Vulkan clip space (x right, y down, depth 0..1), a perspective projection: standard
-  // or reverse-Z, finite or infinite far plane, off-centre or jittered. The renderer derives
-  // the depth convention from it every frame.
+  // or reverse-Z, finite or infinite far plane, off-centre, with this frame's jitter in it. The
+  // renderer derives the depth convention from it every frame.
   glm::mat4 projection{1.0f};
+  // The sub-pixel offset `projection` carries this frame (pixels, x right, y down; a TAA or
+  // upscaler jitter, e.g. Halton(2,3) - 0.5): a point the unjittered projection puts at pixel p
+  // lands at p + jitter. The water is drawn jittered, as the host's world is; its particles,
+  // motion vectors and (unless jitter_reflection) reflection use the unjittered projection, so
+  // jitter neither churns particles nor shows in motion. |jitter| <= 64 px.
+  glm::vec2 jitter{0.0f};
+  bool jitter_reflection = false;  // draw the reflection with the jittered projection too
+  // No previous frame to move from (a cut, a teleport): this frame's motion vectors are zero.
+  // The first frame after create() and resize() is one too.
+  bool camera_cut = false;
   // The pixels of the host's images the view covers; its extent must equal CreateInfo::extent.
   // An extent of 0x0 means {offset, CreateInfo::extent}.
   VkRect2D viewport{};
+  // The water draws only inside this rectangle (host image pixels), which must lie inside the
+  // viewport; 0x0: the whole viewport. Two views sharing pixels (picture in picture) keep apart.
+  VkRect2D scissor{};
 };
 
 // A convenience for hosts without matrices of their own: a position, a target, +Y up.
@@ -189,7 +222,7 @@ struct ExternalImage {
 // rows, top-left origin of the view's viewport:
 enum class ReadbackImage : uint32_t {
   kColor,        // the host's colour with the water, in its format's texels
-  kDepth,        // the host's depth (the water writes none), its depth aspect's 4-byte texels
+  kDepth,        // the host's depth (with the water's, write_depth), its depth aspect's 4-byte texels
   kWaterMask,    // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
   kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h)
   kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)
@@ -232,14 +265,35 @@ struct FrameInputs {
   ExternalImage color;
   // The host's depth image of the same frame: the water is depth-tested against it and reads it
   // for the depth of water behind each pixel (depth attachment and sampled usages; transfer
-  // source with readback). Not written.
+  // source with readback). Written only with CreateInfo::write_depth. The host's render pass
+  // must store it (storeOp STORE): a tiled GPU otherwise hands the water garbage to test against.
   ExternalImage depth;
+  // With CreateInfo::motion_format: the host's motion vectors, the view's pixels of it (colour
+  // attachment usage). Where the water is the nearest surface it writes the screen motion of its
+  // surface point, uv_previous - uv_current in viewport UV units (x right, y down, 1 = the
+  // viewport's width or height), jitter excluded: FSR 2/3's and DLSS's default convention
+  // (DLSS: scale by the viewport's size in pixels). Elsewhere the host's values stay.
+  ExternalImage motion;
+  // With CreateInfo::reactive_format: the host's reactive mask (colour attachment usage). Where
+  // the water is the nearest surface it writes how much a temporal filter should distrust its
+  // history there, 0..1 in the red channel: WaterLook::reactive_strength x the water's opacity
+  // x min(1, the applied ripple strength + the Fresnel reflection share + the foam cover).
+  // Elsewhere the host's values stay.
+  ExternalImage reactive;
   ReadbackTargets readback;
 };
 
+// The format of the reflection target a renderer of `color_format` draws into (and a host's
+// ReflectionCallback draws with): the colour format itself when it has an alpha channel, whose
+// 0 marks "nothing reflected, the sky shows"; R16G16B16A16_SFLOAT for one without
+// (B10G11R11_UFLOAT_PACK32, ...). VK_FORMAT_UNDEFINED for a format create() does not take.
+VkFormat reflection_format(VkFormat color_format);
+
 // The device memory a view of `info` (its extent, formats, frames in flight, readback images,
 // timing) takes, for a host's budget before create(); no device needed. Upper bounds where the
-// river decides (the particles' slots, the tile table).
+// river decides (the particles' slots, the tile table). It refuses exactly what create() refuses
+// of `info`'s sizes and formats without asking a device (create() also asks the device's
+// features of the formats), with the same messages.
 struct ViewMemory {
   // The renderer's own: the reflection and its depth, the refraction copy, the AOV attachments
   // and the flow floor when asked for, the flow texture, particle aux data and tile table, and a
@@ -268,8 +322,12 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // The host has waited until the GPU finished the commands last recorded for this slot.
+  // The host has waited until the GPU finished the commands last recorded for this slot. A frame
+  // updated but not recorded is an error: record it, or abandon_frame() it first.
   Status begin_frame(uint32_t slot);
+  // Drops the frame begun (the host's own recording failed, or it will not submit it): its
+  // particles keep their step, nothing of it reaches the GPU, and begin_frame starts the next.
+  Status abandon_frame();
   // CPU only: the host's view and simulation time for the frame being prepared: advances the
   // river's particles one frame (frame next_frame()) and packs the flow textures into the slot's
   // staging block. The particles carry state from frame to frame: to start at frame N and get
@@ -320,6 +378,14 @@ class Renderer {
   // With CreateInfo::enable_timing: the GPU time of each pass of the frame last recorded in
   // `slot`. Call only after the host waited for that slot's frame.
   Status pass_times(uint32_t slot, std::vector<PassTime>* out) const;
+
+  // The water surface's box in the host's world (CreateInfo::world_from_river applied), metres:
+  // every point of the surface lies inside; for framing or culling the river.
+  struct Bounds {
+    glm::vec3 min{0.0f};
+    glm::vec3 max{0.0f};
+  };
+  Bounds river_bounds() const;
 
   const TileTableLayout& tile_table_layout() const;
   // The index of the next frame update() or simulate() will advance to.

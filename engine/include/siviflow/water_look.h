@@ -53,6 +53,11 @@ struct WaterLook {
   // [0, 4]: 0 none, 1 as the flow makes it, more spreads it further.
   float foam_amount = 1.0f;
   glm::vec3 foam_color{0.80f, 0.82f, 0.82f};  // linear RGB of foam in full light, each in [0, 1]
+  // How much the water asks a host's temporal filter to distrust its history, in [0, 1]: the
+  // reactive mask's scale (FrameInputs::reactive). Ripples, reflections and foam move against
+  // the surface's motion vectors; 0 lets TAA accumulate them (smooth, may smear), 1 keeps them
+  // sharp (may shimmer).
+  float reactive_strength = 0.6f;
 };
 
 // Range limits of the tile size: the renderer sizes its water heights for the largest.

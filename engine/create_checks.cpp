@@ -1,0 +1,114 @@
+// What create() and view_memory() refuse of a CreateInfo without asking a device (its sizes,
+// formats and placement), in one place so that the two refuse exactly the same, in the same
+// words.
+#include <cmath>
+#include <string>
+
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+
+#include "renderer_impl.h"
+#include "sim/text_format.h"
+#include "vk/vk_text.h"
+
+namespace siviflow {
+namespace {
+
+constexpr uint32_t kMaxFramesInFlight = 8;
+
+bool is_host_depth_format(VkFormat format) {
+  return format == VK_FORMAT_D32_SFLOAT || format == VK_FORMAT_D24_UNORM_S8_UINT ||
+         format == VK_FORMAT_D32_SFLOAT_S8_UINT;
+}
+
+// A two-channel float format: motion vectors are signed fractions of the viewport.
+bool is_motion_format(VkFormat format) {
+  return format == VK_FORMAT_R16G16_SFLOAT || format == VK_FORMAT_R32G32_SFLOAT;
+}
+
+// Float or normalized: the reactive mask is a fraction in the red channel.
+bool is_reactive_format(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R8_UNORM:
+    case VK_FORMAT_R16_UNORM:
+    case VK_FORMAT_R16_SFLOAT:
+    case VK_FORMAT_R32_SFLOAT:
+    case VK_FORMAT_R8G8_UNORM:
+    case VK_FORMAT_R16G16_SFLOAT:
+    case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Whether the matrix is finite, affine and invertible; its determinant in `det`.
+bool is_placement(const glm::mat4& m, float* det) {
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(m[c][r])) return false;
+    }
+  }
+  *det = glm::determinant(glm::mat3(m));
+  return m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f && m[3][3] == 1.0f;
+}
+
+}  // namespace
+
+Status check_create_info(const CreateInfo& info) {
+  if (info.extent.width == 0 || info.extent.height == 0) {
+    return argument_error("CreateInfo::extent must be at least 1x1");
+  }
+  if (info.frames_in_flight > kMaxFramesInFlight) {
+    return argument_error("CreateInfo::frames_in_flight " + std::to_string(info.frames_in_flight) +
+                          " exceeds " + std::to_string(kMaxFramesInFlight));
+  }
+  if (info.color_format == VK_FORMAT_UNDEFINED) {
+    return argument_error(
+        "CreateInfo::color_format is VK_FORMAT_UNDEFINED: name the format of the host's colour "
+        "image");
+  }
+  if (color_channel_count(info.color_format) < 3) {
+    return argument_error("CreateInfo::color_format " + format_name(info.color_format) +
+                          " is not an uncompressed colour format with red, green and blue");
+  }
+  if (info.depth_format != VK_FORMAT_UNDEFINED && !is_host_depth_format(info.depth_format)) {
+    return argument_error("CreateInfo::depth_format " + format_name(info.depth_format) +
+                          " is not VK_FORMAT_D32_SFLOAT, VK_FORMAT_D24_UNORM_S8_UINT or "
+                          "VK_FORMAT_D32_SFLOAT_S8_UINT");
+  }
+  if (info.motion_format != VK_FORMAT_UNDEFINED && !is_motion_format(info.motion_format)) {
+    return argument_error("CreateInfo::motion_format " + format_name(info.motion_format) +
+                          " is not VK_FORMAT_R16G16_SFLOAT or VK_FORMAT_R32G32_SFLOAT");
+  }
+  if (info.reactive_format != VK_FORMAT_UNDEFINED && !is_reactive_format(info.reactive_format)) {
+    return argument_error("CreateInfo::reactive_format " + format_name(info.reactive_format) +
+                          " is not a normalized or float format with a red channel "
+                          "(VK_FORMAT_R8_UNORM, VK_FORMAT_R16_SFLOAT, ...)");
+  }
+  if ((info.readback_images & ~kAllReadbackImages) != 0) {
+    return argument_error("CreateInfo::readback_images 0x" +
+                          text_format("%x", info.readback_images) + " has bits past the " +
+                          std::to_string(kReadbackImageCount) + " ReadbackImage values");
+  }
+  float det = 0.0f;
+  if (!is_placement(info.world_from_river, &det) || !(std::abs(det) > 1e-12f) ||
+      !std::isfinite(1.0f / det)) {
+    const glm::mat4& m = info.world_from_river;
+    std::string rows;
+    for (int r = 0; r < 4; ++r) {
+      rows += text_format("%s[%g %g %g %g]", r == 0 ? "" : " ", m[0][r], m[1][r], m[2][r], m[3][r]);
+    }
+    return argument_error("CreateInfo::world_from_river " + rows +
+                          " is not a finite, invertible affine transform (last row 0 0 0 1)");
+  }
+  return Status::success();
+}
+
+VkFormat reflection_format(VkFormat color_format) {
+  if (color_channel_count(color_format) < 3) return VK_FORMAT_UNDEFINED;
+  return color_has_alpha(color_format) ? color_format : VK_FORMAT_R16G16B16A16_SFLOAT;
+}
+
+}  // namespace siviflow
