@@ -124,6 +124,15 @@ TEST(AccessTable, NamesAreStable) {
   EXPECT_EQ(access_flags_name(VK_ACCESS_2_TRANSFER_WRITE_BIT | (1ull << 60)),
             "TRANSFER_WRITE|0x1000000000000000");
   EXPECT_EQ(layout_name(VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL), "TRANSFER_DST_OPTIMAL");
+  // The dumps' own order and set of names, not vk_text's ascending full set.
+  EXPECT_EQ(stage_flags_name(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
+                             VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT |
+                             VK_PIPELINE_STAGE_2_GEOMETRY_SHADER_BIT),
+            "TRANSFER|COMPUTE_SHADER|0x40");
+  EXPECT_EQ(access_flags_name(VK_ACCESS_2_SHADER_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT),
+            "MEMORY_WRITE|SHADER_READ");
+  EXPECT_EQ(layout_name(VK_IMAGE_LAYOUT_PRESENT_SRC_KHR), "PRESENT_SRC_KHR");
+  EXPECT_EQ(layout_name(VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL), "LAYOUT_1000241000");
 }
 
 TEST(FrameGraphCompile, ExactBarrierListingOfUploadSceneReadback) {
