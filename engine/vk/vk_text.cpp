@@ -147,8 +147,8 @@ struct FormatInfo {
   FormatInfo { f, #f, 0, 0, false }
 
 // Every core format, ascending (for a binary search). Generated once: names and values from
-// vulkan_core.h 1.3.239, the colour formats' sizes and components from its vk.xml (a format with
-// no depth or stencil component, no compression, chroma subsampling or planes).
+// vulkan_core.h 1.3.239, the colour formats' sizes and components from its vk.xml: those with no
+// depth or stencil component, compression, planes, or chroma (which marks a YCbCr format).
 constexpr FormatInfo kFormats[] = {
     SIVIFLOW_FORMAT_OTHER(VK_FORMAT_UNDEFINED),
     SIVIFLOW_FORMAT_COLOR(VK_FORMAT_R4G4_UNORM_PACK8, 1, 2, false),
@@ -392,7 +392,7 @@ constexpr FormatInfo kFormats[] = {
 };
 #undef SIVIFLOW_FORMAT_COLOR
 #undef SIVIFLOW_FORMAT_OTHER
-// 1.0's 0..184, 1.1's 34 YCbCr formats, 1.3's 4 planar 4:4:4, 2 A4 and 14 ASTC HDR formats.
+// 1.0's 0..184, 1.1's 34 of sampler YCbCr conversion, 1.3's 4 planar 4:4:4, 2 A4 and 14 ASTC HDR.
 static_assert(std::size(kFormats) == 185 + 34 + 4 + 2 + 14);
 static_assert(std::is_sorted(std::begin(kFormats), std::end(kFormats),
                              [](const FormatInfo& a, const FormatInfo& b) {

@@ -17,7 +17,8 @@ std::string format_name(VkFormat format);
 
 // Of an uncompressed, single-plane colour format (R8_UNORM 1, B10G11R11_UFLOAT_PACK32 4,
 // R32G32B32A32_SFLOAT 16): the bytes of one texel, its channels, whether one is alpha. 0 (false)
-// for UNDEFINED, depth/stencil, compressed, YCbCr (packed 4:2:2 or multi-planar) and unknown ones.
+// for UNDEFINED, depth/stencil, compressed, multi-planar and unknown formats and those that need
+// a sampler YCbCr conversion (G8B8G8R8_422_UNORM, R10X6G10X6B10X6A10X6_UNORM_4PACK16).
 uint32_t color_texel_bytes(VkFormat format);
 uint32_t color_channel_count(VkFormat format);
 bool color_has_alpha(VkFormat format);

@@ -65,6 +65,7 @@ TEST(VkText, ColorTexelBytes) {
   EXPECT_EQ(color_texel_bytes(VK_FORMAT_BC7_UNORM_BLOCK), 0u);
   EXPECT_EQ(color_texel_bytes(VK_FORMAT_ASTC_4x4_SFLOAT_BLOCK), 0u);
   EXPECT_EQ(color_texel_bytes(VK_FORMAT_G8B8G8R8_422_UNORM), 0u);
+  EXPECT_EQ(color_texel_bytes(VK_FORMAT_R10X6G10X6B10X6A10X6_UNORM_4PACK16), 0u);  // YCbCr 4:4:4
   EXPECT_EQ(color_texel_bytes(VK_FORMAT_G8_B8R8_2PLANE_420_UNORM), 0u);
   EXPECT_EQ(color_texel_bytes(static_cast<VkFormat>(123456789)), 0u);
 }
