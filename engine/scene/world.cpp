@@ -23,6 +23,7 @@
 #include "vk/frame_ring.h"
 #include "vk/gpu_resources.h"
 #include "vk/pipeline.h"
+#include "vk/vk_text.h"
 
 namespace siviflow {
 namespace {
@@ -392,8 +393,13 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
                            double time_seconds, const ExternalImage& host_color,
                            const ExternalImage& host_depth) {
   Impl& w = *this;
-  if (host_color.format != w.info.color_format || host_depth.format != w.info.depth_format) {
-    return world_error("colour or depth image format differs from WorldCreateInfo's");
+  if (host_color.format != w.info.color_format) {
+    return world_error("the colour image's format " + format_name(host_color.format) +
+                       " differs from WorldCreateInfo's " + format_name(w.info.color_format));
+  }
+  if (host_depth.format != w.info.depth_format) {
+    return world_error("the depth image's format " + format_name(host_depth.format) +
+                       " differs from WorldCreateInfo's " + format_name(w.info.depth_format));
   }
   ViewMath math;
   SIVIFLOW_TRY(derive_view_math(view.view, view.projection, &math));

@@ -1,8 +1,11 @@
 #include "vk/access.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <iterator>
-#include <utility>
+#include <string_view>
+
+#include "vk/vk_text.h"
 
 namespace siviflow {
 namespace {
@@ -71,64 +74,95 @@ constexpr VkAccessFlags2 kWriteAccess =
     VK_ACCESS_2_HOST_WRITE_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT |
     VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 
-using FlagName = std::pair<uint64_t, const char*>;
-
-// Print order of the bits; ALL_TRANSFER (== TRANSFER) prints as "TRANSFER".
-const FlagName kStageNames[] = {
-    {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, "ALL_COMMANDS"},
-    {VK_PIPELINE_STAGE_2_ALL_GRAPHICS_BIT, "ALL_GRAPHICS"},
-    {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, "TRANSFER"},
-    {VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, "TOP_OF_PIPE"},
-    {VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, "DRAW_INDIRECT"},
-    {VK_PIPELINE_STAGE_2_VERTEX_INPUT_BIT, "VERTEX_INPUT"},
-    {VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT, "INDEX_INPUT"},
-    {VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT, "VERTEX_ATTRIBUTE_INPUT"},
-    {VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT, "VERTEX_SHADER"},
-    {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, "FRAGMENT_SHADER"},
-    {VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT, "EARLY_FRAGMENT_TESTS"},
-    {VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, "LATE_FRAGMENT_TESTS"},
-    {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, "COLOR_ATTACHMENT_OUTPUT"},
-    {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, "COMPUTE_SHADER"},
-    {VK_PIPELINE_STAGE_2_COPY_BIT, "COPY"},
-    {VK_PIPELINE_STAGE_2_RESOLVE_BIT, "RESOLVE"},
-    {VK_PIPELINE_STAGE_2_BLIT_BIT, "BLIT"},
-    {VK_PIPELINE_STAGE_2_CLEAR_BIT, "CLEAR"},
-    {VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, "BOTTOM_OF_PIPE"},
-    {VK_PIPELINE_STAGE_2_HOST_BIT, "HOST"},
+// The dumps name these bits, in this order, as the tests read them (others print as hex); each
+// name is vk_text's without its prefix and "_BIT".
+constexpr VkPipelineStageFlags2 kStageDumpOrder[] = {
+    VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+    VK_PIPELINE_STAGE_2_ALL_GRAPHICS_BIT,
+    VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+    VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT,
+    VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT,
+    VK_PIPELINE_STAGE_2_VERTEX_INPUT_BIT,
+    VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT,
+    VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT,
+    VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT,
+    VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT,
+    VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+    VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+    VK_PIPELINE_STAGE_2_COPY_BIT,
+    VK_PIPELINE_STAGE_2_RESOLVE_BIT,
+    VK_PIPELINE_STAGE_2_BLIT_BIT,
+    VK_PIPELINE_STAGE_2_CLEAR_BIT,
+    VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT,
+    VK_PIPELINE_STAGE_2_HOST_BIT,
 };
 
-const FlagName kAccessNames[] = {
-    {VK_ACCESS_2_MEMORY_READ_BIT, "MEMORY_READ"},
-    {VK_ACCESS_2_MEMORY_WRITE_BIT, "MEMORY_WRITE"},
-    {VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT, "INDIRECT_COMMAND_READ"},
-    {VK_ACCESS_2_INDEX_READ_BIT, "INDEX_READ"},
-    {VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT, "VERTEX_ATTRIBUTE_READ"},
-    {VK_ACCESS_2_UNIFORM_READ_BIT, "UNIFORM_READ"},
-    {VK_ACCESS_2_INPUT_ATTACHMENT_READ_BIT, "INPUT_ATTACHMENT_READ"},
-    {VK_ACCESS_2_SHADER_READ_BIT, "SHADER_READ"},
-    {VK_ACCESS_2_SHADER_WRITE_BIT, "SHADER_WRITE"},
-    {VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, "SHADER_SAMPLED_READ"},
-    {VK_ACCESS_2_SHADER_STORAGE_READ_BIT, "SHADER_STORAGE_READ"},
-    {VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, "SHADER_STORAGE_WRITE"},
-    {VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT, "COLOR_ATTACHMENT_READ"},
-    {VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, "COLOR_ATTACHMENT_WRITE"},
-    {VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT, "DEPTH_STENCIL_ATTACHMENT_READ"},
-    {VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, "DEPTH_STENCIL_ATTACHMENT_WRITE"},
-    {VK_ACCESS_2_TRANSFER_READ_BIT, "TRANSFER_READ"},
-    {VK_ACCESS_2_TRANSFER_WRITE_BIT, "TRANSFER_WRITE"},
-    {VK_ACCESS_2_HOST_READ_BIT, "HOST_READ"},
-    {VK_ACCESS_2_HOST_WRITE_BIT, "HOST_WRITE"},
+constexpr VkAccessFlags2 kAccessDumpOrder[] = {
+    VK_ACCESS_2_MEMORY_READ_BIT,
+    VK_ACCESS_2_MEMORY_WRITE_BIT,
+    VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
+    VK_ACCESS_2_INDEX_READ_BIT,
+    VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT,
+    VK_ACCESS_2_UNIFORM_READ_BIT,
+    VK_ACCESS_2_INPUT_ATTACHMENT_READ_BIT,
+    VK_ACCESS_2_SHADER_READ_BIT,
+    VK_ACCESS_2_SHADER_WRITE_BIT,
+    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+    VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+    VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+    VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT,
+    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
+    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+    VK_ACCESS_2_TRANSFER_READ_BIT,
+    VK_ACCESS_2_TRANSFER_WRITE_BIT,
+    VK_ACCESS_2_HOST_READ_BIT,
+    VK_ACCESS_2_HOST_WRITE_BIT,
 };
+
+// The layouts the dumps name; any other prints as LAYOUT_ and its number.
+constexpr VkImageLayout kDumpLayouts[] = {
+    VK_IMAGE_LAYOUT_UNDEFINED,
+    VK_IMAGE_LAYOUT_GENERAL,
+    VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+    VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+    VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL,
+    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+    VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+    VK_IMAGE_LAYOUT_PREINITIALIZED,
+    VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL,
+    VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL,
+    VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+};
+
+// "VK_ACCESS_2_TRANSFER_WRITE_BIT" -> "TRANSFER_WRITE".
+std::string dump_name(std::string name, std::string_view prefix) {
+  if (name.starts_with(prefix)) name.erase(0, prefix.size());
+  if (name.ends_with("_BIT")) name.resize(name.size() - 4);
+  return name;
+}
+
+std::string stage_dump_name(uint64_t bit) {
+  // The dumps have always called ALL_TRANSFER by its alias.
+  if (bit == VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT) return "TRANSFER";
+  return dump_name(stage_text(bit), "VK_PIPELINE_STAGE_2_");
+}
+
+std::string access_dump_name(uint64_t bit) { return dump_name(access_text(bit), "VK_ACCESS_2_"); }
 
 template <std::size_t N>
-std::string flags_name(uint64_t flags, const FlagName (&names)[N]) {
+std::string flags_name(uint64_t flags, const uint64_t (&order)[N],
+                       std::string (*name_of)(uint64_t bit)) {
   if (flags == 0) return "NONE";
   std::string out;
-  for (const auto& [bits, name] : names) {
-    if ((flags & bits) != bits) continue;
+  for (const uint64_t bit : order) {
+    if ((flags & bit) == 0) continue;
     if (!out.empty()) out += '|';
-    out += name;
-    flags &= ~bits;
+    out += name_of(bit);
+    flags &= ~bit;
   }
   if (flags != 0) {
     char hex[32];
@@ -163,26 +197,20 @@ VkImageLayout image_layout(Access access, VkFormat format) {
 
 VkAccessFlags2 write_bits(VkAccessFlags2 access) { return access & kWriteAccess; }
 
-std::string stage_flags_name(VkPipelineStageFlags2 stages) { return flags_name(stages, kStageNames); }
+std::string stage_flags_name(VkPipelineStageFlags2 stages) {
+  return flags_name(stages, kStageDumpOrder, stage_dump_name);
+}
 
-std::string access_flags_name(VkAccessFlags2 access) { return flags_name(access, kAccessNames); }
+std::string access_flags_name(VkAccessFlags2 access) {
+  return flags_name(access, kAccessDumpOrder, access_dump_name);
+}
 
 std::string layout_name(VkImageLayout layout) {
-  switch (layout) {
-    case VK_IMAGE_LAYOUT_UNDEFINED: return "UNDEFINED";
-    case VK_IMAGE_LAYOUT_GENERAL: return "GENERAL";
-    case VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL: return "COLOR_ATTACHMENT_OPTIMAL";
-    case VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL: return "DEPTH_STENCIL_ATTACHMENT_OPTIMAL";
-    case VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL: return "DEPTH_STENCIL_READ_ONLY_OPTIMAL";
-    case VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL: return "SHADER_READ_ONLY_OPTIMAL";
-    case VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL: return "TRANSFER_SRC_OPTIMAL";
-    case VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL: return "TRANSFER_DST_OPTIMAL";
-    case VK_IMAGE_LAYOUT_PREINITIALIZED: return "PREINITIALIZED";
-    case VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL: return "READ_ONLY_OPTIMAL";
-    case VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL: return "ATTACHMENT_OPTIMAL";
-    case VK_IMAGE_LAYOUT_PRESENT_SRC_KHR: return "PRESENT_SRC_KHR";
-    default: return "LAYOUT_" + std::to_string(static_cast<int>(layout));
+  if (std::find(std::begin(kDumpLayouts), std::end(kDumpLayouts), layout) ==
+      std::end(kDumpLayouts)) {
+    return "LAYOUT_" + std::to_string(static_cast<int>(layout));
   }
+  return dump_name(layout_text(layout), "VK_IMAGE_LAYOUT_");
 }
 
 VkImageAspectFlags aspect_of(VkFormat format) {

@@ -75,6 +75,7 @@ VkImageAspectFlags aspect_of(VkFormat format);
 
 // Stable names for dumps: "EARLY_FRAGMENT_TESTS|LATE_FRAGMENT_TESTS", "TRANSFER_WRITE",
 // "NONE" for zero, unknown bits as hex. Layout names drop the VK_IMAGE_LAYOUT_ prefix.
+// Messages use vk_text.h's full names instead.
 std::string stage_flags_name(VkPipelineStageFlags2 stages);
 std::string access_flags_name(VkAccessFlags2 access);
 std::string layout_name(VkImageLayout layout);

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "vk/device_table.h"
+#include "vk/vk_text.h"
 
 namespace siviflow {
 namespace {
@@ -371,7 +372,8 @@ uint32_t FrameGraph::add_use(uint32_t p, uint32_t id, uint32_t version, bool ima
   if (role != Role::Plain) {
     const bool depth_format = (aspect_of(r.image.format) & VK_IMAGE_ASPECT_COLOR_BIT) == 0;
     if (depth_format != (role == Role::Depth)) {
-      fail(where + ": the format of '" + r.name + "' does not fit " + info.name);
+      fail(where + ": the format of '" + r.name + "' (" + format_name(r.image.format) +
+           ") does not fit " + info.name);
       return version;
     }
   }
@@ -397,7 +399,8 @@ uint32_t FrameGraph::add_use(uint32_t p, uint32_t id, uint32_t version, bool ima
     }
     if (image && use.state.layout != layout) {
       fail(where + " uses '" + r.name + "' as " + use.verbs + " and " + info.name +
-           ", which need different layouts");
+           ", which need different layouts (" + layout_text(use.state.layout) + " and " +
+           layout_text(layout) + ")");
       return version;
     }
     if (use.version != version || (writes && use.writes)) {
@@ -600,7 +603,7 @@ Status FrameGraph::check_outgoing(uint32_t resource, const ResourceState& outgoi
   }
   // VUID-VkImageMemoryBarrier2-newLayout-01198: a barrier cannot transition to these layouts.
   return Status::error("frame graph: the outgoing state of '" + r.name + "' has layout " +
-                       layout_name(outgoing.layout) +
+                       layout_text(outgoing.layout) +
                        ", which no barrier may transition to; state the layout its next user "
                        "needs");
 }

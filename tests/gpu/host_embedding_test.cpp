@@ -368,5 +368,24 @@ TEST_F(HostEmbeddingTest, HostsOwnRiverFlowsAndBadArraysAreRefusedByName) {
   refused(with_flat, "CreateInfo::river->obstacles: obstacle 0");
 }
 
+TEST_F(HostEmbeddingTest, WorldRefusesAnImageOfAnotherFormatNamingBothFormats) {
+  create(nullptr, false);
+  ExternalImage color;
+  color.format = VK_FORMAT_B8G8R8A8_SRGB;
+  ExternalImage depth;
+  depth.format = VK_FORMAT_D32_SFLOAT;
+  const View view = camera_view(Camera{}, {kWidth, kHeight});
+  Status status = world_->record(VK_NULL_HANDLE, view, 0.0, color, depth);
+  EXPECT_EQ(status.message(),
+            "siviflow::World: the colour image's format VK_FORMAT_B8G8R8A8_SRGB differs from "
+            "WorldCreateInfo's VK_FORMAT_R16G16B16A16_SFLOAT");
+  color.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  depth.format = VK_FORMAT_D24_UNORM_S8_UINT;
+  status = world_->record(VK_NULL_HANDLE, view, 0.0, color, depth);
+  EXPECT_EQ(status.message(),
+            "siviflow::World: the depth image's format VK_FORMAT_D24_UNORM_S8_UINT differs from "
+            "WorldCreateInfo's VK_FORMAT_D32_SFLOAT");
+}
+
 }  // namespace
 }  // namespace siviflow::testing

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "vk/vk_text.h"
+
 namespace siviflow::view {
 namespace {
 
@@ -90,8 +92,10 @@ Status Swapchain::recreate(bool* minimised) {
   *minimised = extent.width == 0 || extent.height == 0;
   if (*minimised) return Status::success();
   if ((caps.supportedUsageFlags & kImageUsage) != kImageUsage) {
-    return Status::error("the window's swapchain images cannot be copied to and from "
-                         "(transfer usage not supported)");
+    return Status::error("the window's swapchain images do not offer " +
+                         image_usage_text(kImageUsage & ~caps.supportedUsageFlags) +
+                         " (the frame is copied in, the panel drawn over it, a screenshot copied "
+                         "out)");
   }
 
   min_image_count_ = std::max(caps.minImageCount, 2u);
