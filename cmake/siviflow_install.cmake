@@ -5,11 +5,11 @@
 include(CMakePackageConfigHelpers)
 
 # Exported as siviflow::sim, siviflow::water, ... — the same names as the in-tree aliases.
-foreach(target sim water scene headless capture shaders warnings)
+foreach(target common sim water scene headless capture shaders warnings)
   set_target_properties(siviflow_${target} PROPERTIES EXPORT_NAME ${target})
 endforeach()
 # One export set per component: water (with what it links), scene (with the headless host), capture.
-install(TARGETS siviflow_sim siviflow_water siviflow_shaders siviflow_warnings
+install(TARGETS siviflow_common siviflow_sim siviflow_water siviflow_shaders siviflow_warnings
         EXPORT siviflowWaterTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(TARGETS siviflow_scene siviflow_headless
         EXPORT siviflowSceneTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
@@ -19,12 +19,13 @@ foreach(component Water Scene Capture)
   install(EXPORT siviflow${component}Targets NAMESPACE siviflow:: FILE siviflow${component}Targets.cmake
           DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/siviflow)
 endforeach()
+# Every public header lies under include/siviflow/ (a system include folder holds nothing else of
+# ours), each library's where its own include/ puts it: the engine's, common's, and the sim
+# headers that the engine's public headers include (siviflow/sim/).
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/siviflow
+                  ${PROJECT_SOURCE_DIR}/engine/common/include/siviflow
+                  ${PROJECT_SOURCE_DIR}/sim/include/siviflow
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/sim DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-        FILES_MATCHING PATTERN "*.h")
-# The GPU layouts the sim's packing writes (included as "shaders/shared.h").
-install(FILES ${PROJECT_SOURCE_DIR}/shaders/shared.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/shaders)
 
 file(WRITE ${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in [=[
 @PACKAGE_INIT@

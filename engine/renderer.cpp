@@ -10,7 +10,7 @@
 #include "default_river.h"
 #include "renderer_impl.h"
 #include "renderer_inspect.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 #include "vk/pipeline.h"
 
 namespace siviflow {

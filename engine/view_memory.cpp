@@ -7,7 +7,7 @@
 #include "shaders/shared.h"
 #include "sim/flow_textures.h"
 #include "sim/particle_tuning.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "renderer_impl.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -41,7 +41,7 @@
 
 #include "siviflow/water_look.h"
 #include "siviflow/water_river.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 
