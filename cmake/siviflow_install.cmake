@@ -21,11 +21,14 @@ foreach(component Water Scene Capture)
 endforeach()
 # Every public header lies under include/siviflow/ (a system include folder holds nothing else of
 # ours), each library's where its own include/ puts it: the engine's, common's, and the sim
-# headers that the engine's public headers include (siviflow/sim/).
+# headers that the engine's public headers include (siviflow/sim/), and the version header
+# generated from project().
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/siviflow
                   ${PROJECT_SOURCE_DIR}/engine/common/include/siviflow
                   ${PROJECT_SOURCE_DIR}/sim/include/siviflow
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES ${PROJECT_BINARY_DIR}/include/siviflow/version.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/siviflow)
 
 file(WRITE ${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in [=[
 @PACKAGE_INIT@

@@ -47,8 +47,6 @@ View camera_view(const Camera& camera, VkExtent2D extent) {
   return view;
 }
 
-const char* version_string() { return "siviflow 0.1.0"; }
-
 
 Status Renderer::Impl::validate_info(const CreateInfo& create) {
   info = create;
