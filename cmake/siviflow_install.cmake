@@ -1,7 +1,7 @@
 # Installs the libraries, the public headers and a CMake package with components, so that an
 # engine embeds the water with find_package(siviflow COMPONENTS water) and links siviflow::water
 # alone, pulling in no file-format library; siviflow::scene, ::headless and ::capture come with
-# their components (all of them when none is named).
+# their components (all of them when none is named); and the embedding example as source.
 include(CMakePackageConfigHelpers)
 
 # Exported as siviflow::sim, siviflow::water, ... — the same names as the in-tree aliases.
@@ -29,6 +29,10 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/siviflow
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${PROJECT_BINARY_DIR}/include/siviflow/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/siviflow)
+# The embedding example, as source a host builds against the installed package.
+install(FILES ${PROJECT_SOURCE_DIR}/tools/examples/embed/CMakeLists.txt
+              ${PROJECT_SOURCE_DIR}/tools/examples/embed/embed_example.cpp
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples/embed)
 
 file(WRITE ${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in [=[
 @PACKAGE_INIT@
