@@ -1,15 +1,15 @@
 # Installs the libraries, the public headers and a CMake package with components, so that an
 # engine embeds the water with find_package(siviflow COMPONENTS water) and links siviflow::water
 # alone, pulling in no file-format library; siviflow::scene, ::headless and ::capture come with
-# their components (all of them when none is named).
+# their components (all of them when none is named); and the embedding example as source.
 include(CMakePackageConfigHelpers)
 
 # Exported as siviflow::sim, siviflow::water, ... — the same names as the in-tree aliases.
-foreach(target sim water scene headless capture shaders warnings)
+foreach(target common sim water scene headless capture shaders warnings)
   set_target_properties(siviflow_${target} PROPERTIES EXPORT_NAME ${target})
 endforeach()
 # One export set per component: water (with what it links), scene (with the headless host), capture.
-install(TARGETS siviflow_sim siviflow_water siviflow_shaders siviflow_warnings
+install(TARGETS siviflow_common siviflow_sim siviflow_water siviflow_shaders siviflow_warnings
         EXPORT siviflowWaterTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(TARGETS siviflow_scene siviflow_headless
         EXPORT siviflowSceneTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
@@ -19,12 +19,20 @@ foreach(component Water Scene Capture)
   install(EXPORT siviflow${component}Targets NAMESPACE siviflow:: FILE siviflow${component}Targets.cmake
           DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/siviflow)
 endforeach()
+# Every public header lies under include/siviflow/ (a system include folder holds nothing else of
+# ours), each library's where its own include/ puts it: the engine's, common's, and the sim
+# headers that the engine's public headers include (siviflow/sim/), and the version header
+# generated from project().
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/siviflow
+                  ${PROJECT_SOURCE_DIR}/engine/common/include/siviflow
+                  ${PROJECT_SOURCE_DIR}/sim/include/siviflow
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/sim DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
-        FILES_MATCHING PATTERN "*.h")
-# The GPU layouts the sim's packing writes (included as "shaders/shared.h").
-install(FILES ${PROJECT_SOURCE_DIR}/shaders/shared.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/shaders)
+install(FILES ${PROJECT_BINARY_DIR}/include/siviflow/version.h
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/siviflow)
+# The embedding example, as source a host builds against the installed package.
+install(FILES ${PROJECT_SOURCE_DIR}/tools/examples/embed/CMakeLists.txt
+              ${PROJECT_SOURCE_DIR}/tools/examples/embed/embed_example.cpp
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples/embed)
 
 file(WRITE ${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in [=[
 @PACKAGE_INIT@

@@ -8,7 +8,7 @@
 #include <glm/matrix.hpp>
 
 #include "renderer_impl.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 #include "vk/vk_text.h"
 
 namespace siviflow {

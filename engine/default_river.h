@@ -7,8 +7,8 @@
 
 #include <glm/vec3.hpp>
 
-#include "sim/obstacle.h"
-#include "sim/procedural_river.h"
+#include "siviflow/sim/obstacle.h"
+#include "siviflow/sim/procedural_river.h"
 
 namespace siviflow {
 

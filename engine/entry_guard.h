@@ -7,7 +7,7 @@
 #include <string_view>
 
 #include "siviflow/renderer.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -10,7 +10,7 @@
 #include <vulkan/vulkan.h>
 
 #include "siviflow/renderer.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 #include "vk/frame_graph.h"
 #include "vk/gpu_resources.h"
 

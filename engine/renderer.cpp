@@ -12,7 +12,7 @@
 #include "default_river.h"
 #include "renderer_impl.h"
 #include "renderer_inspect.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 #include "vk/pipeline.h"
 #include "vk/vk_text.h"
 
@@ -99,8 +99,6 @@ View camera_view(const Camera& camera, VkExtent2D extent) {
   view.viewport = {{0, 0}, extent};
   return view;
 }
-
-const char* version_string() { return "siviflow 0.1.0"; }
 
 
 Status Renderer::Impl::validate_info(const CreateInfo& create) {

@@ -7,8 +7,8 @@
 
 #include <glm/geometric.hpp>
 
-#include "sim/river_surface.h"
-#include "sim/text_format.h"
+#include "siviflow/sim/river_surface.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -13,16 +13,16 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "siviflow/water_river.h"
 #include "sim/flow_textures.h"
 #include "sim/foam.h"
 #include "sim/particles.h"
-#include "sim/procedural_river.h"
 #include "sim/triangle_bvh.h"
-#include "sim/river_surface.h"
-#include "sim/obstacle.h"
-#include "sim/status.h"
-#include "sim/stream_function.h"
+#include "siviflow/sim/obstacle.h"
+#include "siviflow/sim/procedural_river.h"
+#include "siviflow/sim/river_surface.h"
+#include "siviflow/sim/stream_function.h"
+#include "siviflow/status.h"
+#include "siviflow/water_river.h"
 
 namespace siviflow {
 

@@ -10,7 +10,7 @@
 #include <vulkan/vulkan.h>
 
 #include "passes/passes.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 #include "vk/access.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"

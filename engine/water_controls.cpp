@@ -7,7 +7,7 @@
 
 
 #include "renderer_impl.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -17,7 +17,7 @@
 #include "shaders/shared.h"
 #include "sim/particle_tuning.h"
 #include "sim/particles.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

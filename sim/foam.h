@@ -25,7 +25,7 @@
 #include <glm/vec3.hpp>
 
 #include "sim/triangle_bvh.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

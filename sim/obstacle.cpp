@@ -1,4 +1,4 @@
-#include "sim/obstacle.h"
+#include "siviflow/sim/obstacle.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
-#include "sim/river_tuning.h"
-#include "sim/text_format.h"
+#include "siviflow/sim/river_tuning.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -52,10 +52,10 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "sim/obstacle.h"
 #include "sim/particle_tuning.h"
 #include "sim/triangle_bvh.h"
-#include "sim/status.h"
+#include "siviflow/sim/obstacle.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

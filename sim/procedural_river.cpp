@@ -1,4 +1,4 @@
-#include "sim/procedural_river.h"
+#include "siviflow/sim/procedural_river.h"
 
 #include <algorithm>
 #include <array>
@@ -9,8 +9,8 @@
 #include <glm/common.hpp>
 #include <glm/gtc/constants.hpp>
 
-#include "sim/river_tuning.h"
-#include "sim/text_format.h"
+#include "siviflow/sim/river_tuning.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 

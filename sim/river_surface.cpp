@@ -1,4 +1,4 @@
-#include "sim/river_surface.h"
+#include "siviflow/sim/river_surface.h"
 
 #include <algorithm>
 #include <array>
@@ -13,8 +13,8 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
-#include "sim/river_tuning.h"
-#include "sim/text_format.h"
+#include "siviflow/sim/river_tuning.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

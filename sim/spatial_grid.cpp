@@ -1,4 +1,4 @@
-#include "sim/spatial_grid.h"
+#include "siviflow/sim/spatial_grid.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "sim/stream_function.h"
+#include "siviflow/sim/stream_function.h"
 
 #include <algorithm>
 #include <array>
@@ -8,7 +8,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

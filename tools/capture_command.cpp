@@ -19,14 +19,14 @@
 #include "cli.h"
 #include "commands.h"
 #include "frame_writer.h"
+#include "renderer_inspect.h"
 #include "siviflow/frame_folder.h"
 #include "siviflow/headless_context.h"
-#include "renderer_inspect.h"
 #include "siviflow/host_frame.h"
-#include "sim/text_format.h"
 #include "siviflow/renderer.h"
 #include "siviflow/scene_file.h"
 #include "siviflow/scene_river.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "sim/printable_text.h"
+#include "siviflow/printable_text.h"
 
 namespace siviflow::cli {
 namespace {

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow::cli {
 

@@ -13,8 +13,8 @@
 #include "capture_options.h"
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
-#include "sim/status.h"
 #include "siviflow/renderer.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -17,7 +17,7 @@
 #include "capture_options.h"
 #include "frame_encoder.h"
 #include "sim/flow_textures.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -6,7 +6,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "siviflow/frame_folder.h"
-#include "sim/printable_text.h"
+#include "siviflow/printable_text.h"
 
 namespace siviflow {
 namespace {

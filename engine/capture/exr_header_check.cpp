@@ -8,7 +8,7 @@
 #include <string_view>
 
 #include "siviflow/atomic_file.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

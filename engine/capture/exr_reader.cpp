@@ -24,7 +24,7 @@
 #include "exr_header_check.h"
 #include "siviflow/atomic_file.h"
 #include "siviflow/image_files.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -8,7 +8,7 @@
 #include <system_error>
 
 #include "siviflow/image_files.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

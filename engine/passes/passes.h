@@ -10,7 +10,7 @@
 
 #include "shared.h"
 #include "siviflow/renderer.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
 #include "vk/gpu_resources.h"

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "scene/gltf_import.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

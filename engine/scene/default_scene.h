@@ -12,8 +12,8 @@
 #include "default_river.h"
 #include "shaders/shared.h"
 #include "siviflow/renderer.h"
-#include "sim/obstacle.h"
-#include "sim/procedural_river.h"
+#include "siviflow/sim/obstacle.h"
+#include "siviflow/sim/procedural_river.h"
 
 namespace siviflow {
 

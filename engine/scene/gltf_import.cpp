@@ -25,7 +25,7 @@
 #include <glm/matrix.hpp>
 #include <tiny_gltf.h>
 
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

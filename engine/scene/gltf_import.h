@@ -20,7 +20,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -7,8 +7,8 @@
 #include <span>
 
 #include "scene/default_scene.h"
-#include "sim/procedural_river.h"
-#include "sim/status.h"
+#include "siviflow/sim/procedural_river.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -14,8 +14,8 @@
 #include "default_river.h"
 #include "scene/gltf_import.h"
 #include "scene/look_fields.h"
-#include "sim/river_tuning.h"
-#include "sim/text_format.h"
+#include "siviflow/sim/river_tuning.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

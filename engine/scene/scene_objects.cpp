@@ -7,7 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "scene/gltf_import.h"
-#include "sim/text_format.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

@@ -11,7 +11,7 @@
 #include "scene/base_color_texture.h"
 #include "shaders/shared.h"
 #include "siviflow/scene_file.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

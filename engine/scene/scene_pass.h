@@ -8,7 +8,7 @@
 #include <vulkan/vulkan.h>
 
 #include "shared.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
 #include "vk/gpu_resources.h"

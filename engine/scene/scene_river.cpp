@@ -13,11 +13,11 @@
 #include "default_river.h"
 #include "river_simulation.h"
 #include "scene/gltf_import.h"
-#include "sim/procedural_river.h"
-#include "sim/river_surface.h"
-#include "sim/river_tuning.h"
-#include "sim/spatial_grid.h"
-#include "sim/text_format.h"
+#include "siviflow/sim/procedural_river.h"
+#include "siviflow/sim/river_surface.h"
+#include "siviflow/sim/river_tuning.h"
+#include "siviflow/sim/spatial_grid.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {

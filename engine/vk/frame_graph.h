@@ -56,7 +56,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 #include "vk/access.h"
 
 namespace siviflow {

@@ -4,7 +4,7 @@
 
 #include <vulkan/vulkan.h>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 #include "vk/access.h"
 #include "vk/device_table.h"
 

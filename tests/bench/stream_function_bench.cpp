@@ -6,9 +6,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "sim/procedural_river.h"
-#include "sim/river_surface.h"
-#include "sim/stream_function.h"
+#include "siviflow/sim/procedural_river.h"
+#include "siviflow/sim/river_surface.h"
+#include "siviflow/sim/stream_function.h"
 
 namespace siviflow {
 namespace {

@@ -429,6 +429,19 @@ TEST_F(BareHostTest, RiverPlacedInAZUpWorldEqualsTheRotatedView) {
   EXPECT_LT(bounds.max.z - bounds.min.z, 0.25f * (bounds.max.y - bounds.min.y));
 }
 
+TEST_F(BareHostTest, DefaultRiverLiesWhereTheReadmeSays) {
+  std::unique_ptr<Renderer> renderer;
+  ASSERT_TRUE(Renderer::create(bare_info(*context_), &renderer).ok());
+  const Renderer::Bounds b = renderer->river_bounds();
+  // README, "Where the water is": level at y = 0, x -20.7 .. 19.0, z -122.2 .. 123.0.
+  EXPECT_NEAR(b.min.x, -20.7f, 0.1f);
+  EXPECT_NEAR(b.max.x, 19.0f, 0.1f);
+  EXPECT_NEAR(b.min.y, 0.0f, 1e-3f);
+  EXPECT_NEAR(b.max.y, 0.0f, 1e-3f);
+  EXPECT_NEAR(b.min.z, -122.2f, 0.1f);
+  EXPECT_NEAR(b.max.z, 123.0f, 0.1f);
+}
+
 TEST_F(BareHostTest, BadPlacementJitterAndScissorAreRefusedByName) {
   CreateInfo info = bare_info(*context_);
   info.world_from_river = glm::mat4(0.0f);

@@ -16,7 +16,7 @@
 
 #include "gltf_test_files.h"
 #include "run_command.h"
-#include "sim/procedural_river.h"
+#include "siviflow/sim/procedural_river.h"
 
 namespace siviflow::testing {
 namespace {

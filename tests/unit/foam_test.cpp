@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "sim/stream_function.h"
+#include "siviflow/sim/stream_function.h"
 #include "unit/river_test_meshes.h"
 
 namespace siviflow {

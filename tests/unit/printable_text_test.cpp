@@ -1,12 +1,12 @@
 // Messages are text: printable_text keeps valid UTF-8 and escapes every other byte and every
 // control character but newline and tab, and Status::error applies it to every message.
-#include "sim/printable_text.h"
+#include "siviflow/printable_text.h"
 
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 namespace {

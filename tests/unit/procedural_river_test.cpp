@@ -1,12 +1,12 @@
 // The procedural default river: its profiles (used by the terrain) and its water-surface strip.
-#include "sim/procedural_river.h"
+#include "siviflow/sim/procedural_river.h"
 
 #include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "sim/river_surface.h"
+#include "siviflow/sim/river_surface.h"
 
 namespace siviflow {
 namespace {

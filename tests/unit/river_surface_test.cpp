@@ -1,6 +1,6 @@
 // River Surface Generator (Algorithm 1): sections and banks from the topology, per-vertex data,
 // and every bad river mesh of reliability.md §5 that reaches the sim.
-#include "sim/river_surface.h"
+#include "siviflow/sim/river_surface.h"
 
 #include <cmath>
 #include <limits>
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "sim/river_tuning.h"
+#include "siviflow/sim/river_tuning.h"
 #include "unit/river_test_meshes.h"
 
 namespace siviflow {

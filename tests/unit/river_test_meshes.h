@@ -12,7 +12,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
-#include "sim/stream_function.h"
+#include "siviflow/sim/stream_function.h"
 
 namespace siviflow::test {
 

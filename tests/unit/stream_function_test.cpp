@@ -1,13 +1,13 @@
 // Stream-function flow against the analytic oracles of algorithms.md §6, flux conservation,
 // obstacles, incremental re-solves and determinism.
-#include "sim/stream_function.h"
+#include "siviflow/sim/stream_function.h"
 
 #include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
 
-#include "sim/procedural_river.h"
+#include "siviflow/sim/procedural_river.h"
 #include "unit/river_test_meshes.h"
 
 namespace siviflow {

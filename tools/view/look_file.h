@@ -3,8 +3,8 @@
 
 #include <string>
 
+#include "siviflow/status.h"
 #include "siviflow/water_look.h"
-#include "sim/status.h"
 
 namespace siviflow::view {
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "siviflow/renderer.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow::view {
 

@@ -13,7 +13,7 @@
 #include <GLFW/glfw3.h>
 
 #include "siviflow/renderer.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow::view {
 

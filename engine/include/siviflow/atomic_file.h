@@ -4,7 +4,7 @@
 #include <cstddef>
 #include <string>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -11,8 +11,8 @@
 #include <vulkan/vulkan.h>
 
 #include "siviflow/renderer.h"
+#include "siviflow/status.h"
 #include "siviflow/world.h"
-#include "sim/status.h"
 
 namespace siviflow {
 

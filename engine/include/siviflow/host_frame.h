@@ -10,8 +10,8 @@
 
 #include "siviflow/headless_context.h"
 #include "siviflow/renderer.h"
+#include "siviflow/status.h"
 #include "siviflow/world.h"
-#include "sim/status.h"
 
 namespace siviflow {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -41,7 +41,8 @@
 
 #include "siviflow/water_look.h"
 #include "siviflow/water_river.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
+#include "siviflow/version.h"
 
 namespace siviflow {
 
@@ -305,9 +306,6 @@ struct ViewMemory {
 };
 // An extent of 0 or a colour format the renderer does not take is an error naming it.
 Status view_memory(const CreateInfo& info, ViewMemory* out);
-
-// "siviflow 0.1.0", as recorded in EXR metadata.
-const char* version_string();
 
 struct PassTime {
   std::string name;     // the frame graph's pass name: "upload", "reflection", "scene", "flow", ...

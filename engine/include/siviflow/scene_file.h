@@ -21,8 +21,8 @@
 //
 // Defaults of everything optional (metres, seconds, degrees; glTF axes: +Y up):
 //   river.mesh              first mesh of the file
-//   river.procedural.*      each field of ProceduralRiverParams (sim/procedural_river.h) is
-//                           optional with that struct's default; see procedural_river_keys()
+//   river.procedural.*      each field of ProceduralRiverParams (siviflow/sim/procedural_river.h)
+//                           is optional with that struct's default; see procedural_river_keys()
 //   flow.discharge          kDefaultSceneDischarge (20 m^2/s)
 //   flow.p                  kDefaultShepardPower (1.5)
 //   flow.search_radius      absent: 3 x the widest section (FlowParams::search_radius = 0)
@@ -59,11 +59,11 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
+#include "siviflow/sim/obstacle.h"
+#include "siviflow/sim/procedural_river.h"
+#include "siviflow/sim/stream_function.h"
+#include "siviflow/status.h"
 #include "siviflow/water_look.h"
-#include "sim/obstacle.h"
-#include "sim/procedural_river.h"
-#include "sim/status.h"
-#include "sim/stream_function.h"
 
 namespace siviflow {
 

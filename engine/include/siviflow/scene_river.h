@@ -12,11 +12,11 @@
 #include <glm/vec3.hpp>
 
 #include "siviflow/scene_file.h"
+#include "siviflow/sim/obstacle.h"
+#include "siviflow/sim/procedural_river.h"
+#include "siviflow/sim/stream_function.h"
+#include "siviflow/status.h"
 #include "siviflow/water_river.h"
-#include "sim/obstacle.h"
-#include "sim/procedural_river.h"
-#include "sim/status.h"
-#include "sim/stream_function.h"
 
 namespace siviflow {
 

@@ -20,7 +20,7 @@
 
 #include "siviflow/renderer.h"
 #include "siviflow/scene_file.h"
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -19,7 +19,7 @@
 
 #include <glm/vec3.hpp>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

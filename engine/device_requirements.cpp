@@ -1,4 +1,5 @@
-// The device features SiViFlow needs, and the check that names each one a feature chain lacks.
+// The device features the water renderer needs (renderer.h), and the check that names each one
+// a feature chain lacks.
 #include <array>
 #include <string>
 #include <vector>

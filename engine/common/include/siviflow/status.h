@@ -6,7 +6,7 @@
 #include <string_view>
 #include <utility>
 
-#include "sim/printable_text.h"
+#include "siviflow/printable_text.h"
 
 namespace siviflow {
 

@@ -21,11 +21,11 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "sim/obstacle.h"
-#include "sim/river_surface.h"
-#include "sim/river_tuning.h"
-#include "sim/spatial_grid.h"
-#include "sim/status.h"
+#include "siviflow/sim/obstacle.h"
+#include "siviflow/sim/river_surface.h"
+#include "siviflow/sim/river_tuning.h"
+#include "siviflow/sim/spatial_grid.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

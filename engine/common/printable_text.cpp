@@ -1,4 +1,4 @@
-#include "sim/printable_text.h"
+#include "siviflow/printable_text.h"
 
 #include <cstdint>
 

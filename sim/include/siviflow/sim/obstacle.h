@@ -10,7 +10,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "sim/status.h"
+#include "siviflow/status.h"
 
 namespace siviflow {
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <siviflow/renderer.h>
+#include <siviflow/version.h>
 #include <vulkan/vulkan.h>
 
 namespace {
@@ -136,6 +137,12 @@ int fail(const char* what) {
 }  // namespace
 
 int main() {
+  // The headers this engine compiled against and the library it linked are the same release.
+  const siviflow::Version linked = siviflow::version();
+  if (linked.major != SIVIFLOW_VERSION_MAJOR || linked.minor != SIVIFLOW_VERSION_MINOR ||
+      linked.patch != SIVIFLOW_VERSION_PATCH) {
+    return fail("the SiViFlow library linked is not the release of its headers");
+  }
   Engine e;
   // The engine's instance: Vulkan 1.3, the validation layer (synchronization validation on)
   // when it is installed.
