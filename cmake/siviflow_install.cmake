@@ -29,10 +29,11 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/siviflow
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${PROJECT_BINARY_DIR}/include/siviflow/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/siviflow)
-# The embedding example, as source a host builds against the installed package.
-install(FILES ${PROJECT_SOURCE_DIR}/tools/examples/embed/CMakeLists.txt
-              ${PROJECT_SOURCE_DIR}/tools/examples/embed/embed_example.cpp
-        DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples/embed)
+# The examples, as source a host builds against the installed package.
+foreach(example embed modern_frame)
+  install(DIRECTORY ${PROJECT_SOURCE_DIR}/tools/examples/${example}
+          DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples)
+endforeach()
 
 file(WRITE ${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in [=[
 @PACKAGE_INIT@

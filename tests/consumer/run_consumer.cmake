@@ -1,7 +1,8 @@
 # Installs the build into a scratch prefix; checks that every installed header lies under
 # include/siviflow and compiles alone against the prefix (tests/consumer/headers); builds the
-# embedding example from its installed copy (share/siviflow/examples/embed) against the prefix,
-# at C++17, runs it, and checks its binary needs no file-format library.
+# examples from their installed copies (share/siviflow/examples: embed, a first frame; and
+# modern_frame, HDR, reverse-Z, jitter, motion, reactive and depth, each checked) against the
+# prefix, at C++17, runs them, and checks the embed binary needs no file-format library.
 file(REMOVE_RECURSE ${WORK})
 set(prefix ${WORK}/prefix)
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD} --prefix ${prefix}
@@ -27,24 +28,32 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "an installed header does not compile alone against the installed package")
 endif()
 
-# The example as a host gets it, in a target at C++17 (the package raises it to what it needs).
-execute_process(COMMAND ${CMAKE_COMMAND} -S ${prefix}/share/siviflow/examples/embed
-                        -B ${WORK}/build -G Ninja -DCMAKE_PREFIX_PATH=${prefix}
-                        -DCMAKE_CXX_STANDARD=17 -DCMAKE_BUILD_TYPE=Release
-                RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "configuring the installed example against the installed package failed")
-endif()
-execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK}/build RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "building the installed example failed")
-endif()
-execute_process(COMMAND ${WORK}/build/embed_example RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "the example's frame failed")
-endif()
+# Each example as a host gets it, in a target at C++17 (the package raises it to what it needs):
+# built from its installed copy against the prefix, and run.
+function(build_and_run example program)
+  set(build ${WORK}/${example})
+  execute_process(COMMAND ${CMAKE_COMMAND} -S ${prefix}/share/siviflow/examples/${example}
+                          -B ${build} -G Ninja -DCMAKE_PREFIX_PATH=${prefix}
+                          -DCMAKE_CXX_STANDARD=17 -DCMAKE_BUILD_TYPE=Release
+                  RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "configuring the installed example ${example} failed")
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} --build ${build} RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "building the installed example ${example} failed")
+  endif()
+  execute_process(COMMAND ${build}/${program} RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the example ${example} failed")
+  endif()
+endfunction()
+build_and_run(embed embed_example)
+build_and_run(modern_frame modern_frame)
+
 # The binary of an engine that links siviflow::water alone needs no file-format library.
-execute_process(COMMAND readelf -d ${WORK}/build/embed_example OUTPUT_VARIABLE dynamic RESULT_VARIABLE rc)
+execute_process(COMMAND readelf -d ${WORK}/embed/embed_example OUTPUT_VARIABLE dynamic
+                RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "readelf failed on the example")
 endif()
