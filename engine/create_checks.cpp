@@ -2,10 +2,9 @@
 // formats and placement), in one place so that the two refuse exactly the same, in the same
 // words.
 #include <cmath>
-#include <string>
-
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
+#include <string>
 
 #include "renderer_impl.h"
 #include "siviflow/text_format.h"

@@ -2,13 +2,13 @@
 // shader would sample them (SRGB decoded, BGR swizzled, a missing alpha 1).
 #pragma once
 
+#include <vulkan/vulkan.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <vector>
-
 #include <glm/gtc/packing.hpp>
-#include <vulkan/vulkan.h>
+#include <vector>
 
 namespace siviflow::testing {
 

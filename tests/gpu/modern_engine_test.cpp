@@ -1,14 +1,14 @@
 // The water in a modern engine's frame: the colour formats engines render to, a TAA jitter,
 // views that share pixels under scissors, a river placed in a Z-up world, the water's box and
 // its depth, and the words of what is refused.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <glm/gtc/matrix_transform.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/gtc/matrix_transform.hpp>
-#include <gtest/gtest.h>
 
 #include "render_frames.h"
 #include "vk/device_table.h"
@@ -80,10 +80,10 @@ class ModernEngineTest : public RenderTest {
 
 struct FormatTolerance {
   VkFormat format;
-  float absolute;     // linear units, after clamping to what the format holds
-  float relative;     // of the value
-  bool unorm;         // holds [0, 1] only
-  bool srgb;          // compared in its encoded steps
+  float absolute;  // linear units, after clamping to what the format holds
+  float relative;  // of the value
+  bool unorm;      // holds [0, 1] only
+  bool srgb;       // compared in its encoded steps
 };
 
 // Each listed format renders the RGBA16F frame within its own precision: the world is drawn,
@@ -189,9 +189,10 @@ TEST_F(ModernEngineTest, OverlappingViewsStayInsideTheirScissors) {
   ASSERT_TRUE(create_sampled_targets({kWidth, kHeight}, &targets).ok());
   HostBuffer masks[2];
   for (HostBuffer& mask : masks) {
-    ASSERT_TRUE(context_->create_readback_buffer(
-                            renderer_->readback_bytes(ReadbackImage::kWaterMask), &mask)
-                    .ok());
+    ASSERT_TRUE(
+        context_
+            ->create_readback_buffer(renderer_->readback_bytes(ReadbackImage::kWaterMask), &mask)
+            .ok());
   }
   // Three frames from `first` on (the river's time only goes forward).
   const auto render_pair = [&](bool scissored, uint32_t first) {
@@ -214,8 +215,7 @@ TEST_F(ModernEngineTest, OverlappingViewsStayInsideTheirScissors) {
         ReadbackTargets readback;
         readback[ReadbackImage::kWaterMask] = masks[v].buffer;
         Renderer* const one[] = {renderers[v]};
-        const Status status =
-            record_view(cmd, *world_, one, views[v], time, readback, &targets);
+        const Status status = record_view(cmd, *world_, one, views[v], time, readback, &targets);
         ASSERT_TRUE(status.ok()) << status.message();
       }
       ASSERT_TRUE(context_->end_slot_and_submit(0).ok());
@@ -229,8 +229,8 @@ TEST_F(ModernEngineTest, OverlappingViewsStayInsideTheirScissors) {
     for (uint32_t y = 0; y < kHeight; ++y) {
       for (uint32_t x = 0; x < kWidth; ++x) {
         if (mask[size_t{y} * kWidth + x] < 0.5f) continue;
-        const bool in = x >= static_cast<uint32_t>(rect.offset.x) &&
-                        x < rect.offset.x + rect.extent.width;
+        const bool in =
+            x >= static_cast<uint32_t>(rect.offset.x) && x < rect.offset.x + rect.extent.width;
         (in ? *inside : *outside) += 1;
       }
     }
@@ -261,14 +261,15 @@ class BareHostTest : public GpuTest {
   void SetUp() override {
     GpuTest::SetUp();
     const char* missing = nullptr;
-    ASSERT_EQ(load_device_table(context_->instance(), context_->physical_device(),
-                                context_->device(), context_->get_instance_proc_addr(), nullptr,
-                                false, &table_, &missing),
-              VK_SUCCESS);
+    ASSERT_EQ(
+        load_device_table(context_->instance(), context_->physical_device(), context_->device(),
+                          context_->get_instance_proc_addr(), nullptr, false, &table_, &missing),
+        VK_SUCCESS);
   }
 
   static CreateInfo bare_info(HeadlessContext& context) {
-    CreateInfo info = context.renderer_create_info({kWidth, kHeight}, VK_FORMAT_R16G16B16A16_SFLOAT);
+    CreateInfo info =
+        context.renderer_create_info({kWidth, kHeight}, VK_FORMAT_R16G16B16A16_SFLOAT);
     info.depth_format = VK_FORMAT_D32_SFLOAT;
     info.frames_in_flight = 1;
     info.write_depth = true;
@@ -341,8 +342,8 @@ class BareHostTest : public GpuTest {
       barriers[i].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
       barriers[i].image = images[i]->image;
       barriers[i].subresourceRange = {
-          i == 0 ? VkImageAspectFlags{VK_IMAGE_ASPECT_COLOR_BIT} : VK_IMAGE_ASPECT_DEPTH_BIT, 0,
-          1, 0, 1};
+          i == 0 ? VkImageAspectFlags{VK_IMAGE_ASPECT_COLOR_BIT} : VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1,
+          0, 1};
     }
     VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
     dependency.imageMemoryBarrierCount = 2;

@@ -1,7 +1,8 @@
 // SiViFlow renderer: the embedding interface.
 //
-// The host owns the instance, the device, the queue and the command buffers. It fills one
-// CreateInfo (zero-initialised fields take the documented defaults), enables
+// The host owns the instance (Vulkan 1.3: VkApplicationInfo::apiVersion 1.3 or later), the
+// device, the queue and the command buffers. It fills one CreateInfo (zero-initialised fields
+// take the documented defaults; color_format, extent and the handles are required), enables
 // required_device_features() when it creates its device, and per frame:
 //   1. waits on its own fence for the frame slot it is about to reuse, then begin_frame(slot);
 //   2. update(view, time)     — CPU only: the host's view matrices, simulation and packing into
@@ -11,6 +12,13 @@
 //                               command buffer, outside any host render pass: the river is blended
 //                               over the host's colour and depth-tested against its depth, and
 //                               every host image is left in the state the host asked for.
+//   5. (the host submits the command buffer with the slot's fence)
+// An updated frame is recorded or dropped (abandon_frame) before the next begin_frame.
+// Host images (FrameInputs): colour COLOR_ATTACHMENT + TRANSFER_SRC usage; depth
+// DEPTH_STENCIL_ATTACHMENT + SAMPLED, stored by the host's pass (storeOp STORE); motion and
+// reactive COLOR_ATTACHMENT. Each is stated with its state on entry and the state wanted on exit.
+// Space: the host's world is +Y up, in metres; the river is placed in it by
+// CreateInfo::world_from_river; river_bounds() is the water's box there.
 // The renderer draws only the water: no sky, terrain or objects (the built-in world of our tools
 // is a host component of its own, siviflow/world.h).
 // The renderer never submits, never waits idle and never owns a swapchain. It calls Vulkan only
@@ -223,7 +231,7 @@ struct ExternalImage {
 // rows, top-left origin of the view's viewport:
 enum class ReadbackImage : uint32_t {
   kColor,        // the host's colour with the water, in its format's texels
-  kDepth,        // the host's depth (with the water's, write_depth), its depth aspect's 4-byte texels
+  kDepth,        // the host's depth (with the water's under write_depth), 4-byte depth texels
   kWaterMask,    // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
   kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h)
   kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)

@@ -10,19 +10,19 @@
 //   - the reactive mask is above 0 on the water;
 //   - off the water, the engine's motion, reactive and depth values are untouched;
 //   - the validation layer, with synchronization validation, reported nothing.
+#include <siviflow/renderer.h>
+#include <vulkan/vulkan.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <memory>
-#include <vector>
-
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 #include <glm/mat4x4.hpp>
-#include <siviflow/renderer.h>
-#include <vulkan/vulkan.h>
+#include <memory>
+#include <vector>
 
 namespace {
 
@@ -328,10 +328,10 @@ enum class Place { kWater, kDry, kEdge };
 Place place_of(const glm::vec3& p, bool hit) {
   if (!hit) return Place::kDry;
   constexpr float kMargin = 0.5f;
-  const bool inside = std::abs(p.x) < kHalfWidth - kMargin && p.z > kMargin &&
-                      p.z < kLength - kMargin;
-  const bool outside = std::abs(p.x) > kHalfWidth + kMargin || p.z < -kMargin ||
-                       p.z > kLength + kMargin;
+  const bool inside =
+      std::abs(p.x) < kHalfWidth - kMargin && p.z > kMargin && p.z < kLength - kMargin;
+  const bool outside =
+      std::abs(p.x) > kHalfWidth + kMargin || p.z < -kMargin || p.z > kLength + kMargin;
   return inside ? Place::kWater : outside ? Place::kDry : Place::kEdge;
 }
 
@@ -373,8 +373,9 @@ int main() {
   Engine e;
   siviflow::RequiredDeviceFeatures required;
   if (!create_engine(&e, &required)) {
-    return fail("no Vulkan 1.3 instance with the Khronos validation layer and a device with "
-                "SiViFlow's features");
+    return fail(
+        "no Vulkan 1.3 instance with the Khronos validation layer and a device with "
+        "SiViFlow's features");
   }
   Target color, depth, motion, reactive;
   if (!e.target(kColorFormat, kTargetUsage, VK_IMAGE_ASPECT_COLOR_BIT, 4, &color) ||
@@ -472,18 +473,15 @@ int main() {
     const siviflow::ImageState cleared{VK_PIPELINE_STAGE_2_CLEAR_BIT,
                                        VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                        VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL};
-    const siviflow::ImageState to_copy{VK_PIPELINE_STAGE_2_COPY_BIT,
-                                       VK_ACCESS_2_TRANSFER_READ_BIT,
+    const siviflow::ImageState to_copy{VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
                                        VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
     siviflow::FrameInputs inputs;
-    inputs.color = {color.image, color.view, kColorFormat, kExtent, cleared, to_copy,
-                    color.usage};
-    inputs.depth = {depth.image, depth.view, kDepthFormat, kExtent, cleared, to_copy,
-                    depth.usage};
-    inputs.motion = {motion.image, motion.view, kMotionFormat, kExtent, cleared, to_copy,
-                     motion.usage};
-    inputs.reactive = {reactive.image, reactive.view, kReactiveFormat, kExtent, cleared, to_copy,
-                       reactive.usage};
+    inputs.color = {color.image, color.view, kColorFormat, kExtent, cleared, to_copy, color.usage};
+    inputs.depth = {depth.image, depth.view, kDepthFormat, kExtent, cleared, to_copy, depth.usage};
+    inputs.motion = {motion.image, motion.view, kMotionFormat, kExtent,
+                     cleared,      to_copy,     motion.usage};
+    inputs.reactive = {reactive.image, reactive.view, kReactiveFormat, kExtent,
+                       cleared,        to_copy,       reactive.usage};
     status = water->record(cmd, inputs);
     if (!status.ok()) return fail(status.message().c_str());
     for (const Target* t : {&color, &depth, &motion, &reactive}) {
@@ -561,13 +559,14 @@ int main() {
 
   const double median = percentile(errors, 0.5);
   const double p99 = percentile(errors, 0.99);
-  std::printf("water pixels %u, motion error median %.4f px, p99 %.4f px over %zu samples; "
-              "reactive 0 on %u, depth wrong on %u, first frame moving on %u, dry pixels "
-              "touched %u, validation messages %u\n",
-              water_pixels, median, p99, errors.size(), reactive_zero, depth_wrong,
-              first_frame_moving, touched_dry, g_validation_messages);
+  std::printf(
+      "water pixels %u, motion error median %.4f px, p99 %.4f px over %zu samples; "
+      "reactive 0 on %u, depth wrong on %u, first frame moving on %u, dry pixels "
+      "touched %u, validation messages %u\n",
+      water_pixels, median, p99, errors.size(), reactive_zero, depth_wrong, first_frame_moving,
+      touched_dry, g_validation_messages);
   const bool ok = water_pixels > kFrames * kExtent.width * kExtent.height / 10 && median <= 0.05 &&
-                  p99 <= 0.5 && reactive_zero == 0 && depth_wrong == 0 &&
-                  first_frame_moving == 0 && touched_dry == 0 && g_validation_messages == 0;
+                  p99 <= 0.5 && reactive_zero == 0 && depth_wrong == 0 && first_frame_moving == 0 &&
+                  touched_dry == 0 && g_validation_messages == 0;
   return ok ? 0 : 1;
 }
