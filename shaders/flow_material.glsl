@@ -182,9 +182,10 @@ void main() {
   out_motion = 0.5 * (before.xy / before.w - now.xy / now.w);
 #endif
 #ifdef SIVIFLOW_FLOW_REACTIVE
-  // What moves over the surface rather than with it: the ripples as applied, the reflection's
-  // share and the foam; as opaque as the water is.
-  out_reactive = look.temporal.x * alpha * min(1.0, strength + fresnel + foam);
+  // What moves over the surface rather than with it: the ripples as the shore lets them (not the
+  // particles' fade, which would print their cells into the mask), the reflection's share and
+  // the foam; as opaque as the water is.
+  out_reactive = look.temporal.x * alpha * min(1.0, ripple + fresnel + foam);
 #endif
 #ifdef SIVIFLOW_FLOW_AOVS
   out_mask = 1.0;

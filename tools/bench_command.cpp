@@ -58,25 +58,6 @@ Stats stats_of(std::vector<double> values) {
   return {median, values.front(), values.back()};
 }
 
-// The Halton(2,3) sub-pixel jitter a TAA host puts in its projection, frame by frame.
-float halton(uint32_t index, uint32_t base) {
-  float result = 0.0f;
-  float fraction = 1.0f / static_cast<float>(base);
-  for (uint32_t i = index + 1; i > 0; i /= base) {
-    result += fraction * static_cast<float>(i % base);
-    fraction /= static_cast<float>(base);
-  }
-  return result;
-}
-
-void jitter_view(uint32_t frame, VkExtent2D extent, View* view) {
-  const glm::vec2 jitter(halton(frame % 8, 2) - 0.5f, halton(frame % 8, 3) - 0.5f);
-  view->jitter = jitter;
-  // Clip x and y shift by 2 jitter / size per unit of clip w (= -view z).
-  view->projection[2][0] -= 2.0f * jitter.x / static_cast<float>(extent.width);
-  view->projection[2][1] -= 2.0f * jitter.y / static_cast<float>(extent.height);
-}
-
 void print_help() {
   std::printf(
       "usage: siviflow bench [SCENE.json] [--size WxH] [--frames N] [--warmup W] [--json]\n"
@@ -238,7 +219,7 @@ int run_bench(int argc, char** argv) {
     status = context->begin_slot(0, &cmd);
     if (status.ok()) status = renderer->begin_frame(0);
     View view = camera_view(world->scene_camera(time), extent);
-    if (options.motion) jitter_view(frame, extent, &view);
+    if (options.motion) view = with_taa_jitter(view, frame, extent);
     const auto update_start = std::chrono::steady_clock::now();
     if (status.ok()) status = renderer->update(view, time);
     const double update = ms_since(update_start);

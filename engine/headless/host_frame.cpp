@@ -5,6 +5,16 @@
 namespace siviflow {
 namespace {
 
+float halton(uint32_t index, uint32_t base) {
+  float result = 0.0f;
+  float fraction = 1.0f / static_cast<float>(base);
+  for (uint32_t i = index + 1; i > 0; i /= base) {
+    result += fraction * static_cast<float>(i % base);
+    fraction /= static_cast<float>(base);
+  }
+  return result;
+}
+
 ImageState image_state(Access access, VkFormat format) {
   const ResourceState state = state_of(access);
   return {state.stage, state.access, image_layout(access, format)};
@@ -37,6 +47,18 @@ Status create_temporal_targets(HeadlessContext& context, VkFormat motion_format,
   };
   SIVIFLOW_TRY(create(motion_format, &out->motion));
   return create(reactive_format, &out->reactive);
+}
+
+View with_taa_jitter(View view, uint32_t frame, VkExtent2D extent) {
+  view.jitter = {halton(frame % 8, 2) - 0.5f, halton(frame % 8, 3) - 0.5f};
+  // Clip x and y shift by 2 jitter / size per unit of clip w.
+  for (int c = 0; c < 4; ++c) {
+    view.projection[c][0] += 2.0f * view.jitter.x / static_cast<float>(extent.width) *
+                             view.projection[c][3];
+    view.projection[c][1] += 2.0f * view.jitter.y / static_cast<float>(extent.height) *
+                             view.projection[c][3];
+  }
+  return view;
 }
 
 Status record_view(VkCommandBuffer cmd, World& world, std::span<Renderer* const> renderers,

@@ -16,28 +16,6 @@
 namespace siviflow::testing {
 namespace {
 
-// The centred Halton(2,3) jitter of frame n, in pixels.
-glm::vec2 halton_jitter(uint32_t frame) {
-  const auto halton = [](uint32_t index, uint32_t base) {
-    float result = 0.0f;
-    float fraction = 1.0f / static_cast<float>(base);
-    for (uint32_t i = index + 1; i > 0; i /= base) {
-      result += fraction * static_cast<float>(i % base);
-      fraction /= static_cast<float>(base);
-    }
-    return result;
-  };
-  return {halton(frame % 8, 2) - 0.5f, halton(frame % 8, 3) - 0.5f};
-}
-
-// `view` with `jitter` (pixels) put into its projection, as a TAA host does.
-View jittered(View view, glm::vec2 jitter, VkExtent2D extent) {
-  view.jitter = jitter;
-  view.projection[2][0] -= 2.0f * jitter.x / static_cast<float>(extent.width);
-  view.projection[2][1] -= 2.0f * jitter.y / static_cast<float>(extent.height);
-  return view;
-}
-
 // Mean linear colour of the water's pixels.
 glm::vec3 mean_water_colour(const Frame& frame) {
   glm::dvec3 sum(0.0);
@@ -156,7 +134,7 @@ TEST_F(ModernEngineTest, JitterChurnsNoParticlesAndAddsNoShimmer) {
   ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
   const std::vector<Frame> shaken = render_views(0, kFrames, kWidth, kHeight, [&](double time) {
     const auto frame = static_cast<uint32_t>(std::lround(time * 30.0));
-    return jittered(still, halton_jitter(frame), {kWidth, kHeight});
+    return with_taa_jitter(still, frame, {kWidth, kHeight});
   });
   ASSERT_EQ(plain.size(), kFrames);
   ASSERT_EQ(shaken.size(), kFrames);
@@ -341,9 +319,9 @@ class BareHostTest : public GpuTest {
       barriers[i].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
       barriers[i].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
       barriers[i].image = images[i]->image;
-      barriers[i].subresourceRange = {
-          i == 0 ? VkImageAspectFlags{VK_IMAGE_ASPECT_COLOR_BIT} : VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1,
-          0, 1};
+      const VkImageAspectFlags aspect =
+          i == 0 ? VK_IMAGE_ASPECT_COLOR_BIT : VK_IMAGE_ASPECT_DEPTH_BIT;
+      barriers[i].subresourceRange = {aspect, 0, 1, 0, 1};
     }
     VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
     dependency.imageMemoryBarrierCount = 2;

@@ -34,6 +34,10 @@ Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFo
 Status create_temporal_targets(HeadlessContext& context, VkFormat motion_format,
                                VkFormat reactive_format, VkExtent2D extent, HostTargets* out);
 
+// `view` with frame `frame`'s TAA jitter put into its projection, as a temporal-filter host
+// does: the centred Halton(2,3) sequence of 8 (pixels, in View::jitter too).
+View with_taa_jitter(View view, uint32_t frame, VkExtent2D extent);
+
 // Records into `cmd`: the world seen through `view` at `time_seconds`, then the water of each
 // renderer in turn (a scene's rivers; update() for this frame already called on each), the
 // last one copying `readback`. Updates the targets' current states. The world's frame must have

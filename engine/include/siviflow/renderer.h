@@ -286,7 +286,8 @@ struct FrameInputs {
   // With CreateInfo::reactive_format: the host's reactive mask (colour attachment usage). Where
   // the water is the nearest surface it writes how much a temporal filter should distrust its
   // history there, 0..1 in the red channel: WaterLook::reactive_strength x the water's opacity
-  // x min(1, the applied ripple strength + the Fresnel reflection share + the foam cover).
+  // x min(1, the ripple strength the shore lets through + the Fresnel reflection share + the
+  // foam cover).
   // Elsewhere the host's values stay.
   ExternalImage reactive;
   ReadbackTargets readback;
