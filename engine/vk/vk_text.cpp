@@ -407,11 +407,15 @@ constexpr bool ascending(const Named (&names)[N]) {
 static_assert(ascending(kImageUsageNames) && ascending(kFormatFeatureNames) &&
               ascending(kStageNames) && ascending(kAccessNames) && ascending(kLayoutNames));
 
+// By the format's number: a host's value outside the enum's range (a C host may pass any int)
+// is then compared, never loaded back as a VkFormat.
 const FormatInfo* find_format(VkFormat format) {
-  const auto it =
-      std::lower_bound(std::begin(kFormats), std::end(kFormats), format,
-                       [](const FormatInfo& info, VkFormat value) { return info.format < value; });
-  return it != std::end(kFormats) && it->format == format ? it : nullptr;
+  const int64_t key = static_cast<int32_t>(format);
+  const auto it = std::lower_bound(std::begin(kFormats), std::end(kFormats), key,
+                                   [](const FormatInfo& info, int64_t value) {
+                                     return static_cast<int64_t>(info.format) < value;
+                                   });
+  return it != std::end(kFormats) && static_cast<int64_t>(it->format) == key ? it : nullptr;
 }
 
 template <std::size_t N>
