@@ -25,25 +25,16 @@ bool is_motion_format(VkFormat format) {
   return format == VK_FORMAT_R16G16_SFLOAT || format == VK_FORMAT_R32G32_SFLOAT;
 }
 
-// Float or normalized: the reactive mask is a fraction in the red channel.
+// One float or normalized channel: the reactive mask is a fraction, and a channel the water
+// does not write could not keep the host's values.
 bool is_reactive_format(VkFormat format) {
-  switch (format) {
-    case VK_FORMAT_R8_UNORM:
-    case VK_FORMAT_R16_UNORM:
-    case VK_FORMAT_R16_SFLOAT:
-    case VK_FORMAT_R32_SFLOAT:
-    case VK_FORMAT_R8G8_UNORM:
-    case VK_FORMAT_R16G16_SFLOAT:
-    case VK_FORMAT_R8G8B8A8_UNORM:
-    case VK_FORMAT_R16G16B16A16_SFLOAT:
-      return true;
-    default:
-      return false;
-  }
+  return format == VK_FORMAT_R8_UNORM || format == VK_FORMAT_R16_UNORM ||
+         format == VK_FORMAT_R16_SFLOAT || format == VK_FORMAT_R32_SFLOAT;
 }
 
-// Whether the matrix is finite, affine and invertible; its determinant in `det`.
-bool is_placement(const glm::mat4& m, float* det) {
+// Whether the matrix is finite and affine (last row 0 0 0 1); the determinant of its linear part
+// in `det`, which says whether it can be inverted.
+bool finite_affine(const glm::mat4& m, float* det) {
   for (int c = 0; c < 4; ++c) {
     for (int r = 0; r < 4; ++r) {
       if (!std::isfinite(m[c][r])) return false;
@@ -83,8 +74,8 @@ Status check_create_info(const CreateInfo& info) {
   }
   if (info.reactive_format != VK_FORMAT_UNDEFINED && !is_reactive_format(info.reactive_format)) {
     return argument_error("CreateInfo::reactive_format " + format_name(info.reactive_format) +
-                          " is not a normalized or float format with a red channel "
-                          "(VK_FORMAT_R8_UNORM, VK_FORMAT_R16_SFLOAT, ...)");
+                          " is not VK_FORMAT_R8_UNORM, VK_FORMAT_R16_UNORM, VK_FORMAT_R16_SFLOAT "
+                          "or VK_FORMAT_R32_SFLOAT");
   }
   if ((info.readback_images & ~kAllReadbackImages) != 0) {
     return argument_error("CreateInfo::readback_images 0x" +
@@ -92,7 +83,7 @@ Status check_create_info(const CreateInfo& info) {
                           std::to_string(kReadbackImageCount) + " ReadbackImage values");
   }
   float det = 0.0f;
-  if (!is_placement(info.world_from_river, &det) || !(std::abs(det) > 1e-12f) ||
+  if (!finite_affine(info.world_from_river, &det) || !(std::abs(det) > 1e-12f) ||
       !std::isfinite(1.0f / det)) {
     const glm::mat4& m = info.world_from_river;
     std::string rows;
@@ -103,11 +94,6 @@ Status check_create_info(const CreateInfo& info) {
                           " is not a finite, invertible affine transform (last row 0 0 0 1)");
   }
   return Status::success();
-}
-
-VkFormat reflection_format(VkFormat color_format) {
-  if (color_channel_count(color_format) < 3) return VK_FORMAT_UNDEFINED;
-  return color_has_alpha(color_format) ? color_format : VK_FORMAT_R16G16B16A16_SFLOAT;
 }
 
 }  // namespace siviflow

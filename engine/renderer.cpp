@@ -169,9 +169,10 @@ Status Renderer::Impl::validate_info(const CreateInfo& create) {
           VK_FORMAT_FEATURE_TRANSFER_DST_BIT,
       "the water blends into it, copies it and samples the copy"));
   SIVIFLOW_TRY(check_format_features(
-      "color_format", reflection_format(info.color_format),
-      VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
-      "the reflection target is drawn to and sampled"));
+      "color_format's reflection target", reflection_format(info.color_format),
+      VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT |
+          VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT,
+      "the reflection is drawn to and sampled filtered"));
   SIVIFLOW_TRY(check_format_features(
       "depth_format", info.depth_format,
       VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
@@ -327,7 +328,10 @@ Status Renderer::begin_frame(uint32_t slot) {
 Status Renderer::abandon_frame() {
   Impl& r = *impl_;
   return guarded(r.info, [&]() -> Status {
-    if (!r.frame_begun) return argument_error("abandon_frame called without a frame begun");
+    if (!r.frame_begun) {
+      return argument_error("abandon_frame called without a frame begun and not recorded (a "
+                            "recorded frame is submitted)");
+    }
     r.frame_begun = false;
     r.frame_updated = false;
     return Status::success();
@@ -376,9 +380,10 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   view = math;
   viewport = rect;
   scissor = clip;
-  previous_view_proj = has_previous && !host_view.camera_cut ? steady_view_proj : steady;
+  // Motion is measured from the last frame the host was shown (recorded, or simulated in its
+  // place), not from one it dropped.
+  previous_view_proj = has_shown && !host_view.camera_cut ? shown_view_proj : steady;
   steady_view_proj = steady;
-  has_previous = true;
 
   // The reflection is the world mirrored about the water plane y = h of river space, seen from
   // the real camera, so the flow pass samples it at its own screen position; only what is above
@@ -427,7 +432,8 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   water_frame.flow.screen = glm::vec4(rect.offset.x, rect.offset.y,
                                     1.0f / static_cast<float>(info.extent.width),
                                     1.0f / static_cast<float>(info.extent.height));
-  water_frame.tiles.view_proj = view.view_proj;
+  // The tiles pick their particles where the particles were placed: in the unjittered view.
+  water_frame.tiles.view_proj = steady_view_proj;
   water_frame.tiles.lattice = glm::vec4(tiles.corner_x, tiles.corner_z, tiles.width, tiles.height);
   water_frame.tiles.screen =
       glm::vec4(info.extent.width, info.extent.height, static_cast<float>(layout.texel_px),
@@ -455,7 +461,9 @@ Status Renderer::simulate(const View& view, double time_seconds) {
   Impl& r = *impl_;
   return guarded(r.info, [&]() -> Status {
     if (r.frame_begun) return argument_error("simulate called between begin_frame and record");
-    return r.simulate(view, time_seconds);
+    SIVIFLOW_TRY(r.simulate(view, time_seconds));
+    r.show_frame();  // a frame advanced in place of a rendered one
+    return Status::success();
   });
 }
 
@@ -569,6 +577,7 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
     r.frame_begun = false;
     r.frame_updated = false;
     r.frame_recorded = true;
+    r.show_frame();
     return Status::success();
   });
   // The host may record again, or begin the next frame and drop this one.
@@ -595,7 +604,7 @@ Status Renderer::Impl::resize(VkExtent2D extent) {
   // The particles live in screen space: a new viewport starts them afresh at frame 0. This can
   // fail (a size the particles cannot cover); nothing has changed then.
   SIVIFLOW_TRY(r.simulation.resize({extent.width, extent.height}));
-  r.has_previous = false;  // the particles start afresh: no motion from the old size
+  r.has_shown = false;  // the particles start afresh: no motion from the old size
   // Past this point the old configuration is gone: a failure leaves nothing to record with,
   // until a resize succeeds.
   Status status = r.ring.ensure_staging_capacity(r.simulation.layout().total_bytes + kStagingAlignment);
@@ -612,12 +621,8 @@ Status Renderer::Impl::resize(VkExtent2D extent) {
 
 Renderer::Bounds Renderer::river_bounds() const {
   const Impl& r = *impl_;
-  glm::vec3 lo(std::numeric_limits<float>::max());
-  glm::vec3 hi(-std::numeric_limits<float>::max());
-  for (const glm::vec3& p : r.river->flow.mesh().positions) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
+  const glm::vec3 lo = r.river->surface_min;
+  const glm::vec3 hi = r.river->surface_max;
   // The box of the river-space box's corners in the host's world.
   Bounds bounds{glm::vec3(std::numeric_limits<float>::max()),
                 glm::vec3(-std::numeric_limits<float>::max())};

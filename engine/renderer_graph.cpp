@@ -15,6 +15,16 @@ VkExtent2D reflection_extent(VkExtent2D extent) {
           std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
 }
 
+VkFormat reflection_format(VkFormat color_format) {
+  if (color_channel_count(color_format) < 3) return VK_FORMAT_UNDEFINED;
+  // Without alpha there is no "nothing reflected here, show the sky"; 32-bit floats add nothing
+  // to a half-size, filtered reflection and are not filterable on every device.
+  if (!color_has_alpha(color_format) || color_format == VK_FORMAT_R32G32B32A32_SFLOAT) {
+    return VK_FORMAT_R16G16B16A16_SFLOAT;
+  }
+  return color_format;
+}
+
 ImageHandle Renderer::Impl::frame_image(ImageHandle handle, bool persistent) {
   frame_images.push_back({handle, Image{}, persistent});
   return handle;

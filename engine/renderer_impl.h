@@ -70,8 +70,9 @@ struct Renderer::Impl {
   DataHandle<VkOffset2D> refraction_data;
   ViewMath view;        // of the frame being prepared, in river space, as drawn (jittered)
   glm::mat4 steady_view_proj{1.0f};  // river -> clip without the jitter: particles, motion
-  glm::mat4 previous_view_proj{1.0f};  // steady_view_proj of the frame before
-  bool has_previous = false;           // false after create(), resize() and a camera cut
+  glm::mat4 previous_view_proj{1.0f};  // what this frame's motion is measured from
+  glm::mat4 shown_view_proj{1.0f};     // steady_view_proj of the last frame shown
+  bool has_shown = false;              // false after create() and resize()
   VkRect2D viewport{};  // in the host's images
   VkRect2D scissor{};   // inside the viewport
   ReflectionView reflection_view{};
@@ -105,6 +106,12 @@ struct Renderer::Impl {
   Status set_occluders(const OccluderMesh& mesh);
   Status set_look(const WaterLook& new_look);
   Status simulate(const View& host_view, double time_seconds);
+  // The frame prepared was recorded (or simulated without rendering): the next one's motion
+  // starts from it.
+  void show_frame() {
+    shown_view_proj = steady_view_proj;
+    has_shown = true;
+  }
   float visible_water_level();
   Status check_inputs(const FrameInputs& inputs) const;
   Status bind_frame(const FrameInputs& inputs);

@@ -73,12 +73,14 @@ void SharedRiver::add_water_heights() {
       water_heights(surface, kWaterHeightSpacing, kWaterHeightMargin, kMaxWaterHeightSamples);
   heights_origin = heights.origin;
   heights_spacing = heights.spacing;
-  water_lo = glm::vec2(std::numeric_limits<float>::max());
-  water_hi = glm::vec2(std::numeric_limits<float>::lowest());
+  surface_min = glm::vec3(std::numeric_limits<float>::max());
+  surface_max = glm::vec3(std::numeric_limits<float>::lowest());
   for (const glm::vec3& p : surface) {
-    water_lo = glm::min(water_lo, glm::vec2(p.x, p.z));
-    water_hi = glm::max(water_hi, glm::vec2(p.x, p.z));
+    surface_min = glm::min(surface_min, p);
+    surface_max = glm::max(surface_max, p);
   }
+  water_lo = glm::vec2(surface_min.x, surface_min.z);
+  water_hi = glm::vec2(surface_max.x, surface_max.z);
   // A tile centre is within a tile of water it covers, and water within its longest triangle
   // edge of a vertex: samples farther than both (at the largest tile) are no tile's. Steps go
   // along the axes, so a distance d takes up to d sqrt(2) / spacing of them, plus one for the

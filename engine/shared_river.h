@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 #include "river_simulation.h"
@@ -38,6 +39,8 @@ struct SharedRiver {
   RiverFlow flow;
   StaticAssets assets;
   uint32_t index_count = 0;     // of the surface's triangles
+  glm::vec3 surface_min{0.0f};  // bounds of the surface, river space
+  glm::vec3 surface_max{0.0f};
   glm::vec2 water_lo{0.0f};     // XZ bounds of the surface
   glm::vec2 water_hi{0.0f};
   glm::vec2 heights_origin{0.0f};  // world x, z of the water heights' sample (0, 0)

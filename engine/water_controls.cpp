@@ -5,7 +5,6 @@
 #include <string>
 #include <vector>
 
-
 #include "renderer_impl.h"
 #include "siviflow/text_format.h"
 

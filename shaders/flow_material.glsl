@@ -179,7 +179,8 @@ void main() {
   // filter needs to find the point in its history.
   vec4 now = look.motion_now * vec4(in_world, 1.0);
   vec4 before = look.motion_before * vec4(in_world, 1.0);
-  out_motion = 0.5 * (before.xy / before.w - now.xy / now.w);
+  // A point behind the last frame's camera has no place in its history: no motion to give.
+  out_motion = before.w > 0.0 ? 0.5 * (before.xy / before.w - now.xy / now.w) : vec2(0.0);
 #endif
 #ifdef SIVIFLOW_FLOW_REACTIVE
   // What moves over the surface rather than with it: the ripples as the shore lets them (not the

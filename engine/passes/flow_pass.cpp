@@ -99,7 +99,7 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, const Conf
   }
   if (!config.with_floor) return Status::success();
   // The same geometry, depth test, colour format and blending as the water, so the floor shades
-  // exactly its pixels and writes them as the water does.
+  // exactly its pixels and writes its colour as the water does (not the temporal outputs).
   GraphicsPipelineDesc floor = desc;
   floor.fragment_shader = "flow_floor.frag";
   floor.fragment_constants.clear();
@@ -331,7 +331,8 @@ void FlowPass::draw_river(const PassContext& ctx, VkPipeline pipeline, const Han
   vk.vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                         sizeof(gpu::FlowConstants), &frame.flow);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-  // Not written, only tested: water in front of (or level with) what the host drew.
+  // Tested (written only by the depth pass's own pipeline): water in front of (or level with)
+  // what the host drew.
   vk.vkCmdSetDepthCompareOp(cmd, frame.reverse_z ? VK_COMPARE_OP_GREATER_OR_EQUAL
                                                  : VK_COMPARE_OP_LESS_OR_EQUAL);
   const VkBuffer vertices = ctx.buffer(h.vertices);

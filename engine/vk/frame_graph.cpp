@@ -1,5 +1,7 @@
 #include "vk/frame_graph.h"
 
+#include <algorithm>
+#include <cstdint>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -772,6 +774,19 @@ Status FrameGraph::execute(const DeviceTable& table, VkCommandBuffer cmd,
       };
       if (step.depth) take_area(*step.depth);  // a depth-only pass has no colour to take it from
       for (const Attachment& a : step.colors) take_area(a);
+      // An image of the graph's own lies at the origin, its declared size: the area stays on it.
+      const auto clip_area = [&](const Attachment& a) {
+        const Resource& r = resources_[a.resource];
+        if (r.origin == Origin::Imported) return;
+        const int64_t right = std::min<int64_t>(int64_t{area.offset.x} + area.extent.width,
+                                                r.image.extent.width);
+        const int64_t bottom = std::min<int64_t>(int64_t{area.offset.y} + area.extent.height,
+                                                 r.image.extent.height);
+        area.extent = {static_cast<uint32_t>(std::max<int64_t>(right - area.offset.x, 0)),
+                       static_cast<uint32_t>(std::max<int64_t>(bottom - area.offset.y, 0))};
+      };
+      if (step.depth) clip_area(*step.depth);
+      for (const Attachment& a : step.colors) clip_area(a);
       VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
       rendering.renderArea = area;
       rendering.layerCount = 1;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <string>
 #include <vector>
 
@@ -143,6 +144,8 @@ TEST_F(ModernEngineTest, JitterChurnsNoParticlesAndAddsNoShimmer) {
     // The flow texture holds each texel's particle id: the same ids over the same texels.
     EXPECT_EQ(plain[f].flow_texture, shaken[f].flow_texture) << "frame " << f;
     EXPECT_EQ(plain[f].particle_aux, shaken[f].particle_aux) << "frame " << f;
+    // The tiles pick the same particles: the ripples' flow and foam do not churn either.
+    EXPECT_EQ(plain[f].tile_table, shaken[f].tile_table) << "frame " << f;
     plain_colours.push_back(mean_water_colour(plain[f]));
     shaken_colours.push_back(mean_water_colour(shaken[f]));
   }
@@ -366,16 +369,45 @@ TEST_F(BareHostTest, RiverPlacedInAZUpWorldEqualsTheRotatedView) {
   View world_view = river_view;
   world_view.view = river_view.view * glm::inverse(placement);
 
+  // The reflection each asks its host to draw (drawing nothing: the sky is reflected).
+  ReflectionView mirrored[2];
+  const ReflectionCallback keep = [](VkCommandBuffer, const ReflectionView& view, void* user) {
+    *static_cast<ReflectionView*>(user) = view;
+  };
   CreateInfo info = bare_info(*context_);
+  info.reflection = keep;
   std::unique_ptr<Renderer> placed;
   info.world_from_river = placement;
+  info.reflection_user = &mirrored[0];
   ASSERT_TRUE(Renderer::create(info, &placed).ok());
   const Result a = render(*placed, 4, [&](uint32_t) { return world_view; });
 
   info.world_from_river = glm::mat4(1.0f);
+  info.reflection_user = &mirrored[1];
   std::unique_ptr<Renderer> plain;
   ASSERT_TRUE(Renderer::create(info, &plain).ok());
   const Result b = render(*plain, 4, [&](uint32_t) { return river_view; });
+
+  // The placed river's reflection, in the host's world, is the plain one's carried there: the
+  // same clip position and side of the clip plane for each river point, the camera moved along.
+  glm::mat4 world_mirror, river_mirror;
+  std::memcpy(&world_mirror[0][0], mirrored[0].view_proj, sizeof(world_mirror));
+  std::memcpy(&river_mirror[0][0], mirrored[1].view_proj, sizeof(river_mirror));
+  const glm::vec4 world_plane = glm::make_vec4(mirrored[0].clip_plane);
+  const glm::vec4 river_plane = glm::make_vec4(mirrored[1].clip_plane);
+  for (const glm::vec3 p : {glm::vec3(0.0f, 2.0f, 10.0f), glm::vec3(-5.0f, -1.0f, 30.0f),
+                            glm::vec3(8.0f, 0.5f, -20.0f)}) {
+    const glm::vec4 in_world = placement * glm::vec4(p, 1.0f);
+    const glm::vec4 expected = river_mirror * glm::vec4(p, 1.0f);
+    const glm::vec4 got = world_mirror * in_world;
+    for (int c = 0; c < 4; ++c)
+      EXPECT_NEAR(got[c], expected[c], 1e-3f * (1.0f + std::abs(expected[c])));
+    EXPECT_NEAR(glm::dot(world_plane, in_world), glm::dot(river_plane, glm::vec4(p, 1.0f)), 1e-3f);
+  }
+  const glm::vec3 camera =
+      glm::vec3(placement * glm::vec4(glm::make_vec3(mirrored[1].camera_position), 1.0f));
+  const glm::vec3 placed_camera = glm::make_vec3(mirrored[0].camera_position);
+  EXPECT_LT(glm::distance(camera, placed_camera), 1e-3f);
 
   size_t water = 0, differ = 0;
   for (size_t i = 0; i < a.mask.size(); ++i) water += a.mask[i] > 0.5f ? 1 : 0;

@@ -17,8 +17,9 @@
 // Host images (FrameInputs): colour COLOR_ATTACHMENT + TRANSFER_SRC usage; depth
 // DEPTH_STENCIL_ATTACHMENT + SAMPLED, stored by the host's pass (storeOp STORE); motion and
 // reactive COLOR_ATTACHMENT. Each is stated with its state on entry and the state wanted on exit.
-// Space: the host's world is +Y up, in metres; the river is placed in it by
-// CreateInfo::world_from_river; river_bounds() is the water's box there.
+// Space: river space is +Y up, in metres (the river's mesh, obstacles, the look's sun);
+// CreateInfo::world_from_river places it in the host's world (identity: the host's world is
+// river space); views, occluders and river_bounds() are in the host's world.
 // The renderer draws only the water: no sky, terrain or objects (the built-in world of our tools
 // is a host component of its own, siviflow/world.h).
 // The renderer never submits, never waits idle and never owns a swapchain. It calls Vulkan only
@@ -113,9 +114,10 @@ struct CreateInfo {
   // host's fog, depth of field and later transparent passes); its own reads of what lies behind
   // it still see the host's depth. Off: the host's depth is only tested, never written.
   bool write_depth = false;
-  // Places the river (its mesh, obstacles and their keys, all in river space: +Y up, metres) in
-  // the host's world: a rigid transform, a rotation and a translation (a uniform scale also
-  // works, the water's look then measuring river metres). Views, occluders and river_bounds()
+  // Places the river (its mesh, obstacles and their keys, the look's sun direction, all in river
+  // space: +Y up, metres) in the host's world. Meant for a rotation and a translation; any
+  // finite invertible affine matrix is taken, but the water's look measures river metres, so a
+  // scale or shear stretches its ripples and depths with it. Views, occluders and river_bounds()
   // are in the host's world. A Z-up engine puts its rotation here instead of rotating its views.
   glm::mat4 world_from_river{1.0f};
   // The images to copy into host buffers each frame (ReadbackImage bits, readback_bit()); 0,
@@ -235,7 +237,7 @@ enum class ReadbackImage : uint32_t {
   kWaterMask,    // 32-bit float, 1 where the river surface is the nearest thing seen, else 0
   kFlowTexture,  // the flow texture as uploaded (layout in shaders/shared.h)
   kParticleAux,  // the particles' auxiliary data as uploaded (shaders/shared.h)
-  kNormal,       // RGBA32F: the final water normal in world space (xyz) on water, 0 elsewhere
+  kNormal,       // RGBA32F: the final water normal in river space (xyz) on water, 0 elsewhere
   kReflection,   // RGBA32F: the reflection sample of the water material before blending
   kTileTable,    // RGBA32UI: the water's tile table (shaders/shared.h), tile_table_layout()
   kFoam,         // 32-bit float: how much of the water foam covers, 0 none to 1 full, 0 off water
@@ -253,7 +255,7 @@ inline constexpr uint32_t kAovReadbackImages = readback_bit(ReadbackImage::kWate
 // The tile table of the water material (shaders/shared.h): its size and which lattice points
 // the last updated frame put in it (the corner moves with the camera on rivers larger than the
 // table: decode a read-back table before updating the next frame). Texel (x, y) holds lattice
-// point corner + ((x, y) - corner) mod size, the world point (i, j) * tile_size_m / 2 in x, z.
+// point corner + ((x, y) - corner) mod size, the river point (i, j) * tile_size_m / 2 in x, z.
 struct TileTableLayout {
   uint32_t width = 0;  // texels, a power of two
   uint32_t height = 0;
@@ -296,7 +298,9 @@ struct FrameInputs {
 // The format of the reflection target a renderer of `color_format` draws into (and a host's
 // ReflectionCallback draws with): the colour format itself when it has an alpha channel, whose
 // 0 marks "nothing reflected, the sky shows"; R16G16B16A16_SFLOAT for one without
-// (B10G11R11_UFLOAT_PACK32, ...). VK_FORMAT_UNDEFINED for a format create() does not take.
+// (B10G11R11_UFLOAT_PACK32, ...) and for R32G32B32A32_SFLOAT (a half-size, filtered reflection
+// gains nothing from 32-bit floats, which not every device filters). VK_FORMAT_UNDEFINED for a
+// format create() does not take.
 VkFormat reflection_format(VkFormat color_format);
 
 // The device memory a view of `info` (its extent, formats, frames in flight, readback images,
@@ -332,8 +336,11 @@ class Renderer {
   // The host has waited until the GPU finished the commands last recorded for this slot. A frame
   // updated but not recorded is an error: record it, or abandon_frame() it first.
   Status begin_frame(uint32_t slot);
-  // Drops the frame begun (the host's own recording failed, or it will not submit it): its
-  // particles keep their step, nothing of it reaches the GPU, and begin_frame starts the next.
+  // Drops the frame begun and not yet recorded (the host's own recording failed, or it decided
+  // not to draw the water): its particles keep their step, nothing of it reaches the GPU, the next
+  // frame's motion is measured from the last frame recorded, and begin_frame starts the next.
+  // A command buffer that record() filled successfully must be submitted: it uploads the river's
+  // static data once.
   Status abandon_frame();
   // CPU only: the host's view and simulation time for the frame being prepared: advances the
   // river's particles one frame (frame next_frame()) and packs the flow textures into the slot's

@@ -15,13 +15,15 @@ namespace siviflow {
 
 struct WaterObstacleKey {
   double t = 0.0;            // seconds; keys strictly increasing in t
-  glm::vec3 centre{0.0f};    // world position of the obstacle's centre at t
+  glm::vec3 centre{0.0f};    // river-space position of the obstacle's centre at t
 };
 
 // An obstacle on the water (a boulder, a boat the player steers, a log): its footprint seen
 // from above, which the flow goes round (its outline becomes a streamline).
 struct WaterObstacle {
-  glm::vec3 centre{0.0f};  // world position; the footprint lies around it in x and z
+  // River-space position (the host's world under the default CreateInfo::world_from_river); the
+  // footprint lies around it in x and z.
+  glm::vec3 centre{0.0f};
   float radius = 0.0f;     // a circle of this radius (metres) when `polygon` is empty
   // How far it stands above its centre, metres: the water behind it, seen through it up to
   // there, gets no particles (0: flat, hides nothing). It counts as a solid over its whole
