@@ -100,7 +100,6 @@ View camera_view(const Camera& camera, VkExtent2D extent) {
   return view;
 }
 
-
 Status Renderer::Impl::validate_info(const CreateInfo& create) {
   info = create;
   if (info.instance == VK_NULL_HANDLE || info.physical_device == VK_NULL_HANDLE ||

@@ -414,7 +414,6 @@ class Renderer {
   std::string dump_frame_graph() const;
   std::string dump_frame_graph_graphviz() const;
 
-
  private:
   struct Impl;
   friend class RendererInspector;  // what our tools and tests read of the simulation
