@@ -44,19 +44,6 @@ bool rect_inside(const VkRect2D& inner, const VkRect2D& outer) {
          inner.extent.height > 0;
 }
 
-// `view_proj` without the jitter its projection carries: a clip-space shift of 2 jitter / size
-// per unit of clip w (x right, y down, as Vulkan's clip space and the pixels run).
-glm::mat4 unjittered(const glm::mat4& view_proj, glm::vec2 jitter, VkExtent2D extent) {
-  const glm::vec2 shift(2.0f * jitter.x / static_cast<float>(extent.width),
-                        2.0f * jitter.y / static_cast<float>(extent.height));
-  glm::mat4 out = view_proj;
-  for (int c = 0; c < 4; ++c) {
-    out[c][0] -= shift.x * view_proj[c][3];
-    out[c][1] -= shift.y * view_proj[c][3];
-  }
-  return out;
-}
-
 std::string api_version_text(uint32_t version) {
   return std::to_string(VK_API_VERSION_MAJOR(version)) + "." +
          std::to_string(VK_API_VERSION_MINOR(version));
@@ -373,7 +360,8 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   const float dt = simulation.next_frame() == 0 ? 0.0f : static_cast<float>(time_seconds - last_time);
   if (dt < 0.0f) return argument_error("time went backwards");
   // Particles are placed and kept in the unjittered view: jitter churns none of them.
-  const glm::mat4 steady = unjittered(math.view_proj, jitter, info.extent);
+  const glm::mat4 steady = shifted_by_pixels(
+      math.view_proj, -jitter, glm::vec2(info.extent.width, info.extent.height));
   SIVIFLOW_TRY(river->flow.set_time(time_seconds));
   SIVIFLOW_TRY(simulation.simulate(steady, dt));
   view = math;

@@ -57,6 +57,16 @@ Status derive_view_math(const glm::mat4& view, const glm::mat4& projection, View
   return Status::success();
 }
 
+glm::mat4 shifted_by_pixels(const glm::mat4& m, glm::vec2 pixels, glm::vec2 size) {
+  const glm::vec2 shift = 2.0f * pixels / size;
+  glm::mat4 out = m;
+  for (int c = 0; c < 4; ++c) {
+    out[c][0] += shift.x * m[c][3];
+    out[c][1] += shift.y * m[c][3];
+  }
+  return out;
+}
+
 glm::mat4 mirrored_view_proj(const glm::mat4& view_proj, float height) {
   glm::mat4 mirror(1.0f);
   mirror[1][1] = -1.0f;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -28,6 +29,11 @@ struct ViewMath {
 // function of view z alone) and `view` a finite invertible matrix, and derives the rest. Errors
 // name the matrix and what is wrong with it.
 Status derive_view_math(const glm::mat4& view, const glm::mat4& projection, ViewMath* out);
+
+// `m` (a projection or view-projection into Vulkan clip space) with its image moved by `pixels`
+// on a viewport of `size` pixels (x right, y down): a clip-space shift of 2 pixels / size per
+// unit of clip w. A TAA jitter is put in with +jitter and taken out with -jitter.
+glm::mat4 shifted_by_pixels(const glm::mat4& m, glm::vec2 pixels, glm::vec2 size);
 
 // The far value of window depth under the convention.
 inline float far_depth(bool reverse_z) { return reverse_z ? 0.0f : 1.0f; }

@@ -1,5 +1,6 @@
 #include "siviflow/host_frame.h"
 
+#include "view_math.h"
 #include "vk/access.h"
 
 namespace siviflow {
@@ -51,13 +52,8 @@ Status create_temporal_targets(HeadlessContext& context, VkFormat motion_format,
 
 View with_taa_jitter(View view, uint32_t frame, VkExtent2D extent) {
   view.jitter = {halton(frame % 8, 2) - 0.5f, halton(frame % 8, 3) - 0.5f};
-  // Clip x and y shift by 2 jitter / size per unit of clip w.
-  for (int c = 0; c < 4; ++c) {
-    view.projection[c][0] += 2.0f * view.jitter.x / static_cast<float>(extent.width) *
-                             view.projection[c][3];
-    view.projection[c][1] += 2.0f * view.jitter.y / static_cast<float>(extent.height) *
-                             view.projection[c][3];
-  }
+  view.projection = shifted_by_pixels(view.projection, view.jitter,
+                                      glm::vec2(extent.width, extent.height));
   return view;
 }
 

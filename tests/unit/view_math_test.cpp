@@ -71,6 +71,25 @@ TEST(ViewMath, JitteredAndOffCentreProjectionsKeepTheirConvention) {
   EXPECT_NEAR(distance_ratio(math, depth_of(p, 40.0f), depth_of(p, 8.0f)), 5.0f, 1e-3f);
 }
 
+TEST(ViewMath, PixelShiftMovesAPointByThosePixelsAndBack) {
+  const glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(60.0f), 16.0f / 9.0f, 0.1f, 100.0f);
+  const glm::vec2 size(640.0f, 360.0f);
+  const glm::vec2 jitter(0.3f, -0.45f);
+  const glm::mat4 shifted = shifted_by_pixels(p, jitter, size);
+  const glm::vec4 point(1.5f, -0.7f, -12.0f, 1.0f);
+  const auto pixel = [&](const glm::mat4& m) {
+    const glm::vec4 clip = m * point;
+    return (0.5f * glm::vec2(clip) / clip.w + 0.5f) * size;
+  };
+  const glm::vec2 moved = pixel(shifted) - pixel(p);
+  EXPECT_NEAR(moved.x, jitter.x, 1e-3f);
+  EXPECT_NEAR(moved.y, jitter.y, 1e-3f);
+  const glm::mat4 back = shifted_by_pixels(shifted, -jitter, size);
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(back[c][r], p[c][r], 1e-6f);
+  }
+}
+
 TEST(ViewMath, MirrorReflectsAboutTheWaterPlane) {
   const glm::vec3 mirrored = mirrored_point(glm::vec3(1.0f, 5.0f, 2.0f), 1.5f);
   EXPECT_EQ(mirrored, glm::vec3(1.0f, -2.0f, 2.0f));
