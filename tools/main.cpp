@@ -1,4 +1,6 @@
 // siviflow: command-line front end of the SiViFlow library.
+#include <malloc.h>
+
 #include <cstdio>
 #include <string_view>
 
@@ -20,9 +22,17 @@ void print_usage() {
       "Run 'siviflow <command> --help' for the options of a command.\n");
 }
 
+// lavapipe's rasterizer mallocs and frees tens of megabytes of bins per frame on its queue
+// thread; with glibc's default trim threshold every free hands them back to the kernel
+// (madvise) and the next frame faults them in again (about 3300 page faults a frame at 720p).
+// This process keeps them: the library itself never changes its host's allocator (README,
+// "Frame cost on lavapipe").
+constexpr int kKeptFreeBytes = 256 << 20;
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  mallopt(M_TRIM_THRESHOLD, kKeptFreeBytes);
   if (argc < 2) {
     print_usage();
     return siviflow::cli::kExitError;
