@@ -17,7 +17,7 @@ Status GpuTimer::create(const GpuContext& gpu, VkPhysicalDevice physical_device,
   vk.vkGetPhysicalDeviceQueueFamilyProperties(physical_device, &family_count, families.data());
   const uint32_t bits = families[queue_family].timestampValidBits;
   if (bits == 0) {
-    return Status::error("siviflow::Renderer: enable_timing: the queue family has no timestamps",
+    return Status::error("enable_timing: the queue family has no timestamps",
                          VK_ERROR_FEATURE_NOT_PRESENT);
   }
   mask_ = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
@@ -43,7 +43,7 @@ void GpuTimer::destroy(const GpuContext& gpu) {
 Status GpuTimer::begin(const DeviceTable& vk, VkCommandBuffer cmd, uint32_t slot, uint32_t passes,
                        FrameGraph::Timestamps* out) {
   if (passes > kMaxTimedPasses) {
-    return Status::error("siviflow::Renderer: " + std::to_string(passes) +
+    return Status::error(std::to_string(passes) +
                          " passes, more than the timer's " + std::to_string(kMaxTimedPasses));
   }
   out->pool = pools_[slot];

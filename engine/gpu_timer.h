@@ -20,7 +20,8 @@ class GpuTimer {
  public:
   static constexpr uint32_t kMaxTimedPasses = 16;
 
-  // Fails when the queue family writes no timestamps.
+  // Fails when the queue family writes no timestamps. Messages name no owner: the caller's
+  // guard adds its prefix.
   Status create(const GpuContext& gpu, VkPhysicalDevice physical_device, uint32_t queue_family,
                 uint32_t slots);
   void destroy(const GpuContext& gpu);

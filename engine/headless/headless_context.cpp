@@ -434,6 +434,7 @@ WorldCreateInfo HeadlessContext::world_create_info(VkFormat color_format,
   info.color_format = color_format;
   info.depth_format = depth_format;
   info.debug_utils = impl_->report.validation_enabled;
+  info.queue_family_index = impl_->queue_family;
   return info;
 }
 

@@ -1,9 +1,11 @@
 #include "scene/default_scene.h"
 
 #include "scene/river_ground.h"
+#include "scene/terrain_chunks.h"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
@@ -26,28 +28,21 @@ glm::vec3 terrain_normal(const ProceduralRiver& river, float x, float z) {
 
 void add_terrain(const ProceduralRiver& river, SceneGeometry* geometry) {
   const float half_length = 0.5f * river.params().length;
-  const uint32_t base = static_cast<uint32_t>(geometry->vertices.size());
+  std::vector<SceneVertex> points;
   for (int row = 0; row <= kTerrainRows; ++row) {
     const float z = -half_length + river.params().length * static_cast<float>(row) / kTerrainRows;
     for (int col = 0; col <= kTerrainColumns; ++col) {
       const float x = -kTerrainHalfWidth + 2.0f * kTerrainHalfWidth * static_cast<float>(col) /
                                                kTerrainColumns;
       const float y = river.terrain_height(x, z);
-      geometry->vertices.push_back(
+      points.push_back(
           ground_vertex({x, y, z}, terrain_normal(river, x, z), y - river.water_level()));
     }
   }
-  const uint32_t stride = kTerrainColumns + 1;
-  for (uint32_t row = 0; row < kTerrainRows; ++row) {
-    for (uint32_t col = 0; col < kTerrainColumns; ++col) {
-      const uint32_t a = base + row * stride + col;
-      const uint32_t b = a + 1;
-      const uint32_t c = a + stride;
-      const uint32_t d = c + 1;
-      // Counter-clockwise seen from above (+Y) with x right and z towards the viewer.
-      geometry->indices.insert(geometry->indices.end(), {a, c, b, b, c, d});
-    }
-  }
+  // The grid's coarser spacing sets how soon a chunk may coarsen.
+  const float spacing = std::max(2.0f * kTerrainHalfWidth / kTerrainColumns,
+                                 river.params().length / kTerrainRows);
+  add_chunked_grid(points, kTerrainColumns, kTerrainRows, spacing, geometry);
 }
 
 // A latitude-longitude ellipsoid, squashed and bumped so it reads as a boulder.
@@ -80,6 +75,12 @@ void add_boulder(glm::vec3 centre, glm::vec3 radii, glm::vec3 albedo, float seed
   }
 }
 
+// The triangles from `first_index` on as one piece, drawn whole wherever it is seen.
+void add_object_piece(uint32_t first_index, SceneGeometry* geometry) {
+  geometry->pieces.push_back(object_piece(*geometry, first_index,
+                                          static_cast<uint32_t>(geometry->indices.size()) - first_index, 0));
+}
+
 // A cone on a cylinder: a conifer, tall enough to show in the water's reflection later.
 void add_tree(glm::vec3 foot, float height, SceneGeometry* geometry) {
   constexpr int kSegments = 12;
@@ -109,7 +110,6 @@ void add_tree(glm::vec3 foot, float height, SceneGeometry* geometry) {
 
 // The obstacles: a boulder as wide as each footprint, slightly squat, modelled at the origin.
 void add_obstacle_boulders(const std::vector<Obstacle>& obstacles, SceneGeometry* geometry) {
-  geometry->static_index_count = static_cast<uint32_t>(geometry->indices.size());
   for (size_t i = 0; i < obstacles.size(); ++i) {
     const float radius = boulder_radius(obstacles[i]);
     const uint32_t first = static_cast<uint32_t>(geometry->indices.size());
@@ -131,16 +131,54 @@ SceneVertex ground_vertex(const glm::vec3& position, const glm::vec3& normal, fl
 
 SceneLook default_scene_look() { return SceneLook{}; }
 
+LodPiece object_piece(const SceneGeometry& geometry, uint32_t first_index, uint32_t index_count,
+                      uint32_t material) {
+  LodPiece piece;
+  piece.lo = glm::vec3(std::numeric_limits<float>::max());
+  piece.hi = glm::vec3(std::numeric_limits<float>::lowest());
+  for (uint32_t i = first_index; i < first_index + index_count; ++i) {
+    piece.lo = glm::min(piece.lo, geometry.vertices[geometry.indices[i]].position);
+    piece.hi = glm::max(piece.hi, geometry.vertices[geometry.indices[i]].position);
+  }
+  piece.levels = {{first_index, index_count}};
+  piece.material = material;
+  return piece;
+}
+
+void append_geometry(SceneGeometry&& other, SceneGeometry* into) {
+  const auto first_vertex = static_cast<uint32_t>(into->vertices.size());
+  const auto first_index = static_cast<uint32_t>(into->indices.size());
+  into->vertices.insert(into->vertices.end(), other.vertices.begin(), other.vertices.end());
+  for (uint32_t index : other.indices) into->indices.push_back(first_vertex + index);
+  const auto shifted = [first_index](IndexRange range) {
+    range.first_index += first_index;
+    return range;
+  };
+  for (LodPiece& piece : other.pieces) {
+    for (IndexRange& level : piece.levels) level = shifted(level);
+    into->pieces.push_back(std::move(piece));
+  }
+  for (const IndexRange& boulder : other.obstacle_boulders) {
+    into->obstacle_boulders.push_back(shifted(boulder));
+  }
+}
+
 SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vector<Obstacle>& obstacles) {
   SceneGeometry geometry;
   add_terrain(river, &geometry);
-  // Boulders on both banks.
+  // Boulders on both banks, and trees: a piece each.
+  auto first = static_cast<uint32_t>(geometry.indices.size());
   add_boulder(on_ground(river, -10.0f, -20.0f) + glm::vec3(0, 0.6f, 0), {2.2f, 1.6f, 1.9f}, kGranite, 1.0f, &geometry);
+  add_object_piece(first, &geometry);
+  first = static_cast<uint32_t>(geometry.indices.size());
   add_boulder(on_ground(river, 11.0f, 12.0f) + glm::vec3(0, 0.5f, 0), {1.6f, 1.2f, 1.5f}, kSandstone, 2.0f, &geometry);
+  add_object_piece(first, &geometry);
   for (int i = 0; i < 6; ++i) {
     const float z = -60.0f + 22.0f * static_cast<float>(i);
     const float side = (i % 2 == 0) ? -1.0f : 1.0f;
+    first = static_cast<uint32_t>(geometry.indices.size());
     add_tree(on_ground(river, side * (13.0f + 3.0f * static_cast<float>(i % 3)), z), 7.0f + static_cast<float>(i % 3), &geometry);
+    add_object_piece(first, &geometry);
   }
   add_obstacle_boulders(obstacles, &geometry);
   return geometry;
@@ -163,6 +201,7 @@ Status build_riverbed_geometry(const RiverMesh& river, const std::vector<Obstacl
     geometry.vertices.push_back(ground_vertex(bed[v], n, -river.depth[v]));
   }
   geometry.indices = river.indices;
+  add_object_piece(0, &geometry);  // the bed
   SIVIFLOW_TRY(add_ground_around_rivers(ground_rivers, &geometry));
   add_obstacle_boulders(obstacles, &geometry);
   *out = std::move(geometry);

@@ -10,6 +10,7 @@
 #include <glm/vec4.hpp>
 
 #include "default_river.h"
+#include "scene/lod_culling.h"
 #include "shaders/shared.h"
 #include "siviflow/renderer.h"
 #include "siviflow/sim/obstacle.h"
@@ -22,15 +23,20 @@ using gpu::SceneVertex;
 struct SceneGeometry {
   std::vector<SceneVertex> vertices;
   std::vector<uint32_t> indices;  // triangle list, counter-clockwise seen from outside
-  uint32_t static_index_count = 0;  // indices [0, this) never move
+  // What never moves, each piece culled and (terrain chunks) given a level of detail per view.
+  std::vector<LodPiece> pieces;
   // One boulder per obstacle, modelled around the origin and drawn translated to where its
-  // obstacle is each frame: indices [first, first + count).
-  struct Instance {
-    uint32_t first_index = 0;
-    uint32_t index_count = 0;
-  };
-  std::vector<Instance> obstacle_boulders;
+  // obstacle is each frame.
+  std::vector<IndexRange> obstacle_boulders;
 };
+
+// The triangles [first_index, first_index + index_count) of `geometry` as one piece, drawn whole
+// wherever it is seen.
+LodPiece object_piece(const SceneGeometry& geometry, uint32_t first_index, uint32_t index_count,
+                      uint32_t material);
+
+// Moves `other` into `into` after what it holds (its indices and pieces shifted to match).
+void append_geometry(SceneGeometry&& other, SceneGeometry* into);
 
 // Tunables of the look of the default scene, in one place.
 struct SceneLook {

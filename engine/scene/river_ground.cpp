@@ -8,6 +8,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "scene/terrain_chunks.h"
 #include "sim/triangle_bvh.h"
 
 namespace siviflow {
@@ -140,7 +141,8 @@ Status add_ground_around_rivers(std::span<const RiverMesh> rivers, SceneGeometry
       water[i] = shore.y;
     }
   }
-  const uint32_t base = static_cast<uint32_t>(geometry->vertices.size());
+  std::vector<SceneVertex> grid;
+  grid.reserve(points.size());
   for (int row = 0; row <= quads.y; ++row) {
     for (int col = 0; col <= quads.x; ++col) {
       const auto at = [&](int c, int r) {
@@ -149,18 +151,10 @@ Status add_ground_around_rivers(std::span<const RiverMesh> rivers, SceneGeometry
       const glm::vec3 n = glm::normalize(glm::cross(at(col, row + 1) - at(col, row - 1),
                                                     at(col + 1, row) - at(col - 1, row)));
       const size_t i = size_t(row) * columns + col;
-      geometry->vertices.push_back(ground_vertex(points[i], n.y < 0.0f ? -n : n, points[i].y - water[i]));
+      grid.push_back(ground_vertex(points[i], n.y < 0.0f ? -n : n, points[i].y - water[i]));
     }
   }
-  for (uint32_t row = 0; row < uint32_t(quads.y); ++row) {
-    for (uint32_t col = 0; col < uint32_t(quads.x); ++col) {
-      const uint32_t a = base + row * uint32_t(columns) + col;
-      const uint32_t b = a + 1;
-      const uint32_t c = a + uint32_t(columns);
-      const uint32_t d = c + 1;
-      geometry->indices.insert(geometry->indices.end(), {a, c, b, b, c, d});
-    }
-  }
+  add_chunked_grid(grid, uint32_t(quads.x), uint32_t(quads.y), spacing, geometry);
   return Status::success();
 }
 

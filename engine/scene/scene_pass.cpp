@@ -98,14 +98,15 @@ ScenePass::FrameData ScenePass::declare(FrameGraph& graph, const char* pass_name
     const Frame& frame = ctx.data(data.view);
     set_viewport(ctx.table(), ctx.cmd(), frame.viewport);
     draw(ctx.table(), ctx.cmd(), ctx.buffer(h.vertices), ctx.buffer(h.indices),
-         ctx.data(data.draws), frame.reverse_z);
+         ctx.data(data.draws), *frame.sky, frame.reverse_z);
     return Status::success();
   });
   return data;
 }
 
 void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices,
-                     VkBuffer indices, const std::vector<SceneDraw>& draws, bool reverse_z) const {
+                     VkBuffer indices, const std::vector<SceneDraw>& draws,
+                     const gpu::SceneConstants& sky, bool reverse_z) const {
   constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   // Terrain and objects first, so the sky's fragments are depth-tested away behind them.
   const VkDeviceSize offset = 0;
@@ -127,8 +128,7 @@ void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertic
     vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), d.constants);
     vk.vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, 0, 0);
   }
-  // The sky with the view's own constants: those of the first, untranslated draw.
-  vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), draws.front().constants);
+  vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), &sky);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, sky_pipeline_);
   vk.vkCmdSetDepthCompareOp(cmd, reverse_z ? VK_COMPARE_OP_GREATER_OR_EQUAL
                                            : VK_COMPARE_OP_LESS_OR_EQUAL);

@@ -48,6 +48,7 @@ class ScenePass {
   struct Frame {
     bool reverse_z = false;
     VkRect2D viewport{};
+    const gpu::SceneConstants* sky = nullptr;  // the view's own constants
   };
   // What each execute binds: the frame's draws and view.
   struct FrameData {
@@ -57,9 +58,11 @@ class ScenePass {
   // Declares a pass clearing colour and depth, then drawing the frame's draws and the sky; the
   // new versions of colour and depth go back into `handles`.
   FrameData declare(FrameGraph& graph, const char* pass_name, Handles* handles);
-  // Records `draws` then the sky into the rendering begun by the caller (viewport set).
+  // Records `draws` then the sky (with `sky`, the view's own constants) into the rendering begun
+  // by the caller (viewport set).
   void draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices, VkBuffer indices,
-            const std::vector<SceneDraw>& draws, bool reverse_z) const;
+            const std::vector<SceneDraw>& draws, const gpu::SceneConstants& sky,
+            bool reverse_z) const;
 
  private:
   VkPipelineLayout layout_ = VK_NULL_HANDLE;

@@ -18,6 +18,7 @@
 #include "siviflow/scene_river.h"
 #include "static_assets.h"
 #include "view_math.h"
+#include "gpu_timer.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
@@ -34,6 +35,11 @@ constexpr VkFormat kDefaultDepthFormat = VK_FORMAT_D32_SFLOAT;
 constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;  // the renderer's
 constexpr VkFormat kDetailFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr VkFormat kBaseColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
+
+// The widest a terrain level's grid spacing may look, in pixels: the reflection, rippled and
+// faded by Fresnel, takes coarser ground than the main view.
+constexpr float kMainSpacingPixels = 16.0f;
+constexpr float kReflectionSpacingPixels = 32.0f;
 
 constexpr std::string_view kWorldErrorPrefix = "siviflow::World: ";
 
@@ -69,7 +75,8 @@ struct World::Impl {
   // drawn (spares start hidden).
   std::vector<std::optional<glm::vec3>> placed;
   std::vector<bool> shown;
-  std::vector<uint32_t> boulder_index_counts;
+  std::vector<LodPiece> pieces;       // the static world, culled and levelled per view
+  std::vector<IndexRange> boulders;   // per obstacle, drawn translated to it
   SceneCamera camera_path;          // keys empty: the scene's default camera
   // The ground, beds and objects as World::occluders() gives them.
   std::vector<glm::vec3> occluder_positions;
@@ -84,14 +91,19 @@ struct World::Impl {
   ScenePass reflection_pass;  // the renderer's reflection target, when its formats differ
   bool own_reflection_pass = false;
 
-  // What the passes draw: the static scene, each obstacle's boulder with its own constants
-  // (translated to where the obstacle is), the objects. Per view: main, then mirrored.
+  // What the passes draw, chosen per view: the static pieces it sees (nearest first, so the
+  // depth test spares the far ones' shading), then each obstacle's boulder with its own
+  // constants (translated to where the obstacle is). Per view: main, then mirrored.
   std::vector<SceneDraw> main_draws;
   std::vector<SceneDraw> reflection_draws;
   gpu::SceneConstants main_constants{};
   gpu::SceneConstants reflection_constants{};
   std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main, then mirrored
   double time = 0.0;  // of the last record(), for the reflection
+  float tan_scale = 1.0f;  // |projection[1][1]| of the last record()'s view, for the reflection
+  WorldDrawStats stats;
+  GpuTimer timer;  // with WorldCreateInfo::enable_timing
+  uint32_t slot = 0;  // of the last begin_frame()
   ScenePass::Frame frame;  // the main view's depth convention and viewport
   ScenePass::FrameData frame_data;  // where `graph` reads the draws and `frame`
 
@@ -105,7 +117,8 @@ struct World::Impl {
   Status declare_graph();
   gpu::SceneConstants view_constants(const glm::mat4& view_proj, const glm::vec3& camera,
                                      const glm::vec4& clip_plane, bool reverse) const;
-  void place_obstacles(size_t which, const gpu::SceneConstants& constants);
+  void select_draws(const CullView& view, const gpu::SceneConstants& constants, size_t which,
+                    std::vector<SceneDraw>* draws, uint32_t* triangles);
   void destroy();
   static Status create(const WorldCreateInfo& info, std::unique_ptr<World>* out);
   Status record(VkCommandBuffer cmd, const View& view, double time_seconds,
@@ -157,27 +170,10 @@ Status World::Impl::create_resources() {
   }
   SceneObjects objects;
   if (info.scene != nullptr) SIVIFLOW_TRY(load_scene_objects(*info.scene, &objects));
-  // Sized once: the draws point into it.
-  obstacle_constants.resize(2 * obstacles.size());
-  main_draws = {{0, geometry.static_index_count, &main_constants}};
-  reflection_draws = {{0, geometry.static_index_count, &reflection_constants}};
-  for (size_t i = 0; i < geometry.obstacle_boulders.size(); ++i) {
-    const SceneGeometry::Instance& boulder = geometry.obstacle_boulders[i];
-    boulder_index_counts.push_back(boulder.index_count);
-    main_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i]});
-    reflection_draws.push_back({boulder.first_index, boulder.index_count, &obstacle_constants[2 * i + 1]});
-  }
+  obstacle_constants.resize(2 * obstacles.size());  // sized once: the draws point into it
+  boulders = geometry.obstacle_boulders;
   // The other rivers' valleys or beds, static like the first's.
-  for (const SceneGeometry& other : other_rivers) {
-    const auto first_vertex = static_cast<uint32_t>(geometry.vertices.size());
-    const auto first_index = static_cast<uint32_t>(geometry.indices.size());
-    geometry.vertices.insert(geometry.vertices.end(), other.vertices.begin(), other.vertices.end());
-    for (uint32_t i = 0; i < other.static_index_count; ++i) {
-      geometry.indices.push_back(first_vertex + other.indices[i]);
-    }
-    main_draws.push_back({first_index, other.static_index_count, &main_constants});
-    reflection_draws.push_back({first_index, other.static_index_count, &reflection_constants});
-  }
+  for (SceneGeometry& other : other_rivers) append_geometry(std::move(other), &geometry);
   other_rivers.clear();
   // The objects after the valley, in world space: drawn with the view's own constants.
   const auto first_object_vertex = static_cast<uint32_t>(geometry.vertices.size());
@@ -185,19 +181,19 @@ Status World::Impl::create_resources() {
   geometry.vertices.insert(geometry.vertices.end(), objects.vertices.begin(), objects.vertices.end());
   for (uint32_t index : objects.indices) geometry.indices.push_back(first_object_vertex + index);
   for (const SceneObjects::Draw& draw : objects.draws) {
-    main_draws.push_back({first_object_index + draw.first_index, draw.index_count, &main_constants,
-                          draw.texture + 1});
-    reflection_draws.push_back({first_object_index + draw.first_index, draw.index_count,
-                                &reflection_constants, draw.texture + 1});
+    geometry.pieces.push_back(object_piece(geometry, first_object_index + draw.first_index,
+                                           draw.index_count, draw.texture + 1));
   }
-  // Everything drawn with the view's own constants is static; the boulders stand for the
-  // renderer's obstacles, which it knows itself.
+  pieces = std::move(geometry.pieces);
+  // Every piece is static; the boulders stand for the renderer's obstacles, which it knows
+  // itself. The finest level stops particles, its skirts (under the ground) left out.
   occluder_positions.reserve(geometry.vertices.size());
   for (const SceneVertex& v : geometry.vertices) occluder_positions.push_back(v.position);
-  for (const SceneDraw& draw : main_draws) {
-    if (draw.constants != &main_constants) continue;
-    occluder_indices.insert(occluder_indices.end(), geometry.indices.begin() + draw.first_index,
-                            geometry.indices.begin() + draw.first_index + draw.index_count);
+  for (const LodPiece& piece : pieces) {
+    const IndexRange& finest = piece.levels.front();
+    const auto begin = geometry.indices.begin() + finest.first_index;
+    occluder_indices.insert(occluder_indices.end(), begin,
+                            begin + (finest.index_count - piece.level0_skirt_index_count));
   }
   assets.add_buffer({"world vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                      bytes_of(geometry.vertices)});
@@ -211,6 +207,10 @@ Status World::Impl::create_resources() {
                       std::move(texture.texels), std::move(texture.mip_offsets)});
   }
   SIVIFLOW_TRY(ring.init(gpu, info.frames_in_flight, 0));
+  if (info.enable_timing) {
+    SIVIFLOW_TRY(timer.create(gpu, info.physical_device, info.queue_family_index,
+                              info.frames_in_flight));
+  }
   SIVIFLOW_TRY(assets.create(gpu));
   std::vector<VkImageView> base_colors;
   for (uint32_t n = kFirstBaseColor; n < assets.image_count(); ++n) {
@@ -260,14 +260,32 @@ gpu::SceneConstants World::Impl::view_constants(const glm::mat4& view_proj,
   return c;
 }
 
-// The boulders where their obstacles are at the frame's time; `which` 0 main view, 1 mirrored.
-void World::Impl::place_obstacles(size_t which, const gpu::SceneConstants& constants) {
-  std::vector<SceneDraw>& draws = which == 0 ? main_draws : reflection_draws;
+// The pieces `view` sees, nearest first, then the boulders where their obstacles are at the
+// frame's time; `which` 0 main view, 1 mirrored.
+void World::Impl::select_draws(const CullView& view, const gpu::SceneConstants& constants,
+                               size_t which, std::vector<SceneDraw>* draws, uint32_t* triangles) {
+  std::vector<std::pair<float, SceneDraw>> seen;
+  for (const LodPiece& piece : pieces) {
+    const uint32_t level = choose_level(piece, view);
+    if (level == kCulled) continue;
+    const IndexRange& range = piece.levels[level];
+    const glm::vec3 nearest = glm::clamp(view.camera, piece.lo, piece.hi);
+    seen.push_back({glm::length(nearest - view.camera),
+                    {range.first_index, range.index_count, &constants, piece.material}});
+  }
+  std::stable_sort(seen.begin(), seen.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  draws->clear();
+  for (const auto& entry : seen) draws->push_back(entry.second);
   for (size_t i = 0; i < obstacles.size(); ++i) {
+    if (!shown[i]) continue;
     const glm::vec3 centre = placed[i] ? *placed[i] : obstacle_centre_at(obstacles[i], time);
     obstacle_constants[2 * i + which] = translated(constants, centre);
-    draws[1 + i].index_count = shown[i] ? boulder_index_counts[i] : 0;  // after the valley
+    draws->push_back({boulders[i].first_index, boulders[i].index_count,
+                      &obstacle_constants[2 * i + which]});
   }
+  *triangles = 0;
+  for (const SceneDraw& draw : *draws) *triangles += draw.index_count / 3;
 }
 
 void World::Impl::destroy() {
@@ -275,6 +293,7 @@ void World::Impl::destroy() {
   main_pass.destroy(gpu);
   reflection_pass.destroy(gpu);
   assets.destroy(gpu);
+  timer.destroy(gpu);
   ring.destroy();
 }
 
@@ -380,7 +399,11 @@ Status World::hide_boulder(uint32_t index) {
 }
 
 Status World::begin_frame(uint32_t slot) {
-  return guarded(kWorldErrorPrefix, nullptr, nullptr, [&] { return impl_->ring.begin_slot(slot); });
+  return guarded(kWorldErrorPrefix, nullptr, nullptr, [&] {
+    SIVIFLOW_TRY(impl_->ring.begin_slot(slot));
+    impl_->slot = slot;
+    return Status::success();
+  });
 }
 
 Status World::record(VkCommandBuffer cmd, const View& view, double time_seconds,
@@ -412,7 +435,18 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
   // Nothing clipped in the main view.
   w.main_constants = w.view_constants(math.view_proj, math.camera_position,
                                       glm::vec4(0.0f, 0.0f, 0.0f, 1.0f), math.reverse_z);
-  w.place_obstacles(0, w.main_constants);
+  w.frame.viewport = view.viewport;
+  if (w.frame.viewport.extent.width == 0 && w.frame.viewport.extent.height == 0) {
+    w.frame.viewport.extent = host_color.extent;
+  }
+  w.frame.sky = &w.main_constants;
+  CullView cull;
+  cull.view_proj = math.view_proj;
+  cull.camera = math.camera_position;
+  w.tan_scale = std::abs(view.projection[1][1]);
+  cull.focal_pixels = 0.5f * w.tan_scale * float(w.frame.viewport.extent.height);
+  cull.max_spacing_pixels = kMainSpacingPixels;
+  w.select_draws(cull, w.main_constants, 0, &w.main_draws, &w.stats.main_triangles);
 
   FrameBindings& b = w.bindings;
   b.reset();
@@ -424,20 +458,33 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
   };
   bind_host(w.color, host_color);
   bind_host(w.depth, host_depth);
-  w.frame.viewport = view.viewport;
-  if (w.frame.viewport.extent.width == 0 && w.frame.viewport.extent.height == 0) {
-    w.frame.viewport.extent = host_color.extent;
-  }
   b.bind_data(w.frame_data.draws, &w.main_draws);
   b.bind_data(w.frame_data.view, &w.frame);
   b.set_render_area(w.color, w.frame.viewport);  // the view's part only: cleared, then drawn
   VkClearValue far{};
   far.depthStencil = {far_depth(math.reverse_z), 0};
   b.set_clear(w.depth, far);
-  SIVIFLOW_TRY(w.graph.execute(w.table, cmd, b));
+  FrameGraph::Timestamps timestamps;
+  if (w.timer.enabled()) {
+    SIVIFLOW_TRY(w.timer.begin(w.table, cmd, w.slot,
+                               static_cast<uint32_t>(w.graph.pass_order().size()), &timestamps));
+  }
+  SIVIFLOW_TRY(w.graph.execute(w.table, cmd, b, w.timer.enabled() ? &timestamps : nullptr));
   if (!w.assets.uploaded()) w.assets.finish_upload(w.ring, w.gpu);
   return Status::success();
 }
+
+Status World::pass_times(uint32_t slot, std::vector<PassTime>* out) const {
+  return guarded(kWorldErrorPrefix, nullptr, nullptr, [&] {
+    const Impl& w = *impl_;
+    if (out == nullptr) return world_error("pass_times: out must not be null");
+    if (!w.timer.enabled()) return world_error("pass_times needs WorldCreateInfo::enable_timing");
+    if (slot >= w.info.frames_in_flight) return world_error("pass_times: slot out of range");
+    return w.timer.pass_times(w.table, slot, w.graph.pass_order(), out);
+  });
+}
+
+WorldDrawStats World::draw_stats() const { return impl_->stats; }
 
 void World::draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, void* world) {
   Impl& w = *static_cast<World*>(world)->impl_;
@@ -448,10 +495,18 @@ void World::draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, voi
   std::memcpy(&clip_plane[0], view.clip_plane, sizeof(view.clip_plane));
   std::memcpy(&camera[0], view.camera_position, sizeof(view.camera_position));
   w.reflection_constants = w.view_constants(view_proj, camera, clip_plane, view.reverse_z);
-  w.place_obstacles(1, w.reflection_constants);
+  CullView cull;
+  cull.view_proj = view_proj;
+  cull.camera = camera;
+  cull.clip_plane = clip_plane;
+  cull.focal_pixels = 0.5f * w.tan_scale * float(view.extent.height);
+  cull.max_spacing_pixels = kReflectionSpacingPixels;
+  w.select_draws(cull, w.reflection_constants, 1, &w.reflection_draws,
+                 &w.stats.reflection_triangles);
   const ScenePass& pass = w.own_reflection_pass ? w.reflection_pass : w.main_pass;
   pass.draw(w.table, cmd, w.assets.buffer(Impl::kVertices).buffer,
-            w.assets.buffer(Impl::kIndices).buffer, w.reflection_draws, view.reverse_z);
+            w.assets.buffer(Impl::kIndices).buffer, w.reflection_draws, w.reflection_constants,
+            view.reverse_z);
 }
 
 }  // namespace siviflow

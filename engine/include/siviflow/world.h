@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -43,6 +44,15 @@ struct WorldCreateInfo {
   // with place_boulder(); each `spare_boulder_radius` metres round.
   uint32_t spare_boulders = 0;
   float spare_boulder_radius = 1.5f;
+  bool enable_timing = false;        // GPU timestamps around the world's pass (pass_times())
+  uint32_t queue_family_index = 0;   // with enable_timing: the family of the queue that runs it
+};
+
+// What the world drew in its last main view (record()) and reflection (draw_reflection()):
+// the pieces its views see, at their levels of detail, and the boulders.
+struct WorldDrawStats {
+  uint32_t main_triangles = 0;
+  uint32_t reflection_triangles = 0;
 };
 
 class World {
@@ -76,6 +86,11 @@ class World {
   // their final states. The depth convention (standard or reverse-Z) is the projection's.
   Status record(VkCommandBuffer cmd, const View& view, double time_seconds,
                 const ExternalImage& color, const ExternalImage& depth);
+
+  // The world's passes ("world") of the frame last recorded in `slot`, once the host waited for
+  // it; needs WorldCreateInfo::enable_timing.
+  Status pass_times(uint32_t slot, std::vector<PassTime>* out) const;
+  WorldDrawStats draw_stats() const;
 
   // A siviflow::ReflectionCallback (user: this World): draws the world as of the last record(),
   // mirrored and clipped as `view` says.

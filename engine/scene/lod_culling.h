@@ -1,0 +1,51 @@
+// Which pieces of the built-in world a view draws, and how finely: a piece outside the view's
+// frustum or wholly below its clip plane is left out, and a terrain chunk draws the coarsest
+// level whose grid spacing still spans at most a few pixels where the chunk is nearest.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+namespace siviflow {
+
+struct IndexRange {
+  uint32_t first_index = 0;
+  uint32_t index_count = 0;
+};
+
+// A static piece of the world: a terrain chunk with its levels of detail, or an object.
+struct LodPiece {
+  glm::vec3 lo{0.0f};  // bounds in the world
+  glm::vec3 hi{0.0f};
+  // Metres between level 0's vertices; level l joins every 2^l-th. 0: one level at any distance.
+  float spacing = 0.0f;
+  std::vector<IndexRange> levels;  // level 0 first; a chunk's level ends with its skirts
+  uint32_t level0_skirt_index_count = 0;  // of levels[0], the last this many (not solid ground)
+  uint32_t material = 0;  // SceneDraw::material
+};
+
+struct CullView {
+  glm::mat4 view_proj{1.0f};
+  glm::vec3 camera{0.0f};
+  glm::vec4 clip_plane{0.0f, 0.0f, 0.0f, 1.0f};  // kept where dot(plane, (p, 1)) >= 0
+  float focal_pixels = 1.0f;  // pixels per unit of tangent: viewport height / (2 tan(fov_y / 2))
+  float max_spacing_pixels = 16.0f;  // the widest a level's grid spacing may look
+};
+
+constexpr uint32_t kCulled = ~uint32_t{0};
+
+// The level `piece` is drawn at in `view`, or kCulled.
+uint32_t choose_level(const LodPiece& piece, const CullView& view);
+
+// Whether the box lies wholly outside the view's frustum (its far plane aside) or wholly below
+// its clip plane.
+bool culled(const glm::vec3& lo, const glm::vec3& hi, const CullView& view);
+
+// The focal length in pixels of a perspective projection shown `viewport_height` pixels high.
+float focal_pixels(const glm::mat4& projection, float viewport_height);
+
+}  // namespace siviflow
