@@ -39,10 +39,7 @@ void add_terrain(const ProceduralRiver& river, SceneGeometry* geometry) {
           ground_vertex({x, y, z}, terrain_normal(river, x, z), y - river.water_level()));
     }
   }
-  // The grid's coarser spacing sets how soon a chunk may coarsen.
-  const float spacing = std::max(2.0f * kTerrainHalfWidth / kTerrainColumns,
-                                 river.params().length / kTerrainRows);
-  add_chunked_grid(points, kTerrainColumns, kTerrainRows, spacing, geometry);
+  add_chunked_grid(points, kTerrainColumns, kTerrainRows, geometry);
 }
 
 // A latitude-longitude ellipsoid, squashed and bumped so it reads as a boulder.

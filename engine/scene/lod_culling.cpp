@@ -33,14 +33,12 @@ bool culled(const glm::vec3& lo, const glm::vec3& hi, const CullView& view) {
 
 uint32_t choose_level(const LodPiece& piece, const CullView& view) {
   if (piece.levels.empty() || culled(piece.lo, piece.hi, view)) return kCulled;
-  if (piece.spacing <= 0.0f) return 0;
-  // The nearest point of the box sets the finest spacing the chunk needs.
+  // The nearest point of the box sets the smallest error the chunk needs.
   const glm::vec3 nearest = glm::clamp(view.camera, piece.lo, piece.hi);
   const float distance = glm::length(nearest - view.camera);
   uint32_t level = 0;
-  while (level + 1 < piece.levels.size() &&
-         piece.spacing * float(2u << level) * view.focal_pixels <=
-             view.max_spacing_pixels * distance) {
+  while (level + 1 < piece.level_error.size() &&
+         piece.level_error[level + 1] * view.focal_pixels <= view.max_error_pixels * distance) {
     ++level;
   }
   return level;

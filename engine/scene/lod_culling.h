@@ -1,6 +1,6 @@
 // Which pieces of the built-in world a view draws, and how finely: a piece outside the view's
 // frustum or wholly below its clip plane is left out, and a terrain chunk draws the coarsest
-// level whose grid spacing still spans at most a few pixels where the chunk is nearest.
+// level whose height error still looks at most a pixel or so where the chunk is nearest.
 #pragma once
 
 #include <cstdint>
@@ -21,9 +21,10 @@ struct IndexRange {
 struct LodPiece {
   glm::vec3 lo{0.0f};  // bounds in the world
   glm::vec3 hi{0.0f};
-  // Metres between level 0's vertices; level l joins every 2^l-th. 0: one level at any distance.
-  float spacing = 0.0f;
   std::vector<IndexRange> levels;  // level 0 first; a chunk's level ends with its skirts
+  // Per level, the most its surface strays from level 0's in height (metres; non-decreasing).
+  // Empty: one level, drawn at any distance.
+  std::vector<float> level_error;
   uint32_t level0_skirt_index_count = 0;  // of levels[0], the last this many (not solid ground)
   uint32_t material = 0;  // SceneDraw::material
 };
@@ -33,7 +34,7 @@ struct CullView {
   glm::vec3 camera{0.0f};
   glm::vec4 clip_plane{0.0f, 0.0f, 0.0f, 1.0f};  // kept where dot(plane, (p, 1)) >= 0
   float focal_pixels = 1.0f;  // pixels per unit of tangent: viewport height / (2 tan(fov_y / 2))
-  float max_spacing_pixels = 16.0f;  // the widest a level's grid spacing may look
+  float max_error_pixels = 1.0f;  // the most a level's height error may look
 };
 
 constexpr uint32_t kCulled = ~uint32_t{0};

@@ -154,7 +154,7 @@ Status add_ground_around_rivers(std::span<const RiverMesh> rivers, SceneGeometry
       grid.push_back(ground_vertex(points[i], n.y < 0.0f ? -n : n, points[i].y - water[i]));
     }
   }
-  add_chunked_grid(grid, uint32_t(quads.x), uint32_t(quads.y), spacing, geometry);
+  add_chunked_grid(grid, uint32_t(quads.x), uint32_t(quads.y), geometry);
   return Status::success();
 }
 

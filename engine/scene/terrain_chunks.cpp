@@ -1,6 +1,7 @@
 #include "scene/terrain_chunks.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <map>
 
@@ -8,6 +9,8 @@
 
 namespace siviflow {
 namespace {
+
+constexpr float kSkirtMarginM = 0.1f;  // below the deepest crack
 
 // The grid lines a level of a chunk joins: every step-th from `begin`, and the chunk's end.
 std::vector<uint32_t> level_lines(uint32_t begin, uint32_t end, uint32_t step) {
@@ -17,16 +20,45 @@ std::vector<uint32_t> level_lines(uint32_t begin, uint32_t end, uint32_t step) {
   return lines;
 }
 
+// The most level `step`'s triangles over grid quads [c0, c1) x [r0, r1) stray in height from the
+// grid's points (each coarse quad split as the fine ones are, from its top right to bottom left).
+float level_error(const std::vector<SceneVertex>& points, uint32_t columns, uint32_t c0,
+                  uint32_t c1, uint32_t r0, uint32_t r1, uint32_t step) {
+  const auto y = [&](uint32_t c, uint32_t r) { return points[r * (columns + 1) + c].position.y; };
+  const std::vector<uint32_t> cols = level_lines(c0, c1, step);
+  const std::vector<uint32_t> rows = level_lines(r0, r1, step);
+  float error = 0.0f;
+  for (size_t j = 0; j + 1 < rows.size(); ++j) {
+    for (size_t i = 0; i + 1 < cols.size(); ++i) {
+      const float a = y(cols[i], rows[j]), b = y(cols[i + 1], rows[j]);
+      const float c = y(cols[i], rows[j + 1]), d = y(cols[i + 1], rows[j + 1]);
+      for (uint32_t r = rows[j]; r <= rows[j + 1]; ++r) {
+        for (uint32_t col = cols[i]; col <= cols[i + 1]; ++col) {
+          const float u = float(col - cols[i]) / float(cols[i + 1] - cols[i]);
+          const float v = float(r - rows[j]) / float(rows[j + 1] - rows[j]);
+          const float coarse = u + v <= 1.0f ? a + u * (b - a) + v * (c - a)
+                                             : d + (1.0f - u) * (c - d) + (1.0f - v) * (b - d);
+          error = std::max(error, std::abs(coarse - y(col, r)));
+        }
+      }
+    }
+  }
+  return error;
+}
+
 class ChunkBuilder {
  public:
+  // Skirts hang `skirt_depth` metres: deeper than any level's error, so no crack between two
+  // chunks at any levels shows through.
   ChunkBuilder(const std::vector<SceneVertex>& points, uint32_t columns, uint32_t base,
-               SceneGeometry* geometry)
-      : points_(points), columns_(columns), base_(base), geometry_(geometry) {}
+               float skirt_depth, SceneGeometry* geometry)
+      : points_(points), columns_(columns), base_(base), skirt_depth_(skirt_depth),
+        geometry_(geometry) {}
 
-  // The chunk of grid quads [c0, c1) x [r0, r1).
-  LodPiece build(uint32_t c0, uint32_t c1, uint32_t r0, uint32_t r1, float spacing) {
+  // The chunk of grid quads [c0, c1) x [r0, r1), its levels' errors given.
+  LodPiece build(uint32_t c0, uint32_t c1, uint32_t r0, uint32_t r1, std::vector<float> errors) {
     LodPiece piece;
-    piece.spacing = spacing;
+    piece.level_error = std::move(errors);
     piece.lo = glm::vec3(std::numeric_limits<float>::max());
     piece.hi = glm::vec3(std::numeric_limits<float>::lowest());
     for (uint32_t r = r0; r <= r1; ++r) {
@@ -35,12 +67,9 @@ class ChunkBuilder {
         piece.hi = glm::max(piece.hi, points_[at(c, r)].position);
       }
     }
-    // A crack between levels is never deeper than the chunk's own rise.
-    skirt_depth_ = std::max(1.0f, piece.hi.y - piece.lo.y);
     std::vector<uint32_t>& indices = geometry_->indices;
-    for (uint32_t level = 0; level < kTerrainLevels; ++level) {
+    for (uint32_t level = 0; level < piece.level_error.size(); ++level) {
       const uint32_t step = 1u << level;
-      if (step > std::max(c1 - c0, r1 - r0)) break;
       const std::vector<uint32_t> cols = level_lines(c0, c1, step);
       const std::vector<uint32_t> rows = level_lines(r0, r1, step);
       const auto first = static_cast<uint32_t>(indices.size());
@@ -67,7 +96,7 @@ class ChunkBuilder {
       if (level == 0) piece.level0_skirt_index_count = end - skirts_first;
     }
     piece.lo.y -= skirt_depth_;
-    hung_.clear();  // skirts hang per chunk: their depth is the chunk's
+    hung_.clear();  // each chunk its own copies: a neighbour may draw at another level
     return piece;
   }
 
@@ -99,23 +128,42 @@ class ChunkBuilder {
   const std::vector<SceneVertex>& points_;
   uint32_t columns_;
   uint32_t base_;
+  float skirt_depth_;
   SceneGeometry* geometry_;
-  float skirt_depth_ = 1.0f;
   std::map<uint32_t, uint32_t> hung_;  // grid point -> its hung copy, in the current chunk
 };
 
 }  // namespace
 
 void add_chunked_grid(const std::vector<SceneVertex>& points, uint32_t columns, uint32_t rows,
-                      float spacing, SceneGeometry* geometry) {
-  const auto base = static_cast<uint32_t>(geometry->vertices.size());
-  geometry->vertices.insert(geometry->vertices.end(), points.begin(), points.end());
-  ChunkBuilder builder(points, columns, base, geometry);
+                      SceneGeometry* geometry) {
+  struct Chunk {
+    uint32_t c0, c1, r0, r1;
+    std::vector<float> errors;
+  };
+  std::vector<Chunk> chunks;
+  float deepest = 0.0f;
   for (uint32_t r0 = 0; r0 < rows; r0 += kChunkQuads) {
     for (uint32_t c0 = 0; c0 < columns; c0 += kChunkQuads) {
-      geometry->pieces.push_back(builder.build(c0, std::min(c0 + kChunkQuads, columns), r0,
-                                               std::min(r0 + kChunkQuads, rows), spacing));
+      Chunk chunk{c0, std::min(c0 + kChunkQuads, columns), r0, std::min(r0 + kChunkQuads, rows), {}};
+      for (uint32_t level = 0; level < kTerrainLevels; ++level) {
+        const uint32_t step = 1u << level;
+        if (step > std::max(chunk.c1 - chunk.c0, chunk.r1 - chunk.r0)) break;
+        const float error =
+            level == 0 ? 0.0f : level_error(points, columns, chunk.c0, chunk.c1, chunk.r0, chunk.r1, step);
+        // Non-decreasing, so a level further on is never finer.
+        chunk.errors.push_back(chunk.errors.empty() ? error : std::max(error, chunk.errors.back()));
+      }
+      deepest = std::max(deepest, chunk.errors.back());
+      chunks.push_back(std::move(chunk));
     }
+  }
+  const auto base = static_cast<uint32_t>(geometry->vertices.size());
+  geometry->vertices.insert(geometry->vertices.end(), points.begin(), points.end());
+  ChunkBuilder builder(points, columns, base, deepest + kSkirtMarginM, geometry);
+  for (Chunk& chunk : chunks) {
+    geometry->pieces.push_back(
+        builder.build(chunk.c0, chunk.c1, chunk.r0, chunk.r1, std::move(chunk.errors)));
   }
 }
 

@@ -13,10 +13,10 @@ namespace siviflow {
 constexpr uint32_t kChunkQuads = 16;    // grid quads along a chunk's side
 constexpr uint32_t kTerrainLevels = 4;  // levels 0..3: every 1st, 2nd, 4th, 8th grid point
 
-// Appends the grid's `points` ((columns + 1) x (rows + 1) vertices, row by row, `spacing`
-// metres apart, counter-clockwise seen from above as row grows towards the viewer) to
-// `geometry` as chunk pieces.
+// Appends the grid's `points` ((columns + 1) x (rows + 1) vertices, row by row, counter-
+// clockwise seen from above as the row grows towards the viewer) to `geometry` as chunk pieces,
+// each level with its height error.
 void add_chunked_grid(const std::vector<SceneVertex>& points, uint32_t columns, uint32_t rows,
-                      float spacing, SceneGeometry* geometry);
+                      SceneGeometry* geometry);
 
 }  // namespace siviflow

@@ -36,10 +36,10 @@ constexpr VkFormat kReflectionDepthFormat = VK_FORMAT_D32_SFLOAT;  // the render
 constexpr VkFormat kDetailFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr VkFormat kBaseColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
 
-// The widest a terrain level's grid spacing may look, in pixels: the reflection, rippled and
+// The most a terrain level's height error may look, in pixels: the reflection, rippled and
 // faded by Fresnel, takes coarser ground than the main view.
-constexpr float kMainSpacingPixels = 16.0f;
-constexpr float kReflectionSpacingPixels = 32.0f;
+constexpr float kMainErrorPixels = 3.0f;
+constexpr float kReflectionErrorPixels = 6.0f;
 
 constexpr std::string_view kWorldErrorPrefix = "siviflow::World: ";
 
@@ -445,7 +445,7 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
   cull.camera = math.camera_position;
   w.tan_scale = std::abs(view.projection[1][1]);
   cull.focal_pixels = 0.5f * w.tan_scale * float(w.frame.viewport.extent.height);
-  cull.max_spacing_pixels = kMainSpacingPixels;
+  cull.max_error_pixels = kMainErrorPixels;
   w.select_draws(cull, w.main_constants, 0, &w.main_draws, &w.stats.main_triangles);
 
   FrameBindings& b = w.bindings;
@@ -500,7 +500,7 @@ void World::draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, voi
   cull.camera = camera;
   cull.clip_plane = clip_plane;
   cull.focal_pixels = 0.5f * w.tan_scale * float(view.extent.height);
-  cull.max_spacing_pixels = kReflectionSpacingPixels;
+  cull.max_error_pixels = kReflectionErrorPixels;
   w.select_draws(cull, w.reflection_constants, 1, &w.reflection_draws,
                  &w.stats.reflection_triangles);
   const ScenePass& pass = w.own_reflection_pass ? w.reflection_pass : w.main_pass;

@@ -298,21 +298,35 @@ TEST_F(CliTest, CaptureRefusesBadSceneFiles) {
 }
 
 TEST_F(CliTest, BenchReportsEveryPassAsJson) {
-  const RunResult r = run_siviflow("bench --size 96x54 --frames 3 --warmup 1 --json");
+  const RunResult r = run_siviflow("bench --size 96x54 --frames 5 --warmup 1 --runs 2 --json");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json report = nlohmann::json::parse(r.output, nullptr, false);
   ASSERT_FALSE(report.is_discarded()) << r.output;
-  EXPECT_GT(report.at("frame_ms").get<double>(), 0.0);
-  EXPECT_GT(report.at("floor_ms").get<double>(), 0.0);
-  // The water's own passes, and their span; the world is the host's, not a pass of ours.
-  EXPECT_FALSE(report.at("passes").contains("scene")) << r.output;
-  for (const char* pass : {"upload", "reflection", "flow", "water"}) {
+  const double frame = report.at("frame_ms").get<double>();
+  const double floor = report.at("floor_ms").get<double>();
+  EXPECT_GT(floor, 0.0);
+  EXPECT_LT(report.at("frame_without_floor_ms").get<double>(), frame);
+  // The water's own passes, their span, and the world's pass.
+  for (const char* pass : {"upload", "reflection", "flow", "water", "world"}) {
     ASSERT_TRUE(report.at("passes").contains(pass)) << pass << "\n" << r.output;
     const nlohmann::json& stats = report["passes"][pass];
     EXPECT_LE(stats.at("min_ms").get<double>(), stats.at("median_ms").get<double>()) << pass;
     EXPECT_LE(stats.at("median_ms").get<double>(), stats.at("max_ms").get<double>()) << pass;
   }
   EXPECT_FALSE(report.at("passes").contains("flow floor")) << "the floor is reported apart";
+  // The passes run one after the other: their medians add up to no more than the frame.
+  double passes = floor;
+  for (const char* pass : {"upload", "reflection", "refraction copy", "flow tiles",
+                           "flow material", "world"}) {
+    passes += report.at("passes").at(pass).at("median_ms").get<double>();
+  }
+  EXPECT_LE(passes, frame) << r.output;
+  EXPECT_EQ(report.at("runs").get<int>(), 2);
+  EXPECT_EQ(report.at("run_frame_ms").size(), 2u);
+  EXPECT_GE(report.at("run_spread").get<double>(), 0.0);
+  for (const char* drawn : {"world", "world_reflection", "water"}) {
+    EXPECT_GT(report.at("triangles").at(drawn).get<int>(), 0) << drawn;
+  }
   EXPECT_GE(report.at("cpu").at("update_ms").get<double>(), 0.0);
   EXPECT_GT(report.at("create_ms").get<double>(), 0.0);
   EXPECT_FALSE(report.contains("second_view"));
@@ -325,6 +339,7 @@ TEST_F(CliTest, BenchReportsEveryPassAsJson) {
     EXPECT_GT(second.at("second_view").at(key).get<double>(), 0.0) << key;
   }
   expect_error(run_siviflow("bench --frames 0"), "--frames");
+  expect_error(run_siviflow("bench --runs 0"), "--runs");
   // A scene file, at its own render size.
   const fs::path scene = dir_.parent_path() / "bench_scene.json";
   FILE* f = std::fopen(scene.c_str(), "w");

@@ -66,6 +66,7 @@ class GpuTest : public ::testing::Test {
     WorldCreateInfo world_info = context_->world_create_info(info.color_format, info.depth_format);
     world_info.frames_in_flight = info.frames_in_flight;
     world_info.scene = scene;
+    world_info.enable_timing = time_world_;
     SIVIFLOW_TRY(World::create(world_info, &world_));
     SceneRiverData river;  // read by create() only
     WaterRiver water;
@@ -85,6 +86,7 @@ class GpuTest : public ::testing::Test {
 
   std::unique_ptr<HeadlessContext> context_;
   VkFormat color_format_ = VK_FORMAT_R16G16B16A16_SFLOAT;  // the host's colour images
+  bool time_world_ = false;  // create_renderer's world writes timestamps
   std::unique_ptr<World> world_;
   std::unique_ptr<Renderer> renderer_;
 };

@@ -1,0 +1,157 @@
+// The built-in world's culling and levels of detail: a chunk further away never draws more
+// triangles, a chunk behind the camera, beside the frustum or below the reflection's clip plane
+// is not drawn, and a chunked grid's levels join ever fewer points with skirts at their edges.
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "scene/lod_culling.h"
+#include "scene/terrain_chunks.h"
+
+namespace siviflow {
+namespace {
+
+constexpr float kHeight = 720.0f;
+
+glm::mat4 projection() {
+  glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(55.0f), 16.0f / 9.0f, 0.1f, 600.0f);
+  p[1][1] *= -1.0f;  // Vulkan's +Y down
+  return p;
+}
+
+// A camera at `eye` looking along +Z.
+CullView view_from(glm::vec3 eye) {
+  CullView view;
+  view.camera = eye;
+  view.view_proj = projection() * glm::lookAtRH(eye, eye + glm::vec3(0, 0, 1), glm::vec3(0, 1, 0));
+  view.focal_pixels = focal_pixels(projection(), kHeight);
+  return view;
+}
+
+// A grid of quads 1.5 m apart, its corner at the origin, rolling up to `amplitude` metres above
+// and below y = 0.
+SceneGeometry rolling_grid(uint32_t columns, uint32_t rows, float amplitude) {
+  std::vector<SceneVertex> points;
+  for (uint32_t r = 0; r <= rows; ++r) {
+    for (uint32_t c = 0; c <= columns; ++c) {
+      const float y = amplitude * std::sin(0.5f * c) * std::sin(0.3f * r);
+      points.push_back(ground_vertex({c * 1.5f, y, r * 1.5f}, {0, 1, 0}, 1.0f));
+    }
+  }
+  SceneGeometry geometry;
+  add_chunked_grid(points, columns, rows, &geometry);
+  return geometry;
+}
+
+LodPiece chunk_at(float z) {
+  SceneGeometry geometry = rolling_grid(16, 16, 1.0f);
+  LodPiece piece = geometry.pieces.at(0);
+  piece.lo.z += z;
+  piece.hi.z += z;
+  return piece;
+}
+
+TEST(LodCulling, FocalPixelsOfTheProjection) {
+  EXPECT_NEAR(focal_pixels(projection(), kHeight), kHeight / (2.0f * std::tan(glm::radians(27.5f))), 0.01f);
+}
+
+TEST(LodCulling, AChunkTwiceAsFarDrawsAtMostTheSameTriangles) {
+  const CullView view = view_from({12.0f, 5.0f, 0.0f});
+  const LodPiece chunk = chunk_at(0.0f);
+  ASSERT_EQ(chunk.level_error.size(), kTerrainLevels);
+  EXPECT_EQ(chunk.level_error[0], 0.0f);
+  for (uint32_t level = 1; level < kTerrainLevels; ++level) {
+    EXPECT_GE(chunk.level_error[level], chunk.level_error[level - 1]) << level;
+    EXPECT_LT(chunk.levels[level].index_count, chunk.levels[level - 1].index_count) << level;
+  }
+  EXPECT_GT(chunk.level_error[1], 0.0f);
+  uint32_t levels_seen = 0;
+  for (float z = 2.0f; z < 5000.0f; z *= 2.0f) {
+    const LodPiece near = chunk_at(z);
+    const LodPiece far = chunk_at(2.0f * z);
+    const uint32_t near_level = choose_level(near, view);
+    const uint32_t far_level = choose_level(far, view);
+    ASSERT_NE(near_level, kCulled) << z;
+    ASSERT_NE(far_level, kCulled) << z;
+    EXPECT_GE(far_level, near_level) << z;
+    EXPECT_LE(far.levels[far_level].index_count, near.levels[near_level].index_count) << z;
+    levels_seen |= 1u << far_level;
+  }
+  // Near, the finest; far, the coarsest; and the levels between on the way.
+  EXPECT_EQ(choose_level(chunk_at(2.0f), view), 0u);
+  EXPECT_EQ(levels_seen & (1u << (kTerrainLevels - 1)), 1u << (kTerrainLevels - 1)) << levels_seen;
+  EXPECT_GE(__builtin_popcount(levels_seen), 3) << levels_seen;
+  // A flat chunk is as good coarse as fine: its coarsest level, however near.
+  SceneGeometry flat = rolling_grid(16, 16, 0.0f);
+  EXPECT_EQ(choose_level(flat.pieces.at(0), view), kTerrainLevels - 1);
+}
+
+TEST(LodCulling, AChunkBehindTheCameraOrBesideTheViewIsNotDrawn) {
+  const CullView view = view_from({12.0f, 5.0f, 0.0f});
+  EXPECT_NE(choose_level(chunk_at(10.0f), view), kCulled);
+  EXPECT_EQ(choose_level(chunk_at(-40.0f), view), kCulled) << "behind";
+  LodPiece beside = chunk_at(10.0f);
+  beside.lo.x += 300.0f;
+  beside.hi.x += 300.0f;
+  EXPECT_EQ(choose_level(beside, view), kCulled) << "far to the side";
+  // One the camera stands in is seen whatever it looks at.
+  EXPECT_NE(choose_level(chunk_at(-12.0f), view_from({12.0f, 0.0f, 0.0f})), kCulled);
+}
+
+TEST(LodCulling, AChunkBelowTheReflectionsClipPlaneIsNotDrawn) {
+  CullView view = view_from({12.0f, 5.0f, 0.0f});
+  view.clip_plane = glm::vec4(0.0f, 1.0f, 0.0f, 0.0f);  // keeps y >= 0
+  LodPiece under = chunk_at(10.0f);
+  under.lo.y = -3.0f;
+  under.hi.y = -0.5f;
+  EXPECT_EQ(choose_level(under, view), kCulled);
+  under.hi.y = 0.5f;  // one corner out of the water: drawn, clipped by the pass
+  EXPECT_NE(choose_level(under, view), kCulled);
+}
+
+TEST(LodCulling, ObjectsHaveOneLevelAtAnyDistance) {
+  LodPiece object;
+  object.lo = {10.0f, 0.0f, 200.0f};
+  object.hi = {12.0f, 3.0f, 202.0f};
+  object.levels = {{0, 300}};  // no level errors: one level
+  EXPECT_EQ(choose_level(object, view_from({12.0f, 5.0f, 0.0f})), 0u);
+}
+
+TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
+  const SceneGeometry geometry = rolling_grid(40, 20, 1.0f);
+  // 40 x 20 quads in 16-quad chunks: 3 x 2, the last row and column narrower.
+  ASSERT_EQ(geometry.pieces.size(), 6u);
+  const LodPiece& full = geometry.pieces[0];
+  ASSERT_EQ(full.levels.size(), kTerrainLevels);
+  for (uint32_t level = 0; level < kTerrainLevels; ++level) {
+    const uint32_t per_side = 16u >> level;
+    // Two triangles a quad, and two a skirt segment on four sides.
+    EXPECT_EQ(full.levels[level].index_count, 6u * per_side * per_side + 4u * 6u * per_side) << level;
+  }
+  EXPECT_EQ(full.level0_skirt_index_count, 4u * 6u * 16u);
+  // Skirts hang below the ground, deeper than any level's error: the bounds reach down.
+  float deepest = 0.0f;
+  for (const LodPiece& piece : geometry.pieces) deepest = std::max(deepest, piece.level_error.back());
+  EXPECT_LT(full.lo.y, -deepest);
+  EXPECT_LE(full.hi.y, 1.0f);
+  // Every level's triangles use grid points (or their hung copies) of its own chunk only.
+  for (const LodPiece& piece : geometry.pieces) {
+    for (const IndexRange& level : piece.levels) {
+      for (uint32_t i = level.first_index; i < level.first_index + level.index_count; ++i) {
+        const glm::vec3& p = geometry.vertices.at(geometry.indices.at(i)).position;
+        EXPECT_GE(p.x, piece.lo.x - 1e-4f);
+        EXPECT_LE(p.x, piece.hi.x + 1e-4f);
+        EXPECT_GE(p.z, piece.lo.z - 1e-4f);
+        EXPECT_LE(p.z, piece.hi.z + 1e-4f);
+      }
+    }
+  }
+  // The chunk of 8 x 4 quads (the corner) coarsens as far as its longer side allows.
+  EXPECT_EQ(geometry.pieces[5].levels.size(), 4u);
+  EXPECT_EQ(geometry.pieces[5].level_error.size(), 4u);
+}
+
+}  // namespace
+}  // namespace siviflow
