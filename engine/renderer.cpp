@@ -13,6 +13,7 @@
 #include "renderer_impl.h"
 #include "renderer_inspect.h"
 #include "siviflow/text_format.h"
+#include "view_culling.h"
 #include "vk/pipeline.h"
 #include "vk/vk_text.h"
 
@@ -389,6 +390,7 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
               sizeof(reflection_view.camera_position));
   reflection_view.reverse_z = view.reverse_z;
 
+  choose_water_draws();
   const FlowTextureLayout& layout = simulation.layout();
   water_frame.flow.view_proj = view.view_proj;
   water_frame.flow.camera_position = glm::vec4(view.camera_position, view.depth_ratio_constant);
@@ -427,6 +429,24 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
                 wrapped_time);
   last_time = time_seconds;
   return Status::success();
+}
+
+// The chunks of the surface inside the view, neighbours joined into one draw: a river's GPU cost
+// follows what is on screen, not its length.
+void Renderer::Impl::choose_water_draws() {
+  water_draws.clear();
+  water_triangles = 0;
+  for (const SharedRiver::Chunk& chunk : river->chunks) {
+    if (box_outside_view(chunk.lo, chunk.hi, view.view_proj)) continue;
+    if (!water_draws.empty() && water_draws.back().first_index + water_draws.back().index_count ==
+                                    chunk.indices.first_index) {
+      water_draws.back().index_count += chunk.indices.index_count;
+    } else {
+      water_draws.push_back(chunk.indices);
+    }
+    water_triangles += chunk.indices.index_count / 3;
+  }
+  water_frame.draws = &water_draws;
 }
 
 // The plane of the visible reach: the median height of this frame's live particles. They are
@@ -632,6 +652,9 @@ const FlowTextureLayout& RendererInspector::flow_texture_layout(const Renderer& 
 }
 const RiverFlowField& RendererInspector::flow_field(const Renderer& renderer) {
   return renderer.impl_->river->flow.field();
+}
+uint32_t RendererInspector::drawn_water_triangles(const Renderer& renderer) {
+  return renderer.impl_->water_triangles;
 }
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 uint64_t Renderer::flow_solves() const { return impl_->river->flow.full_solves(); }

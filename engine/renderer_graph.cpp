@@ -106,12 +106,13 @@ Status Renderer::Impl::declare_graph() {
       {"tile table", FlowPass::kTileTableFormat,
        {tile_lattice.layout().width, tile_lattice.layout().height}, {}}));
   flow_pass.declare_tiles(graph, &water);
-  flow_pass.declare(graph, river->index_count, &water);
-  if (info.write_depth) flow_pass.declare_depth(graph, river->index_count, &water);
+  water_frame.draws = &water_draws;
+  flow_pass.declare(graph, &water);
+  if (info.write_depth) flow_pass.declare_depth(graph, &water);
   if (info.enable_timing && info.measure_flow_floor) {
     const ImageHandle floor =
         frame_image(graph.create_image({"flow floor", info.color_format, extent, {}}));
-    flow_pass.declare_floor(graph, river->index_count, water, floor);
+    flow_pass.declare_floor(graph, water, floor);
   }
 
   if (info.readback_images != 0) {

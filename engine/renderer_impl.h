@@ -62,6 +62,8 @@ struct Renderer::Impl {
   std::vector<ReadbackImage> readback_kinds;  // which image each of them copies
   FrameBindings bindings;
   FlowPass::Frame water_frame;  // of the frame being prepared: push constants, look, host depth
+  std::vector<IndexRange> water_draws;  // the surface's runs the frame's view sees, joined
+  uint32_t water_triangles = 0;         // in them
   // Where the graph's passes read this frame's upload list, readback copies, reflection view and
   // the viewport's offset in the host's images (the refraction copy's source).
   DataHandle<UploadList> uploads_data;
@@ -113,6 +115,7 @@ struct Renderer::Impl {
     has_shown = true;
   }
   float visible_water_level();
+  void choose_water_draws();
   Status check_inputs(const FrameInputs& inputs) const;
   Status bind_frame(const FrameInputs& inputs);
   Status resize(VkExtent2D extent);

@@ -1,6 +1,6 @@
 // What our tools and tests read of a renderer's simulation, beyond the embedding interface (not
-// installed): the particles of the last simulated frame, the flow texture's layout and the
-// river's flow per vertex.
+// installed): the particles of the last simulated frame, the flow texture's layout, the
+// river's flow per vertex and the water's triangles drawn.
 #pragma once
 
 #include "siviflow/renderer.h"
@@ -17,6 +17,8 @@ class RendererInspector {
   static const FlowTextureLayout& flow_texture_layout(const Renderer& renderer);
   // The river's flow per vertex as the next update's particles read it (shared by its views).
   static const RiverFlowField& flow_field(const Renderer& renderer);
+  // The triangles of the water surface the last updated view draws (its chunks in view).
+  static uint32_t drawn_water_triangles(const Renderer& renderer);
 };
 
 inline const ParticleField& particle_field(const Renderer& renderer) {
@@ -27,6 +29,9 @@ inline const FlowTextureLayout& flow_texture_layout(const Renderer& renderer) {
 }
 inline const RiverFlowField& flow_field(const Renderer& renderer) {
   return RendererInspector::flow_field(renderer);
+}
+inline uint32_t drawn_water_triangles(const Renderer& renderer) {
+  return RendererInspector::drawn_water_triangles(renderer);
 }
 
 }  // namespace siviflow

@@ -20,7 +20,9 @@ constexpr VkFormat kNormalMapFormat = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr float kWaterHeightSpacing = 1.5f;
 constexpr float kWaterHeightMargin = 5.0f * kWaterHeightSpacing;
 static_assert(kWaterHeightMargin >= 0.5f * kMaxTileSizeM);
-constexpr uint32_t kMaxWaterHeightSamples = 2048;  // per axis: 16 MiB at most, samples widen beyond
+constexpr uint32_t kMaxWaterHeightSamples = 2048;
+// Triangles of a surface chunk: a few hundred metres of a river, culled or drawn whole.
+constexpr uint32_t kChunkTriangles = 1024;  // per axis: 16 MiB at most, samples widen beyond
 
 // The longest triangle edge of a mesh, seen from above.
 float longest_edge_xz(const std::vector<glm::vec3>& positions,
@@ -46,7 +48,7 @@ Status SharedRiver::create(const DeviceTable& table, const VkAllocationCallbacks
   SIVIFLOW_TRY(river->flow.create(std::move(input), flow, std::move(obstacles)));
   river->scene_obstacle_count = river->flow.obstacle_count();
   const RiverMesh& surface = river->flow.mesh();
-  river->index_count = static_cast<uint32_t>(surface.indices.size());
+  river->cut_into_chunks();
   StaticAssets& assets = river->assets;
   assets.add_buffer({"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                      bytes_of(surface.positions)});
@@ -63,6 +65,22 @@ Status SharedRiver::create(const DeviceTable& table, const VkAllocationCallbacks
 
 SharedRiver::~SharedRiver() {
   if (gpu.table != nullptr) assets.destroy(gpu);
+}
+
+void SharedRiver::cut_into_chunks() {
+  const RiverMesh& surface = flow.mesh();
+  const auto count = static_cast<uint32_t>(surface.indices.size());
+  for (uint32_t first = 0; first < count; first += 3 * kChunkTriangles) {
+    Chunk chunk;
+    chunk.indices = {first, std::min(3 * kChunkTriangles, count - first)};
+    chunk.lo = glm::vec3(std::numeric_limits<float>::max());
+    chunk.hi = glm::vec3(std::numeric_limits<float>::lowest());
+    for (uint32_t i = first; i < first + chunk.indices.index_count; ++i) {
+      chunk.lo = glm::min(chunk.lo, surface.positions[surface.indices[i]]);
+      chunk.hi = glm::max(chunk.hi, surface.positions[surface.indices[i]]);
+    }
+    chunks.push_back(chunk);
+  }
 }
 
 // The water height under every tile centre the water material may read (shaders/shared.h),

@@ -12,6 +12,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "index_range.h"
 #include "river_simulation.h"
 #include "siviflow/renderer.h"
 #include "static_assets.h"
@@ -38,7 +39,14 @@ struct SharedRiver {
   GpuContext gpu;  // points at `table`
   RiverFlow flow;
   StaticAssets assets;
-  uint32_t index_count = 0;     // of the surface's triangles
+  // The surface's triangles in runs of consecutive ones (neighbours along the river), each with
+  // its bounds in river space: a view draws the runs it can see.
+  struct Chunk {
+    IndexRange indices;
+    glm::vec3 lo{0.0f};
+    glm::vec3 hi{0.0f};
+  };
+  std::vector<Chunk> chunks;
   glm::vec3 surface_min{0.0f};  // bounds of the surface, river space
   glm::vec3 surface_max{0.0f};
   glm::vec2 water_lo{0.0f};     // XZ bounds of the surface
@@ -57,6 +65,7 @@ struct SharedRiver {
 
  private:
   void add_water_heights();
+  void cut_into_chunks();
 };
 
 }  // namespace siviflow

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <memory>
 
+#include "renderer_inspect.h"
 #include "siviflow/host_frame.h"
 #include "siviflow/renderer.h"
 #include "siviflow/scene_river.h"
@@ -82,7 +83,6 @@ Status run_bench_once(HeadlessContext& context, const BenchOptions& options,
     SIVIFLOW_TRY(create_temporal_targets(context, info.motion_format, info.reactive_format,
                                          extent, &second_targets));
   }
-  out->water_triangles = static_cast<uint32_t>(water.indices.size() / 3);
 
   std::vector<PassTime> times;
   std::vector<PassTime> world_times;
@@ -147,6 +147,7 @@ Status run_bench_once(HeadlessContext& context, const BenchOptions& options,
   const WorldDrawStats drawn = world->draw_stats();
   out->world_triangles = drawn.main_triangles;
   out->reflection_world_triangles = drawn.reflection_triangles;
+  out->water_triangles = drawn_water_triangles(*renderer);
   return Status::success();
 }
 

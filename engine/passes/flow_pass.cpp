@@ -225,7 +225,7 @@ void FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
   gpu.table->vkUpdateDescriptorSets(gpu.table->device, 1, &w, 0, nullptr);
 }
 
-void FlowPass::declare(FrameGraph& graph, uint32_t index_count, Handles* handles) {
+void FlowPass::declare(FrameGraph& graph, Handles* handles) {
   PassBuilder pass = graph.add_pass("flow", PassKind::Graphics);
   handles->color = pass.color_write(handles->color, LoadOp::Load);
   // In the material's output order (flow_material.glsl): motion, reactive, then the AOVs.
@@ -252,23 +252,23 @@ void FlowPass::declare(FrameGraph& graph, uint32_t index_count, Handles* handles
   pass.vertex_read(handles->vertices);
   pass.index_read(handles->indices);
   const Handles h = *handles;
-  pass.record([this, h, index_count](const PassContext& ctx) {
+  pass.record([this, h](const PassContext& ctx) {
     const Frame& frame = ctx.data(frame_data_);
     const VkPipeline pipeline = pipelines_[static_cast<uint32_t>(frame.material)]
                                           [frame.debug_view != DebugView::kNone ? 1 : 0];
-    draw_river(ctx, pipeline, h, index_count);
+    draw_river(ctx, pipeline, h);
     return Status::success();
   });
 }
 
-void FlowPass::declare_depth(FrameGraph& graph, uint32_t index_count, Handles* handles) {
+void FlowPass::declare_depth(FrameGraph& graph, Handles* handles) {
   PassBuilder pass = graph.add_pass("water depth", PassKind::Graphics);
   handles->depth = pass.depth_write(handles->depth, LoadOp::Load);
   pass.vertex_read(handles->vertices);
   pass.index_read(handles->indices);
   const Handles h = *handles;
-  pass.record([this, h, index_count](const PassContext& ctx) {
-    draw_river(ctx, depth_pipeline_, h, index_count);
+  pass.record([this, h](const PassContext& ctx) {
+    draw_river(ctx, depth_pipeline_, h);
     return Status::success();
   });
 }
@@ -297,8 +297,7 @@ void FlowPass::declare_tiles(FrameGraph& graph, Handles* handles) {
   });
 }
 
-void FlowPass::declare_floor(FrameGraph& graph, uint32_t index_count, const Handles& inputs,
-                             ImageHandle target) {
+void FlowPass::declare_floor(FrameGraph& graph, const Handles& inputs, ImageHandle target) {
   PassBuilder pass = graph.add_pass("flow floor", PassKind::Graphics);
   pass.color_write(target, LoadOp::DontCare);  // its new version: nothing reads it
   pass.depth_read(inputs.depth);
@@ -313,14 +312,13 @@ void FlowPass::declare_floor(FrameGraph& graph, uint32_t index_count, const Hand
   pass.index_read(inputs.indices);
   pass.side_effect();
   const Handles h = inputs;
-  pass.record([this, h, index_count](const PassContext& ctx) {
-    draw_river(ctx, floor_pipeline_, h, index_count);
+  pass.record([this, h](const PassContext& ctx) {
+    draw_river(ctx, floor_pipeline_, h);
     return Status::success();
   });
 }
 
-void FlowPass::draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h,
-                          uint32_t index_count) const {
+void FlowPass::draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h) const {
   const DeviceTable& vk = ctx.table();
   const VkCommandBuffer cmd = ctx.cmd();
   const Frame& frame = ctx.data(frame_data_);
@@ -339,7 +337,9 @@ void FlowPass::draw_river(const PassContext& ctx, VkPipeline pipeline, const Han
   const VkDeviceSize offset = 0;
   vk.vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
   vk.vkCmdBindIndexBuffer(cmd, ctx.buffer(h.indices), 0, VK_INDEX_TYPE_UINT32);
-  vk.vkCmdDrawIndexed(cmd, index_count, 1, 0, 0, 0);
+  for (const IndexRange& run : *frame.draws) {
+    vk.vkCmdDrawIndexed(cmd, run.index_count, 1, run.first_index, 0, 0);
+  }
 }
 
 }  // namespace siviflow

@@ -8,6 +8,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include "index_range.h"
 #include "shared.h"
 #include "siviflow/renderer.h"
 #include "siviflow/status.h"
@@ -131,6 +132,8 @@ class FlowPass {
     DebugView debug_view = DebugView::kNone;
     gpu::FlowConstants flow{};
     gpu::FlowTileConstants tiles{};
+    // The runs of the river's indices the view can see: the water, depth and floor draw them.
+    const std::vector<IndexRange>* draws = nullptr;
   };
   // Before recording a frame: points the slot's descriptor set at the frame's host depth and
   // writes its look block.
@@ -160,19 +163,17 @@ class FlowPass {
   // The tile table of this frame (shaders/flow_tiles.comp), before declare; the new version of
   // handles->tile_table goes back into `handles`.
   void declare_tiles(FrameGraph& graph, Handles* handles);
-  void declare(FrameGraph& graph, uint32_t index_count, Handles* handles);
+  void declare(FrameGraph& graph, Handles* handles);
   // After declare: the surface's depth into the host's depth where the water is in front (the
   // new version of handles->depth goes back into `handles`).
-  void declare_depth(FrameGraph& graph, uint32_t index_count, Handles* handles);
+  void declare_depth(FrameGraph& graph, Handles* handles);
   // The floor of the flow pass for benchmarks: the same pixels (river mesh, depth test) making
   // the same texture reads with next to no arithmetic, blended into `target` (of the colour
   // format); kept although nothing reads it.
-  void declare_floor(FrameGraph& graph, uint32_t index_count, const Handles& inputs,
-                     ImageHandle target);
+  void declare_floor(FrameGraph& graph, const Handles& inputs, ImageHandle target);
 
  private:
-  void draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h,
-                  uint32_t index_count) const;
+  void draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h) const;
 
   Config config_;
   DataHandle<Frame> frame_data_;  // declared by declare_tiles, in the graph of the passes

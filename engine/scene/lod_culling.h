@@ -10,12 +10,9 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
-namespace siviflow {
+#include "index_range.h"
 
-struct IndexRange {
-  uint32_t first_index = 0;
-  uint32_t index_count = 0;
-};
+namespace siviflow {
 
 // A static piece of the world: a terrain chunk with its levels of detail, or an object.
 struct LodPiece {
@@ -42,8 +39,7 @@ constexpr uint32_t kCulled = ~uint32_t{0};
 // The level `piece` is drawn at in `view`, or kCulled.
 uint32_t choose_level(const LodPiece& piece, const CullView& view);
 
-// Whether the box lies wholly outside the view's frustum (its far plane aside) or wholly below
-// its clip plane.
+// Whether the box lies wholly outside the view's frustum or wholly below its clip plane.
 bool culled(const glm::vec3& lo, const glm::vec3& hi, const CullView& view);
 
 // The focal length in pixels of a perspective projection shown `viewport_height` pixels high.

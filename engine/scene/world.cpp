@@ -38,8 +38,8 @@ constexpr VkFormat kBaseColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
 
 // The most a terrain level's height error may look, in pixels: the reflection, rippled and
 // faded by Fresnel, takes coarser ground than the main view.
-constexpr float kMainErrorPixels = 3.0f;
-constexpr float kReflectionErrorPixels = 6.0f;
+constexpr float kMainErrorPixels = 1.0f;
+constexpr float kReflectionErrorPixels = 2.0f;
 
 constexpr std::string_view kWorldErrorPrefix = "siviflow::World: ";
 

@@ -1,6 +1,6 @@
 // The built-in world's culling and levels of detail: a chunk further away never draws more
-// triangles, a chunk behind the camera, beside the frustum or below the reflection's clip plane
-// is not drawn, and a chunked grid's levels join ever fewer points with skirts at their edges.
+// triangles, a chunk behind the camera, beside the frustum, beyond its far plane or below the
+// reflection's clip plane is not drawn, and a chunked grid's levels join ever fewer points with skirts at their edges.
 #include <algorithm>
 #include <cmath>
 
@@ -14,9 +14,10 @@ namespace siviflow {
 namespace {
 
 constexpr float kHeight = 720.0f;
+constexpr float kFar = 10000.0f;
 
 glm::mat4 projection() {
-  glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(55.0f), 16.0f / 9.0f, 0.1f, 600.0f);
+  glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(55.0f), 16.0f / 9.0f, 0.1f, kFar);
   p[1][1] *= -1.0f;  // Vulkan's +Y down
   return p;
 }
@@ -96,8 +97,24 @@ TEST(LodCulling, AChunkBehindTheCameraOrBesideTheViewIsNotDrawn) {
   beside.lo.x += 300.0f;
   beside.hi.x += 300.0f;
   EXPECT_EQ(choose_level(beside, view), kCulled) << "far to the side";
+  EXPECT_EQ(choose_level(chunk_at(kFar + 10.0f), view), kCulled) << "beyond the far plane";
   // One the camera stands in is seen whatever it looks at.
   EXPECT_NE(choose_level(chunk_at(-12.0f), view_from({12.0f, 0.0f, 0.0f})), kCulled);
+}
+
+TEST(LodCulling, AnInfiniteReverseDepthViewCullsOnlyWhatIsOutside) {
+  const float f = 1.0f / std::tan(glm::radians(27.5f));
+  glm::mat4 reverse(0.0f);  // near maps to 1, infinity to 0
+  reverse[0][0] = f / (16.0f / 9.0f);
+  reverse[1][1] = -f;
+  reverse[2][3] = -1.0f;
+  reverse[3][2] = 0.1f;
+  const glm::vec3 eye(12.0f, 5.0f, 0.0f);
+  CullView view = view_from(eye);
+  view.view_proj = reverse * glm::lookAtRH(eye, eye + glm::vec3(0, 0, 1), glm::vec3(0, 1, 0));
+  EXPECT_NE(choose_level(chunk_at(10.0f), view), kCulled);
+  EXPECT_NE(choose_level(chunk_at(50000.0f), view), kCulled) << "no far plane";
+  EXPECT_EQ(choose_level(chunk_at(-40.0f), view), kCulled) << "behind";
 }
 
 TEST(LodCulling, AChunkBelowTheReflectionsClipPlaneIsNotDrawn) {
