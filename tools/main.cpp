@@ -26,7 +26,7 @@ void print_usage() {
 // thread; with glibc's default trim threshold every free hands them back to the kernel
 // (madvise) and the next frame faults them in again (about 3300 page faults a frame at 720p).
 // This process keeps them: the library itself never changes its host's allocator (README,
-// "Frame cost on lavapipe").
+// "Frame cost").
 constexpr int kKeptFreeBytes = 256 << 20;
 
 }  // namespace
