@@ -6,11 +6,13 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "entry_guard.h"
+#include "gpu_timer.h"
 #include "scene/scene_pass.h"
 #include "scene/default_scene.h"
 #include "scene/detail_texture.h"
@@ -18,7 +20,6 @@
 #include "siviflow/scene_river.h"
 #include "static_assets.h"
 #include "view_math.h"
-#include "gpu_timer.h"
 #include "vk/device_table.h"
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
@@ -96,6 +97,7 @@ struct World::Impl {
   // constants (translated to where the obstacle is). Per view: main, then mirrored.
   std::vector<SceneDraw> main_draws;
   std::vector<SceneDraw> reflection_draws;
+  std::vector<std::pair<float, SceneDraw>> sorted_pieces;  // kept: a steady frame allocates nothing
   gpu::SceneConstants main_constants{};
   gpu::SceneConstants reflection_constants{};
   std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main, then mirrored
@@ -264,7 +266,8 @@ gpu::SceneConstants World::Impl::view_constants(const glm::mat4& view_proj,
 // frame's time; `which` 0 main view, 1 mirrored.
 void World::Impl::select_draws(const CullView& view, const gpu::SceneConstants& constants,
                                size_t which, std::vector<SceneDraw>* draws, uint32_t* triangles) {
-  std::vector<std::pair<float, SceneDraw>> seen;
+  std::vector<std::pair<float, SceneDraw>>& seen = sorted_pieces;
+  seen.clear();
   for (const LodPiece& piece : pieces) {
     const uint32_t level = choose_level(piece, view);
     if (level == kCulled) continue;
