@@ -17,18 +17,27 @@ constexpr float kSlopeStep = 0.5f;         // metres: finite-difference step of 
 
 }  // namespace
 
-Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
-  RiverInput input;
-  SIVIFLOW_TRY(river.generate_mesh(&input.mesh));
-  const RiverMesh& mesh = input.mesh;
-  SIVIFLOW_TRY(RiverSurface::build(mesh.positions, mesh.indices, RiverSurfaceOptions{}, &input.surface));
-  input.slope.resize(mesh.positions.size());
-  for (size_t v = 0; v < mesh.positions.size(); ++v) {
-    const glm::vec3& p = mesh.positions[v];
+Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh,
+                             std::vector<float>* slope) {
+  RiverMesh generated;
+  SIVIFLOW_TRY(river.generate_mesh(&generated));
+  std::vector<float> slopes(generated.positions.size());
+  for (size_t v = 0; v < generated.positions.size(); ++v) {
+    const glm::vec3& p = generated.positions[v];
     const float dx = river.terrain_height(p.x + kSlopeStep, p.z) - river.terrain_height(p.x - kSlopeStep, p.z);
     const float dz = river.terrain_height(p.x, p.z + kSlopeStep) - river.terrain_height(p.x, p.z - kSlopeStep);
-    input.slope[v] = std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
+    slopes[v] = std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
   }
+  *mesh = std::move(generated);
+  *slope = std::move(slopes);
+  return Status::success();
+}
+
+Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
+  RiverInput input;
+  SIVIFLOW_TRY(procedural_river_mesh(river, &input.mesh, &input.slope));
+  SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, RiverSurfaceOptions{},
+                                   &input.surface));
   *out = std::move(input);
   return Status::success();
 }

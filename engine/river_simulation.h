@@ -34,7 +34,10 @@ struct RiverInput {
   RiverSurface surface;
 };
 
-// The procedural river, with the slope of the terrain under each vertex.
+// The procedural river's mesh, with the slope of the terrain under each vertex.
+Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh,
+                             std::vector<float>* slope);
+// procedural_river_mesh with its surface built.
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
 // A host's river (CreateInfo::river): its arrays checked (sizes, finite, non-negative depth and
 // slope) and copied, its surface built. Errors name the field and the vertex.

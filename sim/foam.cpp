@@ -60,24 +60,38 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   const size_t count = positions.size();
   const size_t corners = indices.empty() ? count : indices.size();
   const auto corner = [&](size_t i) { return indices.empty() ? uint32_t(i) : indices[i]; };
-  // One-ring neighbours through the triangles, each listed once.
-  std::vector<std::vector<uint32_t>> rings(count);
+  // One-ring neighbours through the triangles, each listed once: counted, filled, then sorted
+  // and deduplicated in place (a vector per vertex cost a million allocations on a long river).
+  std::vector<uint32_t> fill(count + 1, 0);
+  for (size_t i = 0; i < corners; ++i) {
+    if (corner(i) >= count) return Status::error("FoamField: index out of range");
+    fill[corner(i) + 1] += 2;
+  }
+  for (size_t v = 0; v < count; ++v) fill[v + 1] += fill[v];
+  std::vector<uint32_t> neighbours(fill.back());
   for (size_t t = 0; t + 2 < corners; t += 3) {
     const uint32_t v[3] = {corner(t), corner(t + 1), corner(t + 2)};
     for (int i = 0; i < 3; ++i) {
-      if (v[i] >= count) return Status::error("FoamField: index out of range");
-      rings[v[i]].push_back(v[(i + 1) % 3]);
-      rings[v[i]].push_back(v[(i + 2) % 3]);
+      neighbours[fill[v[i]]++] = v[(i + 1) % 3];
+      neighbours[fill[v[i]]++] = v[(i + 2) % 3];
     }
   }
   field.ring_start_.reserve(count + 1);
-  for (std::vector<uint32_t>& ring : rings) {
-    std::sort(ring.begin(), ring.end());
-    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
-    field.ring_start_.push_back(static_cast<uint32_t>(field.ring_.size()));
-    field.ring_.insert(field.ring_.end(), ring.begin(), ring.end());
+  uint32_t begin = 0;
+  uint32_t kept = 0;
+  for (size_t v = 0; v < count; ++v) {
+    const auto first = neighbours.begin() + begin;
+    const auto last = neighbours.begin() + fill[v];
+    std::sort(first, last);
+    field.ring_start_.push_back(kept);
+    kept = static_cast<uint32_t>(
+        std::copy(first, std::unique(first, last), neighbours.begin() + kept) - neighbours.begin());
+    begin = fill[v];
   }
-  field.ring_start_.push_back(static_cast<uint32_t>(field.ring_.size()));
+  field.ring_start_.push_back(kept);
+  neighbours.resize(kept);
+  neighbours.shrink_to_fit();
+  field.ring_ = std::move(neighbours);
   field.upstream_vertex_.assign(count * 3, 0);
   field.upstream_weight_.assign(count * 3, 0.0f);
   field.source_.assign(count, 0.0f);

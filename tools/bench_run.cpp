@@ -84,6 +84,10 @@ Status run_bench_once(HeadlessContext& context, const BenchOptions& options,
                                          extent, &second_targets));
   }
 
+  // The renderers copied the river: a host frees its arrays after create, and so does this one.
+  info.river = nullptr;
+  river = SceneRiverData{};
+
   std::vector<PassTime> times;
   std::vector<PassTime> world_times;
   for (uint32_t frame = 0; frame < options.warmup + options.frames; ++frame) {

@@ -236,7 +236,7 @@ Status gltf_river_data(TriangleMesh gltf, SceneRiverData* out) {
 
 }  // namespace
 
-Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverData* out) {
+Status scene_river_shape(const SceneFile* scene, size_t river_index, SceneRiverData* out) {
   const size_t rivers = scene == nullptr ? 1 : scene->rivers.size();
   if (river_index >= rivers) {
     return Status::error((scene == nullptr ? std::string("the default scene") : scene->path) +
@@ -244,10 +244,8 @@ Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverDa
                          std::to_string(rivers) + ")");
   }
   SceneRiverData data;
-  std::vector<Obstacle> obstacles;
   if (scene == nullptr) {
     data.procedural.emplace(default_river_params());
-    obstacles = default_scene_obstacles(*data.procedural);
   } else {
     const SceneRiver& river = scene->rivers[river_index];
     data.flow = {river.flow.discharge, river.flow.p, river.flow.search_radius};
@@ -262,14 +260,21 @@ Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverDa
       data.procedural.emplace(river.procedural);
     }
   }
+  *out = std::move(data);
+  return Status::success();
+}
+
+Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverData* out) {
+  SceneRiverData data;
+  SIVIFLOW_TRY(scene_river_shape(scene, river_index, &data));
   if (data.procedural) {
-    RiverInput input;
-    const Status status = procedural_river_input(*data.procedural, &input);
+    const Status status = procedural_river_mesh(*data.procedural, &data.mesh, &data.slope);
     if (!status.ok()) return scene == nullptr ? status : in_scene(*scene, status);
-    data.mesh = std::move(input.mesh);
-    data.slope = std::move(input.slope);
   }
-  if (scene != nullptr) {
+  std::vector<Obstacle> obstacles;
+  if (scene == nullptr) {
+    obstacles = default_scene_obstacles(*data.procedural);
+  } else {
     obstacles = scene->obstacles;
     std::vector<Obstacle> from_objects;
     SIVIFLOW_TRY(scene_object_obstacles(*scene, data.mesh.positions, &from_objects));

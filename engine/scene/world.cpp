@@ -129,7 +129,7 @@ struct World::Impl {
 
 Status World::Impl::load_scene() {
   SceneRiverData first;
-  SIVIFLOW_TRY(scene_river_data(info.scene, 0, &first));
+  SIVIFLOW_TRY(scene_river_shape(info.scene, 0, &first));
   river_from_file = !first.procedural.has_value();
   if (first.procedural) river = *first.procedural;
   river_mesh = std::move(first.mesh);
@@ -137,7 +137,7 @@ Status World::Impl::load_scene() {
   const size_t rivers = info.scene != nullptr ? info.scene->rivers.size() : 1;
   for (size_t i = 1; i < rivers; ++i) {
     SceneRiverData other;
-    SIVIFLOW_TRY(scene_river_data(info.scene, i, &other));
+    SIVIFLOW_TRY(scene_river_shape(info.scene, i, &other));
     SceneGeometry geometry;
     if (other.procedural) {
       geometry = build_scene_geometry(*other.procedural, {});

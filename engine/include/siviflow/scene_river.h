@@ -39,6 +39,10 @@ struct SceneRiverData {
 // boulders): a procedural river with its terrain's slope, a glTF river with the depth profile
 // above. Errors name the scene file (and the glTF file), or the index the scene lacks.
 Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverData* out);
+// River `river_index` as the scene gives it, nothing generated: a procedural river's generator
+// (its mesh and slope left empty: a 100 km river has a million vertices) or a glTF river's mesh,
+// depth and slope; no obstacles. What the built-in world draws the valley or bed from.
+Status scene_river_shape(const SceneFile* scene, size_t river_index, SceneRiverData* out);
 
 struct SceneRiverFlow {
   std::vector<glm::vec3> positions;  // the river primitive's vertices, in the file's accessor order
