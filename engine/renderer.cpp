@@ -435,7 +435,6 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
 // follows what is on screen, not its length.
 void Renderer::Impl::choose_water_draws() {
   water_draws.clear();
-  water_triangles = 0;
   for (const SharedRiver::Chunk& chunk : river->chunks) {
     if (box_outside_view(chunk.lo, chunk.hi, view.view_proj)) continue;
     if (!water_draws.empty() && water_draws.back().first_index + water_draws.back().index_count ==
@@ -444,9 +443,7 @@ void Renderer::Impl::choose_water_draws() {
     } else {
       water_draws.push_back(chunk.indices);
     }
-    water_triangles += chunk.indices.index_count / 3;
   }
-  water_frame.draws = &water_draws;
 }
 
 // The plane of the visible reach: the median height of this frame's live particles. They are
@@ -654,7 +651,9 @@ const RiverFlowField& RendererInspector::flow_field(const Renderer& renderer) {
   return renderer.impl_->river->flow.field();
 }
 uint32_t RendererInspector::drawn_water_triangles(const Renderer& renderer) {
-  return renderer.impl_->water_triangles;
+  uint32_t indices = 0;
+  for (const IndexRange& run : renderer.impl_->water_draws) indices += run.index_count;
+  return indices / 3;
 }
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 uint64_t Renderer::flow_solves() const { return impl_->river->flow.full_solves(); }

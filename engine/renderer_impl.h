@@ -63,7 +63,6 @@ struct Renderer::Impl {
   FrameBindings bindings;
   FlowPass::Frame water_frame;  // of the frame being prepared: push constants, look, host depth
   std::vector<IndexRange> water_draws;  // the surface's runs the frame's view sees, joined
-  uint32_t water_triangles = 0;         // in them
   // Where the graph's passes read this frame's upload list, readback copies, reflection view and
   // the viewport's offset in the host's images (the refraction copy's source).
   DataHandle<UploadList> uploads_data;

@@ -9,12 +9,11 @@
 
 namespace siviflow {
 
-bool culled(const glm::vec3& lo, const glm::vec3& hi, const CullView& view) {
-  return box_outside_view(lo, hi, view.view_proj, view.clip_plane);
-}
-
 uint32_t choose_level(const LodPiece& piece, const CullView& view) {
-  if (piece.levels.empty() || culled(piece.lo, piece.hi, view)) return kCulled;
+  if (piece.levels.empty() ||
+      box_outside_view(piece.lo, piece.hi, view.view_proj, view.clip_plane)) {
+    return kCulled;
+  }
   // The nearest point of the box sets the smallest error the chunk needs.
   const glm::vec3 nearest = glm::clamp(view.camera, piece.lo, piece.hi);
   const float distance = glm::length(nearest - view.camera);

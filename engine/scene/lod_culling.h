@@ -39,9 +39,6 @@ constexpr uint32_t kCulled = ~uint32_t{0};
 // The level `piece` is drawn at in `view`, or kCulled.
 uint32_t choose_level(const LodPiece& piece, const CullView& view);
 
-// Whether the box lies wholly outside the view's frustum or wholly below its clip plane.
-bool culled(const glm::vec3& lo, const glm::vec3& hi, const CullView& view);
-
 // The focal length in pixels of a perspective projection shown `viewport_height` pixels high.
 float focal_pixels(const glm::mat4& projection, float viewport_height);
 

@@ -102,7 +102,7 @@ struct World::Impl {
   gpu::SceneConstants reflection_constants{};
   std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main, then mirrored
   double time = 0.0;  // of the last record(), for the reflection
-  float tan_scale = 1.0f;  // |projection[1][1]| of the last record()'s view, for the reflection
+  glm::mat4 projection{1.0f};  // of the last record()'s view: the reflection's levels use it too
   WorldDrawStats stats;
   GpuTimer timer;  // with WorldCreateInfo::enable_timing
   uint32_t slot = 0;  // of the last begin_frame()
@@ -446,8 +446,8 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
   CullView cull;
   cull.view_proj = math.view_proj;
   cull.camera = math.camera_position;
-  w.tan_scale = std::abs(view.projection[1][1]);
-  cull.focal_pixels = 0.5f * w.tan_scale * float(w.frame.viewport.extent.height);
+  w.projection = view.projection;
+  cull.focal_pixels = focal_pixels(view.projection, float(w.frame.viewport.extent.height));
   cull.max_error_pixels = kMainErrorPixels;
   w.select_draws(cull, w.main_constants, 0, &w.main_draws, &w.stats.main_triangles);
 
@@ -502,7 +502,7 @@ void World::draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, voi
   cull.view_proj = view_proj;
   cull.camera = camera;
   cull.clip_plane = clip_plane;
-  cull.focal_pixels = 0.5f * w.tan_scale * float(view.extent.height);
+  cull.focal_pixels = focal_pixels(w.projection, float(view.extent.height));
   cull.max_error_pixels = kReflectionErrorPixels;
   w.select_draws(cull, w.reflection_constants, 1, &w.reflection_draws,
                  &w.stats.reflection_triangles);
