@@ -25,6 +25,7 @@
 #include <glm/matrix.hpp>
 #include <tiny_gltf.h>
 
+#include "siviflow/sha256.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
@@ -221,6 +222,7 @@ struct LoadContext {
   size_t external_bytes = 0;
   std::vector<std::string> notes;  // why a file was refused, appended to error messages
   const tinygltf::Model* model = nullptr;
+  Sha256* content = nullptr;  // what hash_gltf_content adds every file read to, when asked
 
   void note(std::string why) {
     if (notes.size() < kMaxRefusalNotes &&
@@ -229,6 +231,15 @@ struct LoadContext {
     }
   }
 };
+
+// One file of a load into `content`: its length first, so that no two lists of files hash alike.
+template <typename Container>
+void hash_file(const Container& bytes, Sha256* content) {
+  uint8_t length[8];
+  for (int i = 0; i < 8; ++i) length[i] = static_cast<uint8_t>(uint64_t{bytes.size()} >> (8 * i));
+  content->update(length, sizeof length);
+  content->update(bytes.data(), bytes.size());
+}
 
 // Whether tinygltf may open `joined` (its base_dir + "/" + uri); `real` receives the realpath.
 bool allowed_path(LoadContext* ctx, const std::string& joined, std::string* real) {
@@ -293,6 +304,7 @@ bool fs_read_whole_file(std::vector<unsigned char>* out, std::string* err, const
     return false;
   }
   ctx->external_bytes += out->size();
+  if (ctx->content != nullptr) hash_file(*out, ctx->content);
   return true;
 }
 
@@ -356,12 +368,14 @@ std::string with_notes(std::string message, const std::vector<std::string>& note
   return message;
 }
 
-// Reads, pre-checks and parses `path`; `notes` receives why external files were refused.
+// Reads, pre-checks and parses `path`; `notes` receives why external files were refused, and
+// `content` (when given) every file read (hash_gltf_content).
 Status load_model(const std::string& path, tinygltf::Model* model,
-                  std::vector<std::string>* notes) {
+                  std::vector<std::string>* notes, Sha256* content = nullptr) {
   std::string bytes;
   SIVIFLOW_TRY(read_file_bytes(path, kMaxGltfFileBytes, /*no_follow=*/false, &bytes));
   if (bytes.empty()) return fail(path, "the file is empty");
+  if (content != nullptr) hash_file(bytes, content);
   const bool glb =
       (bytes.size() >= 4 && read_le32(bytes.data()) == kGlbMagic) || ends_with_ci(path, ".glb");
   std::string_view json = bytes;
@@ -380,6 +394,7 @@ Status load_model(const std::string& path, tinygltf::Model* model,
   if (ctx.base_dir.empty()) return fail(path, "cannot resolve the folder of the file");
   ctx.base_prefix = ctx.base_dir.back() == '/' ? ctx.base_dir : ctx.base_dir + "/";
   ctx.model = model;
+  ctx.content = content;
 
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks(tinygltf::FsCallbacks{&fs_file_exists, &fs_expand_file_path,
@@ -1070,6 +1085,12 @@ Status load_river_mesh(const std::string& path, const std::string& mesh_name, Tr
   result.node_index = node;
   *out = std::move(result);
   return Status::success();
+}
+
+Status hash_gltf_content(const std::string& path, Sha256* content) {
+  tinygltf::Model model;
+  std::vector<std::string> notes;
+  return load_model(path, &model, &notes, content);
 }
 
 Status load_gltf_object(const std::string& path, GltfObject* out) {

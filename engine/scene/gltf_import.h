@@ -24,6 +24,8 @@
 
 namespace siviflow {
 
+class Sha256;
+
 // --- Limits: every cap of the importer, in one place ------------------------------------------
 // The .gltf/.glb file itself (tinygltf takes a 32-bit length; the JSON DOM costs ~10x the text).
 inline constexpr size_t kMaxGltfFileBytes = size_t{256} << 20;
@@ -96,6 +98,12 @@ Status load_river_mesh(const std::string& path, const std::string& mesh_name, Tr
 // (else TEXCOORD_0 when present), the base-colour factor and the base-colour image kept encoded.
 // Fails when nothing drawable is left. `out` is left untouched on failure.
 Status load_gltf_object(const std::string& path, GltfObject* out);
+
+// Adds to `content` every byte that loading `path` reads, each file as its length (8 bytes,
+// little-endian) then its bytes: the file, then each external buffer and image in the order the
+// loader reads them (embedded data is in the file). What a capture records its scene's content by.
+// Fails where a load would fail to read or parse the file.
+Status hash_gltf_content(const std::string& path, Sha256* content);
 
 // Reads the width and height from a PNG or JPEG header without decoding; `what` names the image
 // in the message. Fails on any other format or a truncated header.

@@ -14,6 +14,7 @@
 #include "default_river.h"
 #include "scene/gltf_import.h"
 #include "scene/look_fields.h"
+#include "siviflow/sha256.h"
 #include "siviflow/sim/river_tuning.h"
 #include "siviflow/text_format.h"
 
@@ -641,7 +642,9 @@ Status parse_scene_file(std::string_view text, const std::string& file, const st
     } catch (const Json::exception& e) {  // syntax, and numbers like 1e400 that overflow a double
       return Status::error(file + ": not valid JSON: " + e.what());
     }
-    return parse_root(reader, root, file, folder, out);
+    SIVIFLOW_TRY(parse_root(reader, root, file, folder, out));
+    out->text_sha256 = sha256_hex(text);
+    return Status::success();
   } catch (const ParseAbort& e) {
     return Status::error(file + ": " + e.message);
   } catch (const std::bad_alloc&) {

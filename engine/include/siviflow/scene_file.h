@@ -120,6 +120,7 @@ struct SceneRender {
 
 struct SceneFile {
   std::string path;    // the file as given
+  std::string text_sha256;  // SHA-256 (hex) of the text it was parsed from: what captures record
   std::string folder;  // absolute folder that relative paths were resolved against
   std::vector<SceneRiver> rivers{1};  // at least one; each with its own flow
   std::vector<Obstacle> obstacles;  // in every river they touch  // circles (radius > 0) or polygons, keys optional
