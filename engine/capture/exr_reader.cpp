@@ -181,6 +181,16 @@ void read_attributes(const Imf::Header& header, ExrImage* image) {
   if (auto f = image->float_attributes.find(kExrAttrTime); f != image->float_attributes.end()) {
     image->metadata.time_seconds = f->second;
   }
+  if (auto s = image->string_attributes.find(kExrAttrSceneDigest);
+      s != image->string_attributes.end()) {
+    image->metadata.scene_digest = s->second;
+  }
+  if (auto f = image->float_attributes.find(kExrAttrFps); f != image->float_attributes.end()) {
+    image->metadata.fps = f->second;
+  }
+  if (auto s = image->string_attributes.find(kExrAttrAovs); s != image->string_attributes.end()) {
+    image->metadata.aovs = s->second;
+  }
 }
 
 Status read_exr_impl(const std::string& path, ExrImage* out) {

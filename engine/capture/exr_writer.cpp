@@ -129,6 +129,9 @@ Imf::Header part_header(const ExrFrame& frame, ExrCompression compression,
   header.insert(kExrAttrTime, Imf::FloatAttribute(frame.metadata.time_seconds));
   header.insert(kExrAttrSeed, Imf::IntAttribute(frame.metadata.seed));
   header.insert(kExrAttrSoftware, Imf::StringAttribute(frame.metadata.software_version));
+  header.insert(kExrAttrSceneDigest, Imf::StringAttribute(frame.metadata.scene_digest));
+  header.insert(kExrAttrFps, Imf::FloatAttribute(frame.metadata.fps));
+  header.insert(kExrAttrAovs, Imf::StringAttribute(frame.metadata.aovs));
   return header;
 }
 

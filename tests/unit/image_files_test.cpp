@@ -8,6 +8,7 @@
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfOutputPart.h>
+#include <ImfStringAttribute.h>
 #include <ImfTiledOutputPart.h>
 #include <ImfPartType.h>
 #include <ImfTiledOutputFile.h>
@@ -102,6 +103,9 @@ struct TestFrame {
     f.metadata.time_seconds = 1.75f;
     f.metadata.seed = -7;
     f.metadata.software_version = "siviflow 0.1.0-test";
+    f.metadata.scene_digest = "sha256:00112233445566778899aabbccddeeff";
+    f.metadata.fps = 23.976f;
+    f.metadata.aovs = "depth,flow";
     return f;
   }
 };
@@ -194,6 +198,14 @@ TEST_F(ImageFilesExr, RoundTripKeepsPixelsChannelsAndMetadata) {
   EXPECT_EQ(image.string_attributes.at(kExrAttrScene), "straight_river");
   EXPECT_EQ(image.int_attributes.at(kExrAttrFrame), 42);
   EXPECT_EQ(image.float_attributes.at(kExrAttrTime), 1.75f);
+  // What made the frame.
+  EXPECT_EQ(image.metadata.scene_digest, "sha256:00112233445566778899aabbccddeeff");
+  EXPECT_EQ(image.metadata.fps, 23.976f);
+  EXPECT_EQ(image.metadata.aovs, "depth,flow");
+  EXPECT_EQ(image.string_attributes.at("siviflow/scene_digest"),
+            "sha256:00112233445566778899aabbccddeeff");
+  EXPECT_EQ(image.float_attributes.at("siviflow/fps"), 23.976f);
+  EXPECT_EQ(image.string_attributes.at("siviflow/aovs"), "depth,flow");
 
   const Status checked = check_exr_file(file);
   EXPECT_TRUE(checked.ok()) << checked.message();
@@ -223,6 +235,9 @@ TEST_F(ImageFilesExr, PartsHaveTheirLayersCompressionAndTopLeftWindow) {
     EXPECT_FALSE(Imf::hasChromaticities(header));  // sRGB primaries are the spec default
     // Every part carries the metadata, for tools that read one part.
     EXPECT_EQ(header.typedAttribute<Imf::IntAttribute>(kExrAttrFrame).value(), 42) << names[p];
+    EXPECT_EQ(header.typedAttribute<Imf::StringAttribute>(kExrAttrSceneDigest).value(),
+              "sha256:00112233445566778899aabbccddeeff")
+        << names[p];
   }
   EXPECT_EQ(input.header(0).channels().findChannel("G")->type, Imf::HALF);
   EXPECT_EQ(input.header(1).channels().findChannel("depth.Z")->type, Imf::FLOAT);

@@ -17,6 +17,12 @@ inline constexpr const char* kExrAttrFrame = "siviflow/frame";              // i
 inline constexpr const char* kExrAttrTime = "siviflow/time";                // float, seconds
 inline constexpr const char* kExrAttrSeed = "siviflow/seed";                // int
 inline constexpr const char* kExrAttrSoftware = "siviflow/software_version";  // string
+// What made the frame, beside the above: the scene's content ("sha256:<hex>",
+// scene_content_digest), the frame rate of its time and the AOVs asked for ("depth,flow"; "" for
+// the beauty alone). A frame without a digest is of the layout before them.
+inline constexpr const char* kExrAttrSceneDigest = "siviflow/scene_digest";  // string
+inline constexpr const char* kExrAttrFps = "siviflow/fps";                  // float, frames/s
+inline constexpr const char* kExrAttrAovs = "siviflow/aovs";                // string
 
 // One data channel: width * height floats, row-major, top-left origin; written as FLOAT.
 // Names follow the layer convention, e.g. "depth.Z", "flow.X", "water.mask".
@@ -43,6 +49,9 @@ struct ExrMetadata {
   float time_seconds = 0.0f;
   int seed = 0;
   std::string software_version;
+  std::string scene_digest;  // "" where the frame has none (the layout before it)
+  float fps = 0.0f;
+  std::string aovs;
 };
 
 // One frame to write. The caller keeps every pointed-to buffer alive during the call. The
