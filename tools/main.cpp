@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "siviflow/version.h"
 
 namespace {
 
@@ -19,6 +20,7 @@ void print_usage() {
       "  view      a live window: fly along the river, drag boulders, tune the water\n"
       "  verify    check a folder of captured frames: all present, complete and alike\n"
       "  info      print the Vulkan device, driver, required features and validation layer\n"
+      "  version   print the version, as captured frames record it (also --version)\n"
       "Run 'siviflow <command> --help' for the options of a command.\n");
 }
 
@@ -40,6 +42,13 @@ int main(int argc, char** argv) {
   const std::string_view command = argv[1];
   if (command == "--help" || command == "-h" || command == "help") {
     print_usage();
+    return siviflow::cli::kExitOk;
+  }
+  if (command == "--version" || command == "version") {
+    if (argc > 2) {
+      return siviflow::cli::fail(command, siviflow::cli::unexpected_argument(argv[2]).message());
+    }
+    std::printf("%s\n", siviflow::version_string());
     return siviflow::cli::kExitOk;
   }
   if (command == "capture") return siviflow::run_capture(argc, argv);
