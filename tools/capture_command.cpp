@@ -1,54 +1,44 @@
 // `siviflow capture`: the offline frame-capture host. It plays the part of an embedding engine
 // (own device, own command buffers and fences, own target images) and writes each frame to EXR.
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <exception>
 #include <memory>
-#include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
 
+#include "capture_check.h"
 #include "capture_options.h"
 #include "cli.h"
 #include "commands.h"
 #include "frame_writer.h"
 #include "renderer_inspect.h"
-#include "siviflow/frame_folder.h"
 #include "siviflow/headless_context.h"
 #include "siviflow/host_frame.h"
 #include "siviflow/renderer.h"
-#include "siviflow/scene_file.h"
-#include "siviflow/scene_river.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {
 
 constexpr const char* kCommand = "capture";
-constexpr uint32_t kFramesInFlight = 2;
-constexpr VkFormat kOutputFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
-constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
-// Lavapipe does not enforce its 2 GiB heap (reliability notes), so the capture enforces a budget
-// on what grows with the size: the renderers' views, and per frame in flight the host's colour
-// (RGBA16F) and depth (D32) and the readback buffers.
-constexpr uint64_t kHostBytesPerPixel = 8 + 4;
-constexpr uint64_t kMaxCaptureBytes = 2ull << 30;
-
 
 void print_help() {
   std::printf(
       "usage: siviflow capture [SCENE.json] [--frames N | --range A:B] [--size WxH] --out DIR\n"
       "                        [--seed S] [--fps F] [--aov LIST] [--preview] [--validation]\n"
-      "                        [--resume [--force]] [--dry-run]\n"
+      "                        [--resume] [--force] [--dry-run]\n"
       "  Renders the scene file (its render settings unless a flag says otherwise), or the\n"
-      "  built-in default scene, into DIR/frame_NNNNN.exr.\n"
+      "  built-in default scene, into DIR/frame_NNNNN.exr. Each frame records what made it: the\n"
+      "  scene's content (a SHA-256 of the scene file and every file it loads), fps, seed, size,\n"
+      "  AOVs and software version. Frames of this capture already in DIR are rendered again;\n"
+      "  a complete frame of another capture in the range, or the first one outside it, is\n"
+      "  refused with exit 1, naming it and the first difference, unless --force.\n"
       "  --frames N     frames 0..N-1 (same as --range 0:N; default 1)\n"
       "  --range A:B    frames A..B-1; a frame is the same whatever range it is rendered in\n"
       "  --size WxH     output size in pixels (default 1280x720)\n"
@@ -70,11 +60,13 @@ void print_help() {
       "  --preview      also write DIR/frame_NNNNN.png (sRGB, clamped)\n"
       "  --validation   run with the Khronos validation layer; any error fails the capture\n"
       "  --resume       render only the frames of the range that are missing or cannot be read\n"
-      "                 whole; complete ones are left untouched. A complete frame of another\n"
-      "                 capture (scene, seed, size, AOVs, software version) is refused, naming it\n"
-      "  --force        with --resume: re-render such frames instead\n"
-      "  --dry-run      check the options, the scene file and the output folder without a\n"
-      "                 device, print the frames it would render, and render nothing\n");
+      "                 whole; complete frames of this capture are left untouched\n"
+      "  --force        render over the frames of another capture in the range (and beside\n"
+      "                 those outside it) instead of refusing\n"
+      "  --dry-run      check all the capture would before it asks for a device (the options,\n"
+      "                 the scene file and every glTF file it names, its rivers and objects\n"
+      "                 loaded, the AOVs against its rivers, the memory budget, the output folder\n"
+      "                 and the frames in it), print the frames it would render, render nothing\n");
 }
 
 Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help) {
@@ -149,69 +141,10 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
     }
   }
   if (options->out_dir.empty()) return Status::error("--out DIR is required");
-  if (options->force && !options->resume) return Status::error("--force goes with --resume");
-  return Status::success();
-}
-
-Status check_output_dir(const std::string& dir) {
-  struct stat info {};
-  if (stat(dir.c_str(), &info) != 0) {
-    return Status::error("output folder '" + dir + "': " + std::strerror(errno));
-  }
-  if (!S_ISDIR(info.st_mode)) return Status::error("output folder '" + dir + "' is not a folder");
-  if (access(dir.c_str(), W_OK | X_OK) != 0) {
-    return Status::error("output folder '" + dir + "' is not writable: " + std::strerror(errno));
-  }
   return Status::success();
 }
 
 constexpr uint32_t index_of(ReadbackImage image) { return static_cast<uint32_t>(image); }
-
-
-// What every frame of this capture carries: what a resumed capture trusts a frame by.
-FrameExpectation frame_expectation(const CaptureOptions& options) {
-  FrameExpectation expected;
-  expected.scene = options.scene_path.empty() ? "default" : options.scene_path;
-  expected.seed = static_cast<int>(options.seed);
-  expected.width = static_cast<int>(options.size.width);
-  expected.height = static_cast<int>(options.size.height);
-  std::vector<std::string>& names = expected.channels;
-  names = {"R", "G", "B", "A"};
-  if (options.depth_aov) names.push_back("depth.Z");
-  if (options.flow_aov) {
-    names.insert(names.end(), std::begin(kFlowChannels), std::end(kFlowChannels));
-    names.push_back("water.mask");
-  }
-  if (options.particles_aov) names.push_back("particle.id");
-  if (options.normal_aov) {
-    names.insert(names.end(), std::begin(kNormalChannels), std::end(kNormalChannels));
-  }
-  if (options.reflection_aov) {
-    names.insert(names.end(), std::begin(kReflectionChannels), std::end(kReflectionChannels));
-  }
-  if (options.foam_aov) names.push_back("foam.Y");
-  std::sort(names.begin(), names.end());
-  expected.software_version = version_string();
-  return expected;
-}
-
-// With --resume: which frames of the range to render (false: complete, left untouched). A
-// complete frame of another capture is an error naming it, unless --force.
-Status frames_to_render(const CaptureOptions& options, std::vector<bool>* render) {
-  render->assign(options.end_frame - options.first_frame, true);
-  if (!options.resume) return Status::success();
-  const FrameExpectation expected = frame_expectation(options);
-  for (uint32_t frame = options.first_frame; frame < options.end_frame; ++frame) {
-    const FrameCheck check = check_frame(options.out_dir, frame, expected, "this capture");
-    if (check.state == FrameState::kMismatch && !options.force) {
-      return Status::error(options.out_dir + "/" + frame_file_name(frame) + " " + check.problem +
-                           "; nothing was overwritten (--force re-renders such frames)");
-    }
-    (*render)[frame - options.first_frame] = check.state != FrameState::kComplete;
-  }
-  return Status::success();
-}
-
 
 struct SlotTargets {
   HostTargets targets;
@@ -225,8 +158,8 @@ struct SlotTargets {
 
 class Capture {
  public:
-  Capture(const CaptureOptions& options, std::optional<SceneFile> scene)
-      : options_(options), scene_(std::move(scene)) {}
+  Capture(const CaptureOptions& options, CapturePlan plan)
+      : options_(options), plan_(std::move(plan)) {}
   // The GPU may still run a frame after an error: let it finish before the renderer goes.
   ~Capture() {
     if (context_ != nullptr) (void)context_->wait_idle();
@@ -237,16 +170,12 @@ class Capture {
   uint32_t frames_written() const { return frames_to_write_; }
 
  private:
-  uint32_t readback_images() const;
-  // Refuses, before anything is allocated, a size and AOV set over the memory budget, with the
-  // figure it would need.
-  Status check_memory_budget(CreateInfo info, size_t river_count) const;
   // Copies the slot's frame out of its readback buffers into `finished` (its buffers reused).
   void copy_out(const SlotTargets& slot, FinishedFrame* finished) const;
   void report_progress(uint32_t done_count);
 
   CaptureOptions options_;
-  std::optional<SceneFile> scene_;
+  CapturePlan plan_;
   std::unique_ptr<HeadlessContext> context_;
   std::unique_ptr<World> world_;
   std::vector<std::unique_ptr<Renderer>> rivers_;  // one water renderer per river of the scene
@@ -258,14 +187,8 @@ class Capture {
 };
 
 Status Capture::run() {
-  const size_t river_count = scene_.has_value() ? scene_->rivers.size() : 1;
-  if (river_count > 1 && (options_.flow_aov || options_.particles_aov || options_.normal_aov ||
-                          options_.reflection_aov || options_.foam_aov)) {
-    return Status::error("--aov flow, particles, normal, reflection and foam are of one river; the scene has " +
-                         std::to_string(river_count) + " (depth works with any number)");
-  }
-  std::vector<bool> render;  // per frame of the range
-  SIVIFLOW_TRY(frames_to_render(options_, &render));
+  const size_t river_count = plan_.rivers.size();
+  const std::vector<bool>& render = plan_.render;  // per frame of the range
   frames_to_write_ = static_cast<uint32_t>(std::count(render.begin(), render.end(), true));
   if (frames_to_write_ == 0) return Status::success();
   HeadlessContextOptions context_options;
@@ -279,27 +202,25 @@ Status Capture::run() {
                          std::to_string(max_dimension) + " pixels per side");
   }
   CreateInfo info = context_->renderer_create_info(
-      {options_.size.width, options_.size.height}, kOutputFormat);
-  info.frames_in_flight = kFramesInFlight;
-  info.depth_format = kDepthFormat;
-  SIVIFLOW_TRY(check_memory_budget(info, river_count));
+      {options_.size.width, options_.size.height}, kCaptureColorFormat);
+  info.frames_in_flight = kCaptureFramesInFlight;
+  info.depth_format = kCaptureDepthFormat;
   info.seed = options_.seed;
-  const SceneFile* scene = scene_.has_value() ? &*scene_ : nullptr;
+  const SceneFile* scene = plan_.scene.has_value() ? &*plan_.scene : nullptr;
   info.look = scene != nullptr ? &scene->look : nullptr;
-  WorldCreateInfo world_info = context_->world_create_info(kOutputFormat, kDepthFormat);
-  world_info.frames_in_flight = kFramesInFlight;
+  WorldCreateInfo world_info = context_->world_create_info(kCaptureColorFormat, kCaptureDepthFormat);
+  world_info.frames_in_flight = kCaptureFramesInFlight;
   world_info.scene = scene;
   SIVIFLOW_TRY(World::create(world_info, &world_));
   info.reflection = &World::draw_reflection;
   info.reflection_user = world_.get();
   for (size_t i = 0; i < river_count; ++i) {
-    SceneRiverData river;
-    SIVIFLOW_TRY(scene_river_data(scene, i, &river));
-    const WaterRiver water = river.river();
+    const WaterRiver water = plan_.rivers[i].river();
     info.river = &water;
-    info.readback_images = i + 1 == river_count ? readback_images() : 0;
+    info.readback_images = i + 1 == river_count ? capture_readback_images(options_) : 0;
     rivers_.emplace_back();
     SIVIFLOW_TRY(Renderer::create(info, &rivers_.back()));
+    plan_.rivers[i] = {};  // the renderer holds its copy
     SIVIFLOW_TRY(rivers_.back()->set_occluders(world_->occluders()));
     river_renderers_.push_back(rivers_.back().get());
   }
@@ -313,12 +234,12 @@ Status Capture::run() {
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->simulate(view, time));
   }
 
-  std::vector<SlotTargets> slots(kFramesInFlight);
+  std::vector<SlotTargets> slots(kCaptureFramesInFlight);
   const ImageState readable{VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
   for (SlotTargets& slot : slots) {
     SIVIFLOW_TRY(
-        create_host_targets(*context_, kOutputFormat, kDepthFormat, extent, readable, &slot.targets));
+        create_host_targets(*context_, kCaptureColorFormat, kCaptureDepthFormat, extent, readable, &slot.targets));
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
       const auto kind = static_cast<ReadbackImage>(i);
       if ((info.readback_images & readback_bit(kind)) == 0) continue;
@@ -338,7 +259,7 @@ Status Capture::run() {
       for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->simulate(view, time));
       continue;
     }
-    const uint32_t index = rendered++ % kFramesInFlight;
+    const uint32_t index = rendered++ % kCaptureFramesInFlight;
     SlotTargets& slot = slots[index];
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     SIVIFLOW_TRY(context_->begin_slot(index, &cmd));  // waits for this slot's previous frame
@@ -366,10 +287,10 @@ Status Capture::run() {
     if (have_finished) SIVIFLOW_TRY(writer.push(std::move(finished)));
   }
   // Drain: the last frames, at most one per slot, in submission order.
-  for (uint32_t i = rendered > kFramesInFlight ? rendered - kFramesInFlight : 0; i < rendered;
+  for (uint32_t i = rendered > kCaptureFramesInFlight ? rendered - kCaptureFramesInFlight : 0; i < rendered;
        ++i) {
-    SlotTargets& slot = slots[i % kFramesInFlight];
-    SIVIFLOW_TRY(context_->wait_slot(i % kFramesInFlight));
+    SlotTargets& slot = slots[i % kCaptureFramesInFlight];
+    SIVIFLOW_TRY(context_->wait_slot(i % kCaptureFramesInFlight));
     FinishedFrame finished = writer.spare_frame();
     copy_out(slot, &finished);
     SIVIFLOW_TRY(writer.push(std::move(finished)));
@@ -382,37 +303,6 @@ Status Capture::run() {
                          context_->validation_errors().front());
   }
   return Status::success();
-}
-
-// The colour, and what the requested AOVs are made from.
-Status Capture::check_memory_budget(CreateInfo info, size_t river_count) const {
-  const uint64_t pixels = uint64_t{options_.size.width} * options_.size.height;
-  uint64_t needed = kFramesInFlight * pixels * kHostBytesPerPixel;
-  for (size_t i = 0; i < river_count; ++i) {  // the last river's renderer reads back
-    info.readback_images = i + 1 == river_count ? readback_images() : 0;
-    ViewMemory view;
-    SIVIFLOW_TRY(view_memory(info, &view));
-    needed += view.renderer_bytes + kFramesInFlight * view.readback_bytes;
-  }
-  if (needed <= kMaxCaptureBytes) return Status::success();
-  return Status::error(text_format(
-      "--size %ux%u (with the AOVs asked for) needs %llu MiB of device memory (the renderers' images and "
-      "staging, the frames' colour, depth and readback buffers), more than the %llu MiB budget",
-      options_.size.width, options_.size.height,
-      static_cast<unsigned long long>((needed + (1u << 20) - 1) >> 20),
-      static_cast<unsigned long long>(kMaxCaptureBytes >> 20)));
-}
-
-uint32_t Capture::readback_images() const {
-  uint32_t images = readback_bit(ReadbackImage::kColor);
-  if (options_.depth_aov) images |= readback_bit(ReadbackImage::kDepth);
-  if (options_.flow_aov || options_.particles_aov) {
-    images |= readback_bit(ReadbackImage::kWaterMask) | readback_bit(ReadbackImage::kFlowTexture);
-  }
-  if (options_.normal_aov) images |= readback_bit(ReadbackImage::kNormal);
-  if (options_.reflection_aov) images |= readback_bit(ReadbackImage::kReflection);
-  if (options_.foam_aov) images |= readback_bit(ReadbackImage::kFoam);
-  return images;
 }
 
 void Capture::copy_out(const SlotTargets& slot, FinishedFrame* finished) const {
@@ -476,33 +366,32 @@ int run_capture(int argc, char** argv) {
     print_help();
     return cli::kExitOk;
   }
-  status = check_output_dir(options.out_dir);
-  if (!status.ok()) return cli::fail(kCommand, status.message());
-  std::optional<SceneFile> scene;
-  if (!options.scene_path.empty()) {
-    scene.emplace();
-    status = load_scene_file(options.scene_path, &*scene);
-    if (!status.ok()) return cli::fail(kCommand, status.message());
-    // The scene's render settings, unless a flag said otherwise.
-    if (!options.size_given) options.size = {scene->render.width, scene->render.height};
-    if (!options.fps_given) options.fps = static_cast<float>(scene->render.fps);
-    if (!options.seed_given) options.seed = scene->render.seed;
+  CapturePlan plan;
+  try {
+    status = plan_capture(&options, &plan);
+  } catch (const std::exception& e) {  // std::bad_alloc loading the scene: stop, with why
+    status = Status::error(std::string("capture stopped: ") + e.what());
   }
+  if (!status.ok()) return cli::fail(kCommand, status.message());
+  const uint32_t range = options.end_frame - options.first_frame;
+  const auto to_render =
+      static_cast<uint32_t>(std::count(plan.render.begin(), plan.render.end(), true));
   if (options.dry_run) {
-    std::printf("would render frames %u..%u of %s at %ux%u to %s/frame_NNNNN.exr\n",
+    std::printf("would render frames %u..%u of %s at %ux%u to %s/frame_NNNNN.exr",
                 options.first_frame, options.end_frame - 1,
                 options.scene_path.empty() ? "the default scene" : options.scene_path.c_str(),
                 options.size.width, options.size.height, options.out_dir.c_str());
+    if (options.resume) std::printf("; %u are complete and kept", range - to_render);
+    std::printf("\n");
     return cli::kExitOk;
   }
-  Capture capture(options, std::move(scene));
+  Capture capture(options, std::move(plan));
   try {
     status = capture.run();
   } catch (const std::exception& e) {  // std::bad_alloc copying a frame out: stop, with why
     status = Status::error(std::string("capture stopped: ") + e.what());
   }
   if (!status.ok()) return cli::fail(kCommand, status.message());
-  const uint32_t range = options.end_frame - options.first_frame;
   std::printf("wrote %u of frames %u..%u to %s/frame_NNNNN.exr%s", capture.frames_written(),
               options.first_frame, options.end_frame - 1, options.out_dir.c_str(),
               options.preview ? " (+ .png)" : "");

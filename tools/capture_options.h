@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "cli.h"
 
@@ -23,14 +24,29 @@ struct CaptureOptions {
   bool validation = false;
   bool dry_run = false;  // check everything that needs no device, say what would be rendered
   bool resume = false;  // render only the frames of the range not already complete
-  bool force = false;   // with resume: re-render frames of another capture instead of refusing
+  bool force = false;   // render over (or beside) frames of another capture instead of refusing
   bool depth_aov = false;
   bool flow_aov = false;       // flow.X/Y/Z and water.mask
   bool particles_aov = false;  // particle.id and frame_NNNNN.particles.csv
   bool normal_aov = false;     // normal.X/Y/Z
   bool reflection_aov = false; // reflection.R/G/B
   bool foam_aov = false;       // foam.Y
+  std::string scene_digest;    // scene_content_digest, set by plan_capture
 };
+
+// The AOVs asked for, comma-separated in the order --help lists them ("" for the beauty alone):
+// what frames record and captures compare.
+inline std::string aov_names(const CaptureOptions& options) {
+  const std::pair<bool, const char*> aovs[] = {
+      {options.depth_aov, "depth"},   {options.flow_aov, "flow"},
+      {options.particles_aov, "particles"}, {options.normal_aov, "normal"},
+      {options.reflection_aov, "reflection"}, {options.foam_aov, "foam"}};
+  std::string names;
+  for (const auto& [asked, name] : aovs) {
+    if (asked) names += (names.empty() ? "" : ",") + std::string(name);
+  }
+  return names;
+}
 
 // The EXR channels of the AOVs made of three planes.
 inline constexpr const char* kFlowChannels[3] = {"flow.X", "flow.Y", "flow.Z"};

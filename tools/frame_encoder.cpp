@@ -119,6 +119,9 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
   frame.metadata.time_seconds = static_cast<float>(finished.frame / options_.fps);
   frame.metadata.seed = static_cast<int>(options_.seed);
   frame.metadata.software_version = version_string();
+  frame.metadata.scene_digest = options_.scene_digest;
+  frame.metadata.fps = options_.fps;
+  frame.metadata.aovs = aov_names(options_);
 
   out->frame = finished.frame;
   SIVIFLOW_TRY(encode_exr(frame, &out->exr));

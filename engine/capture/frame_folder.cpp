@@ -45,32 +45,58 @@ std::string joined(const std::vector<std::string>& names) {
 
 FrameExpectation expectation_of(const ExrImage& image) {
   FrameExpectation expected;
-  expected.scene = image.metadata.scene;
+  expected.scene_digest = image.metadata.scene_digest;
+  expected.fps = image.metadata.fps;
   expected.seed = image.metadata.seed;
   expected.width = image.width;
   expected.height = image.height;
+  expected.aovs = image.metadata.aovs;
   for (const auto& [name, plane] : image.channels) expected.channels.push_back(name);
   expected.software_version = image.metadata.software_version;
   return expected;
 }
 
-// How `image` differs from `expected` ("" when it does not), every difference.
+// A digest short enough for a message line and long enough to tell two apart.
+std::string short_digest(const std::string& digest) {
+  constexpr size_t kShown = 7 + 12;  // "sha256:" and 12 hex digits
+  if (digest.empty()) return "none";
+  return digest.size() > kShown ? digest.substr(0, kShown) + "..." : digest;
+}
+
+// How `image` differs from `expected` ("" when it does not): every difference, what the capture
+// is made of first.
 std::string disagreement(const ExrImage& image, const FrameExpectation& expected,
                          const std::string& expected_name) {
   const FrameExpectation a = expectation_of(image);
   const FrameExpectation& b = expected;
   std::vector<std::string> differences;
-  if (a.scene != b.scene) differences.push_back("scene '" + a.scene + "' ('" + b.scene + "')");
-  if (a.seed != b.seed) differences.push_back(text_format("seed %d (%d)", a.seed, b.seed));
-  if (a.width != b.width || a.height != b.height) {
-    differences.push_back(text_format("size %dx%d (%dx%d)", a.width, a.height, b.width, b.height));
-  }
-  if (a.channels != b.channels) {
-    differences.push_back("channels " + joined(a.channels) + " (" + joined(b.channels) + ")");
-  }
-  if (a.software_version != b.software_version) {
-    differences.push_back("software version '" + a.software_version + "' ('" +
-                          b.software_version + "')");
+  if (a.scene_digest.empty() != b.scene_digest.empty()) {
+    // The frames before scene digests: another capture, whatever else they hold.
+    const std::string attribute = kExrAttrSceneDigest;
+    differences.push_back(a.scene_digest.empty()
+                              ? "an earlier layout without " + attribute + " (one with it)"
+                              : "a layout with " + attribute + " (an earlier one without it)");
+  } else {
+    if (a.scene_digest != b.scene_digest) {
+      differences.push_back("scene content differs, digest " + short_digest(a.scene_digest) +
+                            " (" + short_digest(b.scene_digest) + ")");
+    }
+    if (a.fps != b.fps) differences.push_back(text_format("fps %g (%g)", a.fps, b.fps));
+    if (a.seed != b.seed) differences.push_back(text_format("seed %d (%d)", a.seed, b.seed));
+    if (a.width != b.width || a.height != b.height) {
+      differences.push_back(
+          text_format("size %dx%d (%dx%d)", a.width, a.height, b.width, b.height));
+    }
+    if (a.aovs != b.aovs) {
+      differences.push_back("AOVs " + (a.aovs.empty() ? std::string("none") : a.aovs) + " (" +
+                            (b.aovs.empty() ? std::string("none") : b.aovs) + ")");
+    } else if (a.channels != b.channels) {  // the AOVs' channels follow from the AOVs otherwise
+      differences.push_back("channels " + joined(a.channels) + " (" + joined(b.channels) + ")");
+    }
+    if (a.software_version != b.software_version) {
+      differences.push_back("software version '" + a.software_version + "' ('" +
+                            b.software_version + "')");
+    }
   }
   if (differences.empty()) return "";
   std::string text = "differs from " + expected_name + " (in brackets):";
@@ -100,21 +126,29 @@ FrameCheck read_frame(const std::string& dir, uint32_t frame, ExrImage* image) {
   return {FrameState::kComplete, ""};
 }
 
-Status check_frames(const std::string& dir, uint32_t first, uint32_t end,
-                    FrameFolderReport* out) {
+Status frames_in(const std::string& dir, std::vector<uint32_t>* out) {
   std::error_code error;
   const fs::file_status status = fs::status(dir, error);
   if (!fs::exists(status)) return Status::error("'" + dir + "': no such folder");
   if (!fs::is_directory(status)) return Status::error("'" + dir + "': not a folder");
-  std::vector<uint32_t> present;  // only to find the range when none is given
+  std::vector<uint32_t> present;
   for (fs::directory_iterator it(dir, error), done; !error && it != done; it.increment(error)) {
     if (auto frame = frame_of_file_name(it->path().filename().string())) present.push_back(*frame);
   }
   if (error) return Status::error("'" + dir + "': cannot list the folder: " + error.message());
+  std::sort(present.begin(), present.end());
+  *out = std::move(present);
+  return Status::success();
+}
+
+Status check_frames(const std::string& dir, uint32_t first, uint32_t end,
+                    FrameFolderReport* out) {
+  std::vector<uint32_t> present;  // only to find the range when none is given
+  SIVIFLOW_TRY(frames_in(dir, &present));
   if (end == 0) {
     if (present.empty()) return Status::error("'" + dir + "': no frame_NNNNN.exr file in it");
-    first = *std::min_element(present.begin(), present.end());
-    end = *std::max_element(present.begin(), present.end()) + 1;
+    first = present.front();
+    end = present.back() + 1;
   }
 
   FrameFolderReport report;
@@ -162,6 +196,14 @@ std::string frame_file_name(uint32_t frame) {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%05u.exr", frame);
   return name;
+}
+
+Status list_frames(const std::string& dir, std::vector<uint32_t>* out) {
+  try {
+    return frames_in(dir, out);
+  } catch (const std::exception& e) {  // std::bad_alloc from a folder of millions of names
+    return Status::error("'" + dir + "': " + e.what());
+  }
 }
 
 Status check_frame_folder(const std::string& dir, uint32_t first, uint32_t end,

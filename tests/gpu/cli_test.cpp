@@ -273,8 +273,13 @@ TEST_F(CliTest, CaptureOfAProceduralSceneFile) {
   EXPECT_EQ(image.metadata.seed, 3);
   EXPECT_NEAR(image.metadata.time_seconds, 2.0f / 24.0f, 1e-6f) << "the scene's fps";
   EXPECT_EQ(image.metadata.scene, scene.string());
-  // A flag wins over the scene's settings.
-  ASSERT_EQ(run_siviflow("capture " + scene.string() + " --size 32x16 --out " + dir_.string()).exit_code, 0);
+  // A flag wins over the scene's settings; frame 2 of the scene's size is another capture, and
+  // the folder is refused unless --force.
+  const std::string smaller = "capture " + scene.string() + " --size 32x16 --out " + dir_.string();
+  expect_error_only(run_siviflow(smaller), "frame_00002.exr, outside the range, differs from this "
+                                           "capture (in brackets): size 80x48 (32x16)");
+  EXPECT_FALSE(fs::exists(dir_ / "frame_00000.exr"));
+  ASSERT_EQ(run_siviflow(smaller + " --force").exit_code, 0);
   ASSERT_TRUE(read_exr((dir_ / "frame_00000.exr").string(), &image).ok());
   EXPECT_EQ(image.width, 32);
 }
@@ -422,23 +427,103 @@ TEST_F(CliTest, ResumeRendersOnlyMissingOrIncompleteFrames) {
       << run.output;
   run = run_siviflow("capture --range 3:6 --size 64x36 --resume --out " + resumed.string());
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("frame_00003.exr differs from this capture (in brackets): channels "
-                            "A,B,G,R,depth.Z (A,B,G,R)"),
+  EXPECT_NE(run.output.find("frame_00003.exr differs from this capture (in brackets): AOVs "
+                            "depth (none)"),
             std::string::npos)
       << run.output;
+  // Without --resume too: another capture's frames are not overwritten.
+  expect_error_only(run_siviflow(args + resumed.string() + " --seed 5"),
+                    "frame_00000.exr differs from this capture (in brackets): seed 1 (5); nothing "
+                    "was overwritten (--force re-renders such frames)");
   for (const char* kept : {"frame_00000.exr", "frame_00003.exr"}) {
     EXPECT_EQ(fs::last_write_time(resumed / kept), old_time) << kept;
   }
-  expect_error_only(run_siviflow(args + resumed.string() + " --force"),
-                    "--force goes with --resume");
 
-  // --force re-renders them.
+  // --force re-renders them, with --resume or without.
   run = run_siviflow(args + resumed.string() + " --seed 5 --resume --force");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("wrote 6 of frames 0..5"), std::string::npos) << run.output;
   ExrImage image;
   ASSERT_TRUE(read_exr((resumed / "frame_00003.exr").string(), &image).ok());
   EXPECT_EQ(image.metadata.seed, 5);
+  run = run_siviflow("capture --range 0:2 --size 64x36 --aov depth --seed 6 --force --out " +
+                     resumed.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  ASSERT_TRUE(read_exr((resumed / "frame_00001.exr").string(), &image).ok());
+  EXPECT_EQ(image.metadata.seed, 6);
+}
+
+// Frames record what made them, and a resume or `verify` compares all of it: a path spelled
+// otherwise is the same capture, an edited scene or another --fps another one, named by its first
+// frame and the difference; a plain capture re-renders its own frames and refuses another's.
+TEST_F(CliTest, FramesKnowWhatMadeThem) {
+  const fs::path scene = dir_ / "scene.json";
+  const std::string text = R"({"version": 1, "river": {"procedural": {"length": 120}},
+    "render": {"size": [48, 27], "seed": 3}})";
+  std::ofstream(scene) << text;
+  const fs::path out = dir_ / "frames";
+  fs::create_directories(out);
+  const std::string in_dir = "cd " + dir_.string() + " && " + SIVIFLOW_BINARY_DIR "/tools/siviflow ";
+  RunResult run = run_shell(in_dir + "capture scene.json --frames 2 --out frames");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  ExrImage image;
+  ASSERT_TRUE(read_exr((out / "frame_00001.exr").string(), &image).ok());
+  const std::string digest = image.metadata.scene_digest;
+  EXPECT_EQ(digest.rfind("sha256:", 0), 0u) << digest;
+  EXPECT_EQ(digest.size(), 7u + 64u);
+  EXPECT_EQ(image.metadata.scene, "scene.json") << "the path as given, for people";
+  EXPECT_EQ(image.metadata.fps, 30.0f);
+  EXPECT_EQ(image.metadata.aovs, "");
+  EXPECT_EQ(image.metadata.seed, 3);
+  EXPECT_EQ(image.metadata.software_version + "\n", run_siviflow("--version").output);
+
+  // The same scene by another spelling of its path: the same capture.
+  run = run_shell(in_dir + "capture ./scene.json --range 0:3 --resume --out frames");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("wrote 1 of frames 0..2"), std::string::npos) << run.output;
+  run = run_siviflow("capture " + scene.string() + " --range 0:3 --resume --out " + out.string());
+  EXPECT_NE(run.output.find("wrote 0 of frames 0..2"), std::string::npos) << run.output;
+  run = run_siviflow("verify " + out.string());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+
+  // A plain capture of this capture renders its frames again.
+  const auto old_time = fs::file_time_type::clock::now() - std::chrono::hours(24);
+  fs::last_write_time(out / "frame_00000.exr", old_time);
+  ASSERT_EQ(run_siviflow("capture " + scene.string() + " --out " + out.string()).exit_code, 0);
+  EXPECT_NE(fs::last_write_time(out / "frame_00000.exr"), old_time);
+  fs::last_write_time(out / "frame_00000.exr", old_time);
+
+  // An edited scene at the same path: another capture, refused by its first frame.
+  std::ofstream(scene) << R"({"version": 1, "river": {"procedural": {"length": 120}},
+    "flow": {"discharge": 12}, "render": {"size": [48, 27], "seed": 3}})";
+  expect_error_only(run_siviflow("capture " + scene.string() + " --range 0:4 --resume --out " +
+                                 out.string()),
+                    out.string() + "/frame_00000.exr differs from this capture (in brackets): "
+                                   "scene content differs, digest sha256:");
+  expect_error_only(run_siviflow("capture " + scene.string() + " --range 0:1 --out " +
+                                 out.string()),
+                    "frame_00000.exr differs from this capture (in brackets): scene content "
+                    "differs, digest " + digest.substr(0, 19) + "... (sha256:");
+  std::ofstream(scene) << text;
+
+  // Another frame rate: another capture; forced into the folder, verify names its frame.
+  expect_error_only(run_siviflow("capture " + scene.string() + " --range 0:4 --fps 24 --resume "
+                                 "--out " + out.string()),
+                    "frame_00000.exr differs from this capture (in brackets): fps 30 (24)");
+  EXPECT_EQ(fs::last_write_time(out / "frame_00000.exr"), old_time) << "nothing overwritten";
+  run = run_siviflow("capture " + scene.string() + " --range 3:4 --fps 24 --force --out " +
+                     out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  ASSERT_TRUE(read_exr((out / "frame_00003.exr").string(), &image).ok());
+  EXPECT_EQ(image.metadata.fps, 24.0f);
+  EXPECT_NEAR(image.metadata.time_seconds, 3.0f / 24.0f, 1e-6f) << "--fps reaches the frame's time";
+  run = run_siviflow("verify " + out.string());
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("frame_00003.exr: differs from frame_00000.exr (in brackets): fps 24 "
+                            "(30)\n"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("3 of 4 complete"), std::string::npos) << run.output;
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // problem, and a folder that cannot be checked refused with a message.
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ namespace fs = std::filesystem;
 using testing::fresh_test_dir;
 using testing::run_siviflow;
 
+constexpr const char* kDigest =
+    "sha256:0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
+
 struct FrameSpec {
   int width = 8;
   int height = 4;
@@ -27,6 +31,9 @@ struct FrameSpec {
   std::string version = "0.1.0";
   bool depth = false;
   int frame_attribute = -1;  // -1: the file's own frame
+  std::string digest = kDigest;  // "": a frame of the layout before digests
+  float fps = 30.0f;
+  std::optional<std::string> aovs;  // absent: "depth" with depth, else ""
 };
 
 void write_frame(const fs::path& dir, uint32_t frame, const FrameSpec& spec = {}) {
@@ -42,6 +49,9 @@ void write_frame(const fs::path& dir, uint32_t frame, const FrameSpec& spec = {}
   exr.metadata.frame = spec.frame_attribute >= 0 ? spec.frame_attribute : static_cast<int>(frame);
   exr.metadata.seed = spec.seed;
   exr.metadata.software_version = spec.version;
+  exr.metadata.scene_digest = spec.digest;
+  exr.metadata.fps = spec.digest.empty() ? 0.0f : spec.fps;  // the earlier layout had neither
+  exr.metadata.aovs = spec.aovs ? *spec.aovs : spec.depth ? "depth" : "";
   const Status status = write_exr((dir / frame_file_name(frame)).string(), exr);
   ASSERT_TRUE(status.ok()) << status.message();
 }
@@ -84,11 +94,15 @@ TEST(FrameFolder, NamesEveryBadFrameAndItsProblem) {
   write_frame(dir, 7);  // no depth.Z
   write_frame(dir, 8, {.version = "0.2.0", .depth = true});
   write_frame(dir, 9, {.depth = true, .frame_attribute = 2});
+  write_frame(dir, 10, {.depth = true, .fps = 24.0f});
+  write_frame(dir, 11, {.depth = true, .digest = "sha256:fedcba98765432100123"});
+  write_frame(dir, 12, {.aovs = "depth"});  // the AOVs' channels under other names
+  write_frame(dir, 13, {.seed = 2, .depth = true, .digest = ""});
 
   FrameFolderReport report;
-  ASSERT_TRUE(check_frame_folder(dir.string(), 0, 10, &report).ok());
+  ASSERT_TRUE(check_frame_folder(dir.string(), 0, 14, &report).ok());
   EXPECT_EQ(report.complete, 2u);
-  ASSERT_EQ(report.problems.size(), 8u);
+  ASSERT_EQ(report.problems.size(), 12u);
   EXPECT_EQ(report.problems[0].file, "frame_00002.exr");
   EXPECT_EQ(problem_of(report, 2), "missing");
   EXPECT_NE(problem_of(report, 3).find("cannot be read whole"), std::string::npos)
@@ -96,14 +110,76 @@ TEST(FrameFolder, NamesEveryBadFrameAndItsProblem) {
   EXPECT_NE(problem_of(report, 4).find("not an EXR file"), std::string::npos)
       << problem_of(report, 4);
   EXPECT_EQ(problem_of(report, 5), "differs from frame_00000.exr (in brackets): seed 7 (1)");
-  EXPECT_EQ(problem_of(report, 6),
-            "differs from frame_00000.exr (in brackets): scene 'other.json' ('default'), "
-            "size 16x4 (8x4)");
-  EXPECT_EQ(problem_of(report, 7),
-            "differs from frame_00000.exr (in brackets): channels A,B,G,R (A,B,G,R,depth.Z)");
+  // The scene's path is for people: its content is compared.
+  EXPECT_EQ(problem_of(report, 6), "differs from frame_00000.exr (in brackets): size 16x4 (8x4)");
+  EXPECT_EQ(problem_of(report, 7), "differs from frame_00000.exr (in brackets): AOVs none (depth)");
   EXPECT_EQ(problem_of(report, 8),
             "differs from frame_00000.exr (in brackets): software version '0.2.0' ('0.1.0')");
   EXPECT_EQ(problem_of(report, 9), "holds frame 2");
+  EXPECT_EQ(problem_of(report, 10), "differs from frame_00000.exr (in brackets): fps 24 (30)");
+  EXPECT_EQ(problem_of(report, 11),
+            "differs from frame_00000.exr (in brackets): scene content differs, digest "
+            "sha256:fedcba987654... (sha256:0123456789ab...)");
+  EXPECT_EQ(problem_of(report, 12),
+            "differs from frame_00000.exr (in brackets): channels A,B,G,R (A,B,G,R,depth.Z)");
+  // A frame of the layout before digests is another capture, whatever else it shares.
+  EXPECT_EQ(problem_of(report, 13),
+            "differs from frame_00000.exr (in brackets): an earlier layout without "
+            "siviflow/scene_digest (one with it)");
+}
+
+TEST(FrameFolder, WhatACaptureIsMadeOfNamesTheFrameOfAnotherOne) {
+  const fs::path dir = fresh_test_dir("frame_folder");
+  // The same content reached by two spellings of the scene's path: one capture.
+  write_frame(dir, 0, {.scene = "./scene.json"});
+  write_frame(dir, 1, {.scene = "scene.json"});
+  FrameFolderReport report;
+  ASSERT_TRUE(check_frame_folder(dir.string(), 0, 0, &report).ok());
+  EXPECT_EQ(report.complete, 2u);
+  EXPECT_TRUE(report.problems.empty());
+
+  FrameExpectation capture;
+  capture.scene_digest = kDigest;
+  capture.fps = 30.0f;
+  capture.seed = 1;
+  capture.width = 8;
+  capture.height = 4;
+  capture.channels = {"A", "B", "G", "R"};
+  capture.software_version = "0.1.0";
+  FrameCheck check = check_frame(dir.string(), 1, capture, "this capture");
+  EXPECT_EQ(check.state, FrameState::kComplete) << check.problem;
+  capture.fps = 25.0f;
+  capture.scene_digest = "sha256:99999999999999999999";
+  check = check_frame(dir.string(), 1, capture, "this capture");
+  EXPECT_EQ(check.state, FrameState::kMismatch);
+  EXPECT_EQ(check.problem,
+            "differs from this capture (in brackets): scene content differs, digest "
+            "sha256:0123456789ab... (sha256:999999999999...), fps 30 (25)");
+  // A folder of the earlier layout, checked by a capture that records digests: named as such.
+  write_frame(dir, 2, {.digest = ""});
+  check = check_frame(dir.string(), 2, capture, "this capture");
+  EXPECT_EQ(check.state, FrameState::kMismatch);
+  EXPECT_EQ(check.problem,
+            "differs from this capture (in brackets): an earlier layout without "
+            "siviflow/scene_digest (one with it)");
+  // And verify, whose reference is the first frame: the later layout is the odd one out there.
+  write_frame(dir, 0, {.digest = ""});
+  ASSERT_TRUE(check_frame_folder(dir.string(), 0, 0, &report).ok());
+  EXPECT_EQ(problem_of(report, 1),
+            "differs from frame_00000.exr (in brackets): a layout with siviflow/scene_digest (an "
+            "earlier one without it)");
+}
+
+TEST(FrameFolder, ListsItsFramesInOrder) {
+  const fs::path dir = fresh_test_dir("frame_folder");
+  for (uint32_t frame : {12u, 3u, 100000u, 7u}) write_frame(dir, frame);
+  std::ofstream(dir / "frame_7.exr") << "not five digits";
+  std::ofstream(dir / "frame_00009.exr.tmp") << "a temporary";
+  std::vector<uint32_t> frames;
+  ASSERT_TRUE(list_frames(dir.string(), &frames).ok());
+  EXPECT_EQ(frames, (std::vector<uint32_t>{3, 7, 12, 100000}));
+  const Status status = list_frames((dir / "absent").string(), &frames);
+  EXPECT_EQ(status.message(), "'" + (dir / "absent").string() + "': no such folder");
 }
 
 TEST(FrameFolder, RefusesWhatIsNotAFolderOfFrames) {
