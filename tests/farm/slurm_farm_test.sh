@@ -2,7 +2,8 @@
 # The farm tier: a single-node Slurm cluster from Debian's packages (munge, slurmctld, slurmd),
 # started in a network namespace that has only loopback and a link to nowhere (so nothing it
 # starts can be reached from beyond this machine), runs tools/farm/submit_slurm.sh: a 4-task
-# array over 24 frames and the verify job after it. The frames must be bit-identical to one local
+# array over 24 frames, into a folder that does not exist yet (the scripts create it), and the
+# verify job after it. The frames must be bit-identical to one local
 # capture of the same range, and verify must find all 24 complete. Fails, saying why, when a
 # package or the namespace is missing.
 #
@@ -30,7 +31,7 @@ ip link set siviflow0 up
 ip link set siviflow1 up
 
 rm -rf "$work"
-mkdir -p "$work/local" "$work/farm"
+mkdir -p "$work/local"  # and not $work/farm: submit_slurm.sh and the tasks create it
 farm="$source_dir/tools/farm"
 export SIVIFLOW="$binary"
 capture_options=(--size 64x36 --aov depth)

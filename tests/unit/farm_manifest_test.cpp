@@ -1,7 +1,7 @@
 // The render-farm pieces that run without a cluster: capture_shard.sh refuses a bad chunking with
-// a message, and the Kubernetes Indexed Job's pods would run valid `siviflow capture`
-// invocations (checked by the tool itself with --dry-run) that cover its range exactly once,
-// with the verify Job checking that same range and folder.
+// a message, and the Kubernetes Indexed Job's pods, on a fresh volume, create the frames' folder
+// and would run valid `siviflow capture` invocations (checked by the tool itself with --dry-run)
+// that cover its range exactly once, with the verify Job checking that same range and folder.
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -85,11 +85,11 @@ TEST(FarmScripts, IndexedJobCoversItsRangeOnceWithValidCaptures) {
   const int end = std::stoi(args[2]);
   EXPECT_EQ((end - first) / std::stoi(args[3]), completions) << "one pod per chunk";
 
-  // The pods' volumes stand in as folders here: the frames' and the scene's.
+  // The pods' volumes stand in as folders here: the frames' (fresh: the frames' folder is not
+  // there yet, and the pods create it) and the scene's.
   const fs::path dir = testing::fresh_test_dir("farm");
   const std::string frames = args[4];
-  args[4] = (dir / "frames").string();
-  fs::create_directories(args[4]);
+  args[4] = (dir / "volume" / "shot010").string();
   for (std::string& arg : args) {
     if (arg.size() > 5 && arg.compare(arg.size() - 5, 5, ".json") == 0) {
       arg = (dir / fs::path(arg).filename()).string();
@@ -109,6 +109,7 @@ TEST(FarmScripts, IndexedJobCoversItsRangeOnceWithValidCaptures) {
       rendered.insert(frame);
     }
   }
+  EXPECT_TRUE(fs::is_directory(args[4])) << "the pods create the frames' folder";
   ASSERT_EQ(rendered.size(), static_cast<size_t>(end - first));
   for (int frame = first; frame < end; ++frame) EXPECT_EQ(rendered.count(frame), 1u) << frame;
 

@@ -2,7 +2,8 @@
 # One shard of a farm capture: the INDEX-th chunk of CHUNK frames of the range FIRST..END-1,
 # rendered with --resume into OUT (a re-run task renders only what its last attempt left
 # missing or incomplete). Run by the Slurm array task (slurm_capture.sbatch, INDEX from
-# SLURM_ARRAY_TASK_ID) and the Kubernetes Indexed Job (INDEX from JOB_COMPLETION_INDEX).
+# SLURM_ARRAY_TASK_ID) and the Kubernetes Indexed Job (INDEX from JOB_COMPLETION_INDEX). OUT is
+# created first where it is missing (a fresh volume has none; `capture` writes only into a folder).
 #
 # usage: capture_shard.sh INDEX FIRST END CHUNK OUT [capture options, e.g. SCENE.json --size WxH]
 # The siviflow binary is $SIVIFLOW, or `siviflow` on the PATH.
@@ -20,4 +21,5 @@ shift 5
 [ "$index" -lt "$shards" ] || farm_fail "INDEX $index is past the last of the $shards chunks"
 
 from=$((first + index * chunk))
+mkdir -p -- "$out" || farm_fail "cannot create the output folder '$out'"
 exec "${SIVIFLOW:-siviflow}" capture --range "$from:$((from + chunk))" --out "$out" --resume "$@"

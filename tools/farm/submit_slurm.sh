@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A farm capture on Slurm: a job array with one task per CHUNK frames of FIRST..END-1 (each task
 # renders its chunk with --resume), and a last job, run once every task has succeeded, that
-# verifies the folder with `siviflow verify`. Prints the two job ids.
+# verifies the folder with `siviflow verify`. Prints the two job ids. OUT is created where it is
+# missing: the tasks' logs go into it.
 #
 # usage: submit_slurm.sh FIRST END CHUNK OUT [capture options, e.g. SCENE.json --size WxH]
 # Extra sbatch options (partition, account, time limit) in SBATCH_OPTIONS; the siviflow binary
@@ -15,7 +16,7 @@ source "$farm/chunking.sh"
 check_chunking "$1" "$2" "$3"
 out="$4"
 shift 4
-[ -d "$out" ] || farm_fail "output folder '$out' does not exist"
+mkdir -p -- "$out" || farm_fail "cannot create the output folder '$out'"
 out="$(cd "$out" && pwd)"
 logs="$out/slurm-logs"  # the tasks' output; verify reads only frame files
 mkdir -p "$logs"
