@@ -34,6 +34,9 @@ foreach(example embed modern_frame)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/tools/examples/${example}
           DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples)
 endforeach()
+# The example scene files, with the glTF files they load (README, "Scene files").
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/scenes
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples)
 
 file(WRITE ${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in [=[
 @PACKAGE_INIT@

@@ -2,7 +2,9 @@
 # include/siviflow and compiles alone against the prefix (tests/consumer/headers); builds the
 # examples from their installed copies (share/siviflow/examples: embed, a first frame; and
 # modern_frame, HDR, reverse-Z, jitter, motion, reactive and depth, each checked) against the
-# prefix, at C++17, runs them, and checks the embed binary needs no file-format library.
+# prefix, at C++17, runs them, and checks the embed binary needs no file-format library; and the
+# installed tool checks each installed example scene as it would render it (--dry-run: the scene
+# came with every file it loads).
 file(REMOVE_RECURSE ${WORK})
 set(prefix ${WORK}/prefix)
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD} --prefix ${prefix}
@@ -50,6 +52,20 @@ function(build_and_run example program)
 endfunction()
 build_and_run(embed embed_example)
 build_and_run(modern_frame modern_frame)
+
+file(GLOB scenes ${prefix}/share/siviflow/examples/scenes/*.json)
+list(LENGTH scenes scene_count)
+if(scene_count LESS 3)
+  message(FATAL_ERROR "the example scenes are not installed: ${scenes}")
+endif()
+file(MAKE_DIRECTORY ${WORK}/frames)
+foreach(scene IN LISTS scenes)
+  execute_process(COMMAND ${prefix}/bin/siviflow capture ${scene} --dry-run --out ${WORK}/frames
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE output ERROR_VARIABLE output)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the installed example scene ${scene} does not check: ${output}")
+  endif()
+endforeach()
 
 # The binary of an engine that links siviflow::water alone needs no file-format library.
 execute_process(COMMAND readelf -d ${WORK}/embed/embed_example OUTPUT_VARIABLE dynamic

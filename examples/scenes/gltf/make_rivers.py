@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Writes rivers.gltf and rivers.bin beside this script: two river surfaces as SiViFlow reads them
+(README, "Scene files"), each a strip of quads from bank to bank, one row of vertices per
+cross-section, vertex 0 on the left bank of the upstream section, the water level at y = 0.
+
+  Bend     a river 10 m wide swinging 8 m either side of x = 0 over 120 m along +Z
+  Channel  a straight channel 9 m wide along +Z at x = 40 m, beside it
+
+Run it again after changing a number here; the committed files are its output.
+"""
+import json
+import math
+import os
+import struct
+
+SPACING = 2.0  # metres between cross-sections
+ACROSS = 7     # vertices from bank to bank
+
+
+def bend_centre(z):
+    return 8.0 * math.sin(2.0 * math.pi * z / 120.0)
+
+
+def strip(length, width, centre):
+    """Positions (x, y, z) and counter-clockwise (seen from +Y) triangle indices of a strip."""
+    sections = int(round(length / SPACING)) + 1
+    positions = []
+    for k in range(sections):
+        z = -0.5 * length + k * SPACING
+        # The centreline's slope turns each cross-section square to the flow.
+        dz = 0.01
+        slope = (centre(z + dz) - centre(z - dz)) / (2.0 * dz)
+        norm = math.hypot(1.0, slope)
+        across = (1.0 / norm, -slope / norm)  # unit (x, z) towards the left bank (+X)
+        for j in range(ACROSS):
+            offset = width * (0.5 - j / (ACROSS - 1))
+            positions.append((centre(z) + offset * across[0], 0.0, z + offset * across[1]))
+    indices = []
+    for k in range(sections - 1):
+        for j in range(ACROSS - 1):
+            a = k * ACROSS + j
+            b, c = a + 1, a + ACROSS
+            indices += [a, b, c, b, c + 1, c]
+    return positions, indices
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    meshes = [("Bend", strip(120.0, 10.0, bend_centre)),
+              ("Channel", strip(120.0, 9.0, lambda z: 40.0))]
+    blob = bytearray()
+    gltf = {"asset": {"version": "2.0", "generator": "examples/scenes/gltf/make_rivers.py"},
+            "scene": 0, "scenes": [{"nodes": list(range(len(meshes)))}],
+            "nodes": [], "meshes": [], "accessors": [], "bufferViews": []}
+    for name, (positions, indices) in meshes:
+        view = len(gltf["bufferViews"])
+        gltf["bufferViews"].append({"buffer": 0, "byteOffset": len(blob),
+                                    "byteLength": 12 * len(positions), "target": 34962})
+        for p in positions:
+            blob += struct.pack("<3f", *p)
+        gltf["bufferViews"].append({"buffer": 0, "byteOffset": len(blob),
+                                    "byteLength": 4 * len(indices), "target": 34963})
+        blob += struct.pack("<%dI" % len(indices), *indices)
+        rounded = [struct.unpack("<3f", struct.pack("<3f", *p)) for p in positions]
+        gltf["accessors"].append({"bufferView": view, "componentType": 5126,
+                                  "count": len(positions), "type": "VEC3",
+                                  "min": [min(p[i] for p in rounded) for i in range(3)],
+                                  "max": [max(p[i] for p in rounded) for i in range(3)]})
+        gltf["accessors"].append({"bufferView": view + 1, "componentType": 5125,
+                                  "count": len(indices), "type": "SCALAR"})
+        gltf["meshes"].append({"name": name, "primitives": [
+            {"attributes": {"POSITION": len(gltf["accessors"]) - 2},
+             "indices": len(gltf["accessors"]) - 1, "mode": 4}]})
+        gltf["nodes"].append({"name": name, "mesh": len(gltf["meshes"]) - 1})
+    gltf["buffers"] = [{"uri": "rivers.bin", "byteLength": len(blob)}]
+    with open(os.path.join(here, "rivers.bin"), "wb") as f:
+        f.write(blob)
+    with open(os.path.join(here, "rivers.gltf"), "w") as f:
+        json.dump(gltf, f, indent=1)
+        f.write("\n")
+
+
+if __name__ == "__main__":
+    main()
