@@ -116,7 +116,8 @@ Status frames_to_render(const CaptureOptions& options, std::vector<bool>* render
       return Status::error(folder + frame_file_name(frame) + " " + check.problem +
                            "; nothing was overwritten (--force re-renders such frames)");
     }
-    if (options.resume) (*render)[frame - options.first_frame] = check.state != FrameState::kComplete;
+    if (options.resume)
+      (*render)[frame - options.first_frame] = check.state != FrameState::kComplete;
   }
   if (options.force) return Status::success();
   std::vector<uint32_t> present;

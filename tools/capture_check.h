@@ -2,11 +2,11 @@
 // --dry-run, so that a dry run refuses all that the real run would refuse before rendering.
 #pragma once
 
+#include <vulkan/vulkan_core.h>
+
 #include <cstdint>
 #include <optional>
 #include <vector>
-
-#include <vulkan/vulkan_core.h>
 
 #include "capture_options.h"
 #include "siviflow/scene_file.h"

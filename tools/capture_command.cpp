@@ -27,6 +27,10 @@ namespace siviflow {
 namespace {
 
 constexpr const char* kCommand = "capture";
+// As plan_capture budgeted memory for.
+constexpr uint32_t kFramesInFlight = kCaptureFramesInFlight;
+constexpr VkFormat kOutputFormat = kCaptureColorFormat;
+constexpr VkFormat kDepthFormat = kCaptureDepthFormat;
 
 void print_help() {
   std::printf(
@@ -38,7 +42,7 @@ void print_help() {
       "  scene's content (a SHA-256 of the scene file and every file it loads), fps, seed, size,\n"
       "  AOVs and software version. Frames of this capture already in DIR are rendered again;\n"
       "  a complete frame of another capture in the range, or the first one outside it, is\n"
-      "  refused with exit 1, naming it and the first difference, unless --force.\n"
+      "  refused with exit 1, naming it and how it differs, unless --force.\n"
       "  --frames N     frames 0..N-1 (same as --range 0:N; default 1)\n"
       "  --range A:B    frames A..B-1; a frame is the same whatever range it is rendered in\n"
       "  --size WxH     output size in pixels (default 1280x720)\n"
@@ -202,14 +206,14 @@ Status Capture::run() {
                          std::to_string(max_dimension) + " pixels per side");
   }
   CreateInfo info = context_->renderer_create_info(
-      {options_.size.width, options_.size.height}, kCaptureColorFormat);
-  info.frames_in_flight = kCaptureFramesInFlight;
-  info.depth_format = kCaptureDepthFormat;
+      {options_.size.width, options_.size.height}, kOutputFormat);
+  info.frames_in_flight = kFramesInFlight;
+  info.depth_format = kDepthFormat;
   info.seed = options_.seed;
   const SceneFile* scene = plan_.scene.has_value() ? &*plan_.scene : nullptr;
   info.look = scene != nullptr ? &scene->look : nullptr;
-  WorldCreateInfo world_info = context_->world_create_info(kCaptureColorFormat, kCaptureDepthFormat);
-  world_info.frames_in_flight = kCaptureFramesInFlight;
+  WorldCreateInfo world_info = context_->world_create_info(kOutputFormat, kDepthFormat);
+  world_info.frames_in_flight = kFramesInFlight;
   world_info.scene = scene;
   SIVIFLOW_TRY(World::create(world_info, &world_));
   info.reflection = &World::draw_reflection;
@@ -234,12 +238,12 @@ Status Capture::run() {
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->simulate(view, time));
   }
 
-  std::vector<SlotTargets> slots(kCaptureFramesInFlight);
+  std::vector<SlotTargets> slots(kFramesInFlight);
   const ImageState readable{VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
   for (SlotTargets& slot : slots) {
     SIVIFLOW_TRY(
-        create_host_targets(*context_, kCaptureColorFormat, kCaptureDepthFormat, extent, readable, &slot.targets));
+        create_host_targets(*context_, kOutputFormat, kDepthFormat, extent, readable, &slot.targets));
     for (uint32_t i = 0; i < kReadbackImageCount; ++i) {
       const auto kind = static_cast<ReadbackImage>(i);
       if ((info.readback_images & readback_bit(kind)) == 0) continue;
@@ -259,7 +263,7 @@ Status Capture::run() {
       for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->simulate(view, time));
       continue;
     }
-    const uint32_t index = rendered++ % kCaptureFramesInFlight;
+    const uint32_t index = rendered++ % kFramesInFlight;
     SlotTargets& slot = slots[index];
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     SIVIFLOW_TRY(context_->begin_slot(index, &cmd));  // waits for this slot's previous frame
@@ -287,10 +291,10 @@ Status Capture::run() {
     if (have_finished) SIVIFLOW_TRY(writer.push(std::move(finished)));
   }
   // Drain: the last frames, at most one per slot, in submission order.
-  for (uint32_t i = rendered > kCaptureFramesInFlight ? rendered - kCaptureFramesInFlight : 0; i < rendered;
+  for (uint32_t i = rendered > kFramesInFlight ? rendered - kFramesInFlight : 0; i < rendered;
        ++i) {
-    SlotTargets& slot = slots[i % kCaptureFramesInFlight];
-    SIVIFLOW_TRY(context_->wait_slot(i % kCaptureFramesInFlight));
+    SlotTargets& slot = slots[i % kFramesInFlight];
+    SIVIFLOW_TRY(context_->wait_slot(i % kFramesInFlight));
     FinishedFrame finished = writer.spare_frame();
     copy_out(slot, &finished);
     SIVIFLOW_TRY(writer.push(std::move(finished)));

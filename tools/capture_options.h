@@ -38,8 +38,8 @@ struct CaptureOptions {
 // what frames record and captures compare.
 inline std::string aov_names(const CaptureOptions& options) {
   const std::pair<bool, const char*> aovs[] = {
-      {options.depth_aov, "depth"},   {options.flow_aov, "flow"},
-      {options.particles_aov, "particles"}, {options.normal_aov, "normal"},
+      {options.depth_aov, "depth"},           {options.flow_aov, "flow"},
+      {options.particles_aov, "particles"},   {options.normal_aov, "normal"},
       {options.reflection_aov, "reflection"}, {options.foam_aov, "foam"}};
   std::string names;
   for (const auto& [asked, name] : aovs) {

@@ -78,8 +78,8 @@ std::string disagreement(const ExrImage& image, const FrameExpectation& expected
                               : "a layout with " + attribute + " (an earlier one without it)");
   } else {
     if (a.scene_digest != b.scene_digest) {
-      differences.push_back("scene content differs, digest " + short_digest(a.scene_digest) +
-                            " (" + short_digest(b.scene_digest) + ")");
+      differences.push_back("scene content differs, digest " + short_digest(a.scene_digest) + " (" +
+                            short_digest(b.scene_digest) + ")");
     }
     if (a.fps != b.fps) differences.push_back(text_format("fps %g (%g)", a.fps, b.fps));
     if (a.seed != b.seed) differences.push_back(text_format("seed %d (%d)", a.seed, b.seed));

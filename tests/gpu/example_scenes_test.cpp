@@ -2,16 +2,15 @@
 // captured small with the validation layer on: the glTF river shows its water and its flow; the
 // two rivers each show their water where that river alone would; the look preset colours the
 // water as its "look" says (muddier than the same river without it).
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-
-#include <nlohmann/json.hpp>
 
 #include "run_command.h"
 #include "siviflow/image_files.h"

@@ -2,11 +2,11 @@
 // run: every file the scene loads, the AOVs against its rivers, the memory budget, and the frames
 // already in the output folder (kept by --resume when they are this capture's, refused by name
 // when they are another's, unless --force). And `siviflow --version`, which frames record.
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "gltf_test_files.h"
 #include "run_command.h"
@@ -36,7 +36,8 @@ class CaptureCheckTest : public ::testing::Test {
       const RunResult run = run_siviflow("capture " + args + " --out " + out_.string() + mode);
       EXPECT_EQ(run.exit_code, 1) << args << mode << "\n" << run.output;
       EXPECT_NE(run.output.find(needle), std::string::npos)
-          << args << mode << ": expected '" << needle << "' in:\n" << run.output;
+          << args << mode << ": expected '" << needle << "' in:\n"
+          << run.output;
     }
     EXPECT_EQ(files(out_), before);
   }
@@ -90,8 +91,9 @@ TEST_F(CaptureCheckTest, EveryFileTheSceneLoadsIsChecked) {
   write_channel_gltf(dir_ / "river.gltf", 12, 5, 8.0f, 2.0f);
   write_textured_box_gltf(dir_ / "box.gltf", glm::vec3(1.0f), "box.png", glm::vec4(1.0f));
   // A PNG whose header reads (4x4) but whose pixels do not decode.
-  write_text(dir_ / "box.png", std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\0\x04\0\0\0\x04\x08\x02\0\0\0", 29) +
-                                   "CRC and no pixels");
+  write_text(dir_ / "box.png",
+             std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0\0\x04\0\0\0\x04\x08\x02\0\0\0", 29) +
+                 "CRC and no pixels");
   const std::string scene = (dir_ / "scene.json").string();
   write_text(scene, R"({"version": 1, "river": {"gltf": "missing_river.gltf"}})");
   expect_refused(scene, "missing_river.gltf");
@@ -160,14 +162,16 @@ TEST_F(CaptureCheckTest, FramesOfAnotherCaptureAreRefusedByName) {
   const std::string file1 = out_.string() + "/frame_00001.exr";
   for (const char* resume : {"", " --resume"}) {
     expect_refused(std::string("--size 16x8 --range 0:3") + resume,
-                   file1 + " differs from this capture (in brackets): seed 4 (1); nothing was "
-                           "overwritten (--force re-renders such frames)");
+                   file1 +
+                       " differs from this capture (in brackets): seed 4 (1); nothing was "
+                       "overwritten (--force re-renders such frames)");
   }
   // Beside the range: the folder's first complete frame stands for it.
   expect_refused("--size 16x8 --range 5:6 --seed 4",
-                 out_.string() + "/frame_00000.exr, outside the range, differs from this capture "
-                                 "(in brackets): seed 1 (4): the folder holds another capture "
-                                 "(--force renders beside it)");
+                 out_.string() +
+                     "/frame_00000.exr, outside the range, differs from this capture "
+                     "(in brackets): seed 1 (4): the folder holds another capture "
+                     "(--force renders beside it)");
   for (const char* args : {"--size 16x8 --range 0:3 --force", "--size 16x8 --range 5:6 --force",
                            "--size 16x8 --range 0:3 --resume --force"}) {
     const RunResult run = dry_run(args);
@@ -175,12 +179,14 @@ TEST_F(CaptureCheckTest, FramesOfAnotherCaptureAreRefusedByName) {
   }
   // Another fps, another scene, a frame of the layout before digests.
   write_frame(1);
-  expect_refused("--size 16x8 --range 0:2 --fps 24", "frame_00000.exr differs from this capture "
-                                                     "(in brackets): fps 30 (24); nothing");
+  expect_refused("--size 16x8 --range 0:2 --fps 24",
+                 "frame_00000.exr differs from this capture "
+                 "(in brackets): fps 30 (24); nothing");
   const std::string scene = (dir_ / "scene.json").string();
   write_text(scene, R"({"version": 1, "river": {"procedural": {}}, "render": {"size": [16, 8]}})");
-  expect_refused(scene + " --range 0:2", "frame_00000.exr differs from this capture (in "
-                                         "brackets): scene content differs, digest sha256:");
+  expect_refused(scene + " --range 0:2",
+                 "frame_00000.exr differs from this capture (in "
+                 "brackets): scene content differs, digest sha256:");
   write_frame(0, [](ExrFrame& exr) {
     exr.metadata.scene_digest.clear();
     exr.metadata.fps = 0.0f;

@@ -3,11 +3,10 @@
 // not know is reported as an error, never skipped.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace siviflow::testing {
 
@@ -39,8 +38,8 @@ class SchemaCheck {
     if (type == "number") return value.is_number();
     if (type == "integer") {
       return value.is_number_integer() ||
-             (value.is_number_float() && value.get<double>() == static_cast<double>(
-                                                                    value.get<long long>()));
+             (value.is_number_float() &&
+              value.get<double>() == static_cast<double>(value.get<long long>()));
     }
     return false;
   }
@@ -61,7 +60,8 @@ class SchemaCheck {
       } else if (keyword == "const") {
         if (value != rule) fail("is not " + rule.dump());
       } else if (keyword == "enum") {
-        if (std::find(rule.begin(), rule.end(), value) == rule.end()) fail("not one of " + rule.dump());
+        if (std::find(rule.begin(), rule.end(), value) == rule.end())
+          fail("not one of " + rule.dump());
       } else if (keyword == "properties") {
         if (!value.is_object()) continue;
         for (const auto& [key, sub] : rule.items()) {
@@ -85,7 +85,8 @@ class SchemaCheck {
       } else if (keyword == "required") {
         if (!value.is_object()) continue;
         for (const Json& key : rule) {
-          if (!value.contains(key.get<std::string>())) fail("'" + key.get<std::string>() + "' is required");
+          if (!value.contains(key.get<std::string>()))
+            fail("'" + key.get<std::string>() + "' is required");
         }
       } else if (keyword == "items") {
         if (!value.is_array()) continue;

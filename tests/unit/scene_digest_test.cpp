@@ -3,14 +3,13 @@
 // an object's image is another digest; a missing glTF file is refused by name.
 #include "siviflow/scene_digest.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "gltf_test_files.h"
 #include "run_command.h"
@@ -76,8 +75,8 @@ TEST(SceneDigest, EveryFileTheLoaderReadsCounts) {
   write_scene(dir);
   const std::string scene = (dir / "scene.json").string();
   const std::string original = digest_of(scene);
-  for (const char* file : {"scene.json", "river.gltf", "river.bin", "box.gltf", "box.bin",
-                           "box.png"}) {
+  for (const char* file :
+       {"scene.json", "river.gltf", "river.bin", "box.gltf", "box.bin", "box.png"}) {
     const std::string bytes = read_bytes(dir / file);
     std::string changed = bytes;
     const bool json = fs::path(file).extension() != ".bin" && fs::path(file).extension() != ".png";

@@ -2,9 +2,9 @@
 // the 64-byte block and the padding's 56-byte boundary.
 #include "siviflow/sha256.h"
 
-#include <string>
-
 #include <gtest/gtest.h>
+
+#include <string>
 
 namespace siviflow {
 namespace {

@@ -1,15 +1,14 @@
 // The scene files the project ships follow the scene schema and load: the examples under
 // examples/scenes (with every glTF file they name, its rivers as the renderer takes them) and the
 // fuzz seeds of the scene parser. The schema check itself refuses what the schema forbids.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-
-#include <nlohmann/json.hpp>
 
 #include "json_schema_check.h"
 #include "siviflow/scene_file.h"
@@ -28,7 +27,9 @@ Json read_json(const fs::path& path) {
   return Json::parse(in);
 }
 
-SchemaCheck scene_schema() { return SchemaCheck(read_json(kSource / "engine/scene/scene.schema.json")); }
+SchemaCheck scene_schema() {
+  return SchemaCheck(read_json(kSource / "engine/scene/scene.schema.json"));
+}
 
 std::vector<fs::path> json_files(const fs::path& dir) {
   std::vector<fs::path> files;
@@ -50,8 +51,8 @@ TEST(ShippedScenes, ExamplesFollowTheSchemaAndLoadEveryRiver) {
   const std::vector<fs::path> examples = json_files(kSource / "examples" / "scenes");
   std::vector<std::string> names;
   for (const fs::path& file : examples) names.push_back(file.filename().string());
-  EXPECT_EQ(names, (std::vector<std::string>{"gltf_river.json", "muddy_river.json",
-                                             "two_rivers.json"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"gltf_river.json", "muddy_river.json", "two_rivers.json"}));
   for (const fs::path& file : examples) {
     const std::vector<std::string> errors = schema.errors(read_json(file));
     EXPECT_TRUE(errors.empty()) << file << "\n" << lines(errors);
@@ -98,7 +99,8 @@ TEST(ShippedScenes, SchemaCheckRefusesWhatTheSchemaForbids) {
   } cases[] = {
       {R"({"version": 2, "river": {"procedural": {}}})", ".version: is not 1"},
       {R"({"version": 1})", "matches 0 of the 2 schemas of oneOf"},
-      {R"({"version": 1, "river": {"procedural": {}}, "colour": 1})", "key 'colour' is not allowed"},
+      {R"({"version": 1, "river": {"procedural": {}}, "colour": 1})",
+       "key 'colour' is not allowed"},
       {R"({"version": 1, "river": {"procedural": {}, "mesh": "A"}})", "matches 0 of the 2"},
       {R"({"version": 1, "rivers": [{"gltf": "a.glb", "flow": {"p": 2}, "x": 1}]})",
        "matches 0 of the 2"},
