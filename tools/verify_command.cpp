@@ -18,9 +18,10 @@ void print_help() {
       "usage: siviflow verify DIR [--range A:B]\n"
       "  Checks the frames DIR/frame_NNNNN.exr of frames A..B-1 (default: from the lowest to the\n"
       "  highest frame in DIR): each must be present, read whole by OpenEXR, hold its own frame\n"
-      "  number, and match the first good frame's scene, seed, size, channels and software\n"
-      "  version. Prints one line per bad frame naming it and the problem, then a summary; exits\n"
-      "  1 if any frame is bad.\n");
+      "  number, and match what made the first good frame: the scene's content (its digest, not\n"
+      "  its path), fps, seed, size, AOVs, channels and software version. Frames of the layout\n"
+      "  before the digest are another capture. Prints one line per bad frame naming it and the\n"
+      "  problem, then a summary; exits 1 if any frame is bad.\n");
 }
 
 }  // namespace
