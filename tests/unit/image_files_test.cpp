@@ -353,7 +353,7 @@ TEST_F(ImageFilesExr, InvalidFramesAreRejectedWithoutFiles) {
   EXPECT_NE(s.message().find("layer 'foam' has no channels"), std::string::npos) << s.message();
 
   ExrFrame null_channel = data.frame();
-  null_channel.layers[0].channels.push_back({"water.mask", nullptr});
+  null_channel.layers[0].channels.push_back({"water.A", nullptr});
   s = write_exr(file, null_channel);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find(file), std::string::npos) << s.message();
