@@ -444,7 +444,9 @@ Status Capture::record_motion(uint32_t frame, SlotTargets* slot) const {
 uint32_t Capture::readback_images() const {
   uint32_t images = readback_bit(ReadbackImage::kColor);
   if (options_.depth_aov || options_.motion_aov) images |= readback_bit(ReadbackImage::kDepth);
-  if (water_layers(options_)) images |= readback_bit(ReadbackImage::kWaterMask);
+  if (water_layers(options_) || options_.motion_aov) {
+    images |= readback_bit(ReadbackImage::kWaterMask);
+  }
   if (options_.flow_aov || options_.particles_aov) {
     images |= readback_bit(ReadbackImage::kFlowTexture);
   }

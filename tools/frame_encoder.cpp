@@ -17,11 +17,12 @@ namespace siviflow {
 namespace {
 
 // Window depth (0 near .. 1 far, glm::perspectiveRH_ZO) to distance along the view axis.
+// In doubles: far from the camera, window depth + a cancels to a few significant bits.
 float linear_depth(float window_depth, float near_plane, float far_plane) {
   if (window_depth >= 1.0f) return std::numeric_limits<float>::infinity();
-  const float a = far_plane / (near_plane - far_plane);
-  const float b = far_plane * near_plane / (near_plane - far_plane);
-  return b / (window_depth + a);
+  const double a = double{far_plane} / (double{near_plane} - far_plane);
+  const double b = double{far_plane} * near_plane / (double{near_plane} - far_plane);
+  return static_cast<float>(b / (window_depth + a));
 }
 
 // The frame's camera in OpenEXR's conventions (siviflow/image_files.h, ExrCamera).
@@ -141,6 +142,7 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
     motion.width = width;
     motion.height = height;
     motion.window_depth = finished.window_depth.data();
+    motion.water_mask = finished.water_mask.data();
     motion.previous = camera_view(finished.previous_camera, extent);
     motion.current = camera_view(finished.camera, extent);
     motion.next = camera_view(finished.next_camera, extent);

@@ -69,7 +69,11 @@ void compute_motion(const MotionFrame& frame, std::vector<float>* xyzw) {
         const glm::dvec3 point = glm::dvec3(h) / h.w;
         glm::dvec3 to_previous;
         glm::dvec3 to_next;
-        displacement(frame.boulders, point, &to_previous, &to_next);
+        if (frame.water_mask[pixel] > 0.5f) {
+          to_previous = to_next = glm::dvec3(0.0);
+        } else {
+          displacement(frame.boulders, point, &to_previous, &to_next);
+        }
         point_now = glm::dvec4(point, 1.0);
         point_previous = glm::dvec4(point + to_previous, 1.0);
         point_next = glm::dvec4(point + to_next, 1.0);
