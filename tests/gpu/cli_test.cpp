@@ -62,7 +62,7 @@ TEST_F(CliTest, BadSizes) {
                "--size 16000x16000 (with the AOVs asked for) needs 12825 MiB of device memory");
   // The AOVs' attachments and readback buffers count: this size fits without them, not with them.
   expect_error(run_siviflow("capture --size 4000x4000 --aov normal,reflection,foam,depth" + out),
-               "needs 2640 MiB of device memory (the renderers' images and staging, the frames' "
+               "needs 2762 MiB of device memory (the renderers' images and staging, the frames' "
                "colour, depth and readback buffers), more than the 2048 MiB budget");
 }
 
