@@ -56,18 +56,21 @@ REPROJECT_TOLERANCE_M = 0.01
 # Vector Blur: the capture of each scene in tests/clients/scenes/ and what its camera does.
 PAN_RANGE = "2:3"
 PAN_FRAME = "frame_00002.exr"
-# Screen motion of the ground this frame, as the scene's camera moves (x right, y up): the camera
-# goes right (and up), so the world goes left (and down) on screen.
+# Which way motion.X,Y points as each scene's camera moves. Blender's Vector layout (Cycles'
+# primitive_motion_vector) holds where a point was in the previous frame minus where it is, x
+# right, y up. The cameras look down +z, so +x is their left: moving along +x (and up), the
+# camera sees the world go right (and down), and a point's previous position lies left (and up)
+# of its current one.
 PANS = {
     "pan_sideways": {"direction": (-1.0, 0.0)},
-    "pan_diagonal": {"direction": (-1.0, -1.0)},
+    "pan_diagonal": {"direction": (-1.0, 1.0)},
 }
 MIN_MEDIAN_MOTION_PX = 2.0  # the scenes move the ground 5 to 20 px a frame
 MAX_MOTION_ANGLE_DEG = 15.0  # median motion against the camera's direction on screen
 # Blender's Vector Blur, measured on neighbours that both move at least BLUR_MIN_PX: the gradient
-# energy it leaves along the motion against across it. With motion computed from the depth as the
-# pan scenes move (5 to 20 px) it left 0.29 along and 0.54 across sideways, 0.27 and 0.44 on the
-# diagonal; the diagonal with the opposite y sign leaves 0.45 along and 0.25 across.
+# energy it leaves along the motion against across it. On the pan scenes' frames (5 to 20 px of
+# motion) it leaves 0.29 along and 0.54 across sideways, 0.24 and 0.45 on the diagonal; fed the
+# diagonal's motion with y negated, 0.45 along and 0.27 across.
 BLUR_MIN_PX = 4.0
 MAX_ALONG_ACROSS_RATIO = 0.75
 MAX_ALONG_LEFT = 0.6
@@ -307,8 +310,8 @@ def check_blender_passes(frame, work_dir):
 
 
 def motion_stats(values):
-    """Median motion (this frame minus the previous, x right, y up, pixels) of the pixels that
-    see anything but sky, and how many they are."""
+    """Median motion.X and motion.Y (pixels) of the pixels that see anything but sky, and how
+    many they are."""
     depth = values["depth.Z"]
     seen = [i for i, d in enumerate(depth) if math.isfinite(d)]
     xs = sorted(values["motion.X"][i] for i in seen)
