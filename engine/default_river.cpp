@@ -20,6 +20,11 @@ float boulder_radius(const Obstacle& obstacle) {
   return radius;
 }
 
+glm::vec3 boulder_radii(const Obstacle& obstacle) {
+  const float radius = boulder_radius(obstacle);
+  return {radius, kBoulderHeightRatio * radius, 0.92f * radius};
+}
+
 glm::vec3 on_ground(const ProceduralRiver& river, float lateral_offset, float z) {
   const float x = river.centreline_x(z) + lateral_offset;
   return {x, river.terrain_height(x, z), z};

@@ -23,5 +23,7 @@ glm::vec3 on_ground(const ProceduralRiver& river, float lateral_offset, float z)
 // its centre, this much of that as high above it.
 inline constexpr float kBoulderHeightRatio = 0.95f;
 float boulder_radius(const Obstacle& obstacle);
+// The radii (x, y, z) of the ellipsoid the boulder is bumped from: slightly squat and narrow.
+glm::vec3 boulder_radii(const Obstacle& obstacle);
 
 }  // namespace siviflow

@@ -38,8 +38,7 @@ Status check_output_dir(const std::string& dir) {
 }
 
 Status check_aovs(const CaptureOptions& options, size_t river_count) {
-  if (river_count > 1 && (options.flow_aov || options.particles_aov || options.normal_aov ||
-                          options.reflection_aov || options.foam_aov)) {
+  if (river_count > 1 && water_layers(options)) {
     return Status::error(
         "--aov flow, particles, normal, reflection and foam are of one river; the scene has " +
         std::to_string(river_count) + " (depth works with any number)");
@@ -84,19 +83,22 @@ FrameExpectation frame_expectation(const CaptureOptions& options) {
   expected.aovs = aov_names(options);
   std::vector<std::string>& names = expected.channels;
   names = {"R", "G", "B", "A"};
-  if (options.depth_aov) names.push_back("depth.Z");
+  if (options.depth_aov) names.push_back(kDepthChannel);
+  if (water_layers(options)) names.push_back(kWaterMaskChannel);
   if (options.flow_aov) {
     names.insert(names.end(), std::begin(kFlowChannels), std::end(kFlowChannels));
-    names.push_back("water.mask");
   }
-  if (options.particles_aov) names.push_back("particle.id");
+  if (options.particles_aov) names.push_back(kParticleIdChannel);
   if (options.normal_aov) {
     names.insert(names.end(), std::begin(kNormalChannels), std::end(kNormalChannels));
   }
   if (options.reflection_aov) {
     names.insert(names.end(), std::begin(kReflectionChannels), std::end(kReflectionChannels));
   }
-  if (options.foam_aov) names.push_back("foam.Y");
+  if (options.foam_aov) names.push_back(kFoamChannel);
+  if (options.motion_aov) {
+    names.insert(names.end(), std::begin(kMotionChannels), std::end(kMotionChannels));
+  }
   std::sort(names.begin(), names.end());
   expected.software_version = version_string();
   return expected;
@@ -139,9 +141,12 @@ Status frames_to_render(const CaptureOptions& options, std::vector<bool>* render
 
 uint32_t capture_readback_images(const CaptureOptions& options) {
   uint32_t images = readback_bit(ReadbackImage::kColor);
-  if (options.depth_aov) images |= readback_bit(ReadbackImage::kDepth);
+  if (options.depth_aov || options.motion_aov) images |= readback_bit(ReadbackImage::kDepth);
+  if (water_layers(options) || options.motion_aov) {
+    images |= readback_bit(ReadbackImage::kWaterMask);
+  }
   if (options.flow_aov || options.particles_aov) {
-    images |= readback_bit(ReadbackImage::kWaterMask) | readback_bit(ReadbackImage::kFlowTexture);
+    images |= readback_bit(ReadbackImage::kFlowTexture);
   }
   if (options.normal_aov) images |= readback_bit(ReadbackImage::kNormal);
   if (options.reflection_aov) images |= readback_bit(ReadbackImage::kReflection);

@@ -49,18 +49,23 @@ void print_help() {
       "  --out DIR      existing folder to write into (required)\n"
       "  --seed S       simulation seed, recorded in the EXR metadata (default 1)\n"
       "  --fps F        frames per second of scene time (default 30)\n"
-      "  --aov LIST     comma list of extra EXR layers:\n"
-      "                 depth      depth.Z: view-axis distance in metres, +inf where only sky is seen\n"
-      "                 flow       flow.X/Y/Z: the flow texture upsampled (nearest) to the output;\n"
-      "                            water.mask: 1 where the river surface is visible\n"
-      "                 particles  particle.id: the id of the particle whose flow texel covers the\n"
-      "                            pixel, on visible water (-1 elsewhere); and beside each frame\n"
+      "  --aov LIST     comma list of extra EXR layers (the README's table has each one's units):\n"
+      "                 depth      depth.Z: view-axis distance in metres to the nearest surface,\n"
+      "                            water included; +inf where only sky is seen\n"
+      "                 flow       flow.X/Y/Z: the flow texture upsampled (nearest) to the output,\n"
+      "                            world space, m/s\n"
+      "                 particles  particle.I (UINT): the id of the particle whose flow texel covers\n"
+      "                            the pixel (0: none); and beside each frame\n"
       "                            frame_NNNNN.particles.csv: id,state,sx,sy,wx,wy,wz,fx,fy,fz,\n"
       "                            speed,depth,slope,fade\n"
-      "                 normal     normal.X/Y/Z: the final water normal in world space (0 off water)\n"
+      "                 normal     normal.X/Y/Z: the final water normal in world space\n"
       "                 reflection reflection.R/G/B: the reflection sample of the water before\n"
-      "                            blending (0 off water)\n"
+      "                            blending\n"
       "                 foam       foam.Y: how much of the water foam covers, 0 none to 1 full\n"
+      "                 motion     motion.X/Y/Z/W: the nearest surface's screen motion in pixels,\n"
+      "                            Blender's Vector pass layout (previous - now, now - next; y up)\n"
+      "                 Each of flow, particles, normal, reflection and foam comes with water.A,\n"
+      "                 1 where the river surface is visible, and is 0 wherever water.A is 0.\n"
       "  --preview      also write DIR/frame_NNNNN.png (sRGB, clamped)\n"
       "  --validation   run with the Khronos validation layer; any error fails the capture\n"
       "  --resume       render only the frames of the range that are missing or cannot be read\n"
@@ -121,9 +126,12 @@ Status parse_options(int argc, char** argv, CaptureOptions* options, bool* help)
           options->reflection_aov = true;
         } else if (aov == "foam") {
           options->foam_aov = true;
+        } else if (aov == "motion") {
+          options->motion_aov = true;
         } else {
           return Status::error("--aov: unknown AOV '" + aov +
-                               "' (available: depth, flow, particles, normal, reflection, foam)");
+                               "' (available: depth, flow, particles, normal, reflection, foam, "
+                               "motion)");
         }
       }
     } else if (arg == "--preview") {
@@ -156,6 +164,9 @@ struct SlotTargets {
   bool pending = false;  // a submitted frame whose readback has not been copied out yet
   uint32_t frame = 0;
   Camera camera;
+  Camera previous_camera;  // with the motion AOV, and the boulders that move about this frame
+  Camera next_camera;
+  std::vector<MovingBoulder> boulders;
   std::vector<Particle> particles;  // as simulated for this frame
 };
 
@@ -174,6 +185,8 @@ class Capture {
   uint32_t frames_written() const { return frames_to_write_; }
 
  private:
+  // With the motion AOV: the neighbouring frames' cameras and the boulders moving about `frame`.
+  Status record_motion(uint32_t frame, SlotTargets* slot) const;
   // Copies the slot's frame out of its readback buffers into `finished` (its buffers reused).
   void copy_out(const SlotTargets& slot, FinishedFrame* finished) const;
   void report_progress(uint32_t done_count);
@@ -210,6 +223,8 @@ Status Capture::run() {
   info.frames_in_flight = kFramesInFlight;
   info.depth_format = kDepthFormat;
   info.seed = options_.seed;
+  // Depth and motion are of the nearest surface, the water's included.
+  info.write_depth = options_.depth_aov || options_.motion_aov;
   const SceneFile* scene = plan_.scene.has_value() ? &*plan_.scene : nullptr;
   info.look = scene != nullptr ? &scene->look : nullptr;
   WorldCreateInfo world_info = context_->world_create_info(kOutputFormat, kDepthFormat);
@@ -277,6 +292,7 @@ Status Capture::run() {
     }
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->begin_frame(index));
     slot.camera = world_->scene_camera(time);
+    if (options_.motion_aov) SIVIFLOW_TRY(record_motion(frame, &slot));
     const View view = camera_view(slot.camera, extent);
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->update(view, time));
     const std::span<const Particle> particles = particle_field(*renderer_).particles();
@@ -309,10 +325,33 @@ Status Capture::run() {
   return Status::success();
 }
 
+Status Capture::record_motion(uint32_t frame, SlotTargets* slot) const {
+  const double time = static_cast<double>(frame) / options_.fps;
+  const double before = (static_cast<double>(frame) - 1.0) / options_.fps;
+  const double after = (static_cast<double>(frame) + 1.0) / options_.fps;
+  slot->previous_camera = world_->scene_camera(before);
+  slot->next_camera = world_->scene_camera(after);
+  slot->boulders.clear();
+  for (uint32_t i = 0; i < world_->boulder_count(); ++i) {
+    BoulderPose then;
+    BoulderPose now;
+    BoulderPose later;
+    SIVIFLOW_TRY(world_->boulder_at(i, before, &then));
+    SIVIFLOW_TRY(world_->boulder_at(i, time, &now));
+    SIVIFLOW_TRY(world_->boulder_at(i, after, &later));
+    if (!now.shown || (then.centre == now.centre && later.centre == now.centre)) continue;
+    slot->boulders.push_back({then.centre, now.centre, later.centre, now.radii});
+  }
+  return Status::success();
+}
+
 void Capture::copy_out(const SlotTargets& slot, FinishedFrame* finished) const {
   const size_t pixels = size_t{options_.size.width} * options_.size.height;
   finished->frame = slot.frame;
   finished->camera = slot.camera;
+  finished->previous_camera = slot.previous_camera;
+  finished->next_camera = slot.next_camera;
+  finished->boulders = slot.boulders;
   // Each read-back image's bytes; the images not read back are left empty.
   const auto copy = [&slot](ReadbackImage kind, size_t count, auto* out) {
     using T = typename std::remove_reference_t<decltype(*out)>::value_type;

@@ -26,11 +26,12 @@ struct CaptureOptions {
   bool resume = false;  // render only the frames of the range not already complete
   bool force = false;   // render over (or beside) frames of another capture instead of refusing
   bool depth_aov = false;
-  bool flow_aov = false;       // flow.X/Y/Z and water.mask
-  bool particles_aov = false;  // particle.id and frame_NNNNN.particles.csv
+  bool flow_aov = false;       // flow.X/Y/Z and water.A
+  bool particles_aov = false;  // particle.I and frame_NNNNN.particles.csv
   bool normal_aov = false;     // normal.X/Y/Z
   bool reflection_aov = false; // reflection.R/G/B
   bool foam_aov = false;       // foam.Y
+  bool motion_aov = false;     // motion.X/Y/Z/W
   std::string scene_digest;    // scene_content_digest, set by plan_capture
 };
 
@@ -40,7 +41,8 @@ inline std::string aov_names(const CaptureOptions& options) {
   const std::pair<bool, const char*> aovs[] = {
       {options.depth_aov, "depth"},           {options.flow_aov, "flow"},
       {options.particles_aov, "particles"},   {options.normal_aov, "normal"},
-      {options.reflection_aov, "reflection"}, {options.foam_aov, "foam"}};
+      {options.reflection_aov, "reflection"}, {options.foam_aov, "foam"},
+      {options.motion_aov, "motion"}};
   std::string names;
   for (const auto& [asked, name] : aovs) {
     if (asked) names += (names.empty() ? "" : ",") + std::string(name);
@@ -48,10 +50,27 @@ inline std::string aov_names(const CaptureOptions& options) {
   return names;
 }
 
-// The EXR channels of the AOVs made of three planes.
+// Whether the frame has water layers, and with them the water mask they are zero outside of.
+inline bool water_layers(const CaptureOptions& options) {
+  return options.flow_aov || options.particles_aov || options.normal_aov ||
+         options.reflection_aov || options.foam_aov;
+}
+
+// The particle layer's id where no particle's texel covers visible water (ids start at 1).
+inline constexpr uint32_t kNoParticleId = 0;
+
+// The EXR channels of the AOVs (the README's table says what each holds). Every channel is
+// LAYER.C with a one-letter C: Blender's reader drops a layer with a longer one.
+inline constexpr const char* kDepthChannel = "depth.Z";
+inline constexpr const char* kWaterMaskChannel = "water.A";
+inline constexpr const char* kParticleIdChannel = "particle.I";  // UINT; 0: no particle
+inline constexpr const char* kFoamChannel = "foam.Y";
 inline constexpr const char* kFlowChannels[3] = {"flow.X", "flow.Y", "flow.Z"};
 inline constexpr const char* kNormalChannels[3] = {"normal.X", "normal.Y", "normal.Z"};
 inline constexpr const char* kReflectionChannels[3] = {"reflection.R", "reflection.G",
                                                        "reflection.B"};
+// Blender's Vector pass layout (tools/motion_vectors.h).
+inline constexpr const char* kMotionChannels[4] = {"motion.X", "motion.Y", "motion.Z",
+                                                   "motion.W"};
 
 }  // namespace siviflow

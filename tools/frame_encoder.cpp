@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 
 #include "renderer_inspect.h"
@@ -16,11 +17,31 @@ namespace siviflow {
 namespace {
 
 // Window depth (0 near .. 1 far, glm::perspectiveRH_ZO) to distance along the view axis.
+// In doubles: far from the camera, window depth + a cancels to a few significant bits.
 float linear_depth(float window_depth, float near_plane, float far_plane) {
   if (window_depth >= 1.0f) return std::numeric_limits<float>::infinity();
-  const float a = far_plane / (near_plane - far_plane);
-  const float b = far_plane * near_plane / (near_plane - far_plane);
-  return b / (window_depth + a);
+  const double a = double{far_plane} / (double{near_plane} - far_plane);
+  const double b = double{far_plane} * near_plane / (double{near_plane} - far_plane);
+  return static_cast<float>(b / (window_depth + a));
+}
+
+// The frame's camera in OpenEXR's conventions (siviflow/image_files.h, ExrCamera).
+ExrCamera exr_camera(const Camera& camera, VkExtent2D extent) {
+  const View view = camera_view(camera, extent);
+  // Our view space looks down -Z; OpenEXR's camera space looks down +Z, x right, y up.
+  const glm::mat4 world_to_camera = glm::scale(glm::mat4(1.0f), {1.0f, 1.0f, -1.0f}) * view.view;
+  // Vulkan clip space (x right, y down, -1..1) to NDC (0..1 from the top-left corner).
+  const glm::mat4 clip_to_ndc = glm::translate(glm::mat4(1.0f), {0.5f, 0.5f, 0.0f}) *
+                                glm::scale(glm::mat4(1.0f), {0.5f, 0.5f, 1.0f});
+  const glm::mat4 world_to_ndc = clip_to_ndc * view.projection * view.view;
+  ExrCamera out;
+  out.present = true;
+  std::memcpy(out.world_to_camera, &world_to_camera[0][0], sizeof(out.world_to_camera));
+  std::memcpy(out.world_to_ndc, &world_to_ndc[0][0], sizeof(out.world_to_ndc));
+  out.fov_y_deg = camera.fov_y_deg;
+  out.near_plane = camera.near_plane;
+  out.far_plane = camera.far_plane;
+  return out;
 }
 
 std::vector<uint32_t> texel_columns(uint32_t width, uint32_t texel_px) {
@@ -64,43 +85,44 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
     for (size_t i = 0; i < pixels; ++i) {
       depth_[i] = linear_depth(finished.window_depth[i], camera.near_plane, camera.far_plane);
     }
-    frame.layers.push_back({"depth", ExrCompression::kZip, {{"depth.Z", depth_.data()}}});
+    frame.layers.push_back({"depth", ExrCompression::kZip, {{kDepthChannel, depth_.data()}}});
   }
   if (options_.flow_aov || options_.particles_aov) decode_flow_texture(finished.flow_texture);
-  // The flow texture upsampled (nearest) to the output: the texel under each pixel.
-  const auto for_each_pixel = [&](auto&& visit) {
+  // The flow texture upsampled (nearest) to the output: the texel under each pixel, on visible
+  // water only (a texel reaches past the water's edge).
+  const auto for_each_water_pixel = [&](auto&& visit) {
     for (uint32_t y = 0; y < height; ++y) {
       const size_t texel_row = size_t{y / layout_.texel_px} * layout_.flow_extent.x;
       for (uint32_t x = 0; x < width; ++x) {
-        visit(size_t{y} * width + x, texel_row + texel_column_[x]);
+        const size_t pixel = size_t{y} * width + x;
+        if (finished.water_mask[pixel] > 0.5f) visit(pixel, texel_row + texel_column_[x]);
       }
     }
   };
+  if (water_layers(options_)) {
+    frame.layers.push_back(
+        {"water", ExrCompression::kZip, {{kWaterMaskChannel, finished.water_mask.data()}}});
+  }
   // Flow, mask and ids are constant over texels and regions: deflate finds the repeated rows.
   if (options_.flow_aov) {
-    for (std::vector<float>& plane : flow_) plane.resize(pixels);
-    for_each_pixel([&](size_t pixel, size_t texel) {
+    for (std::vector<float>& plane : flow_) plane.assign(pixels, 0.0f);
+    for_each_water_pixel([&](size_t pixel, size_t texel) {
       for (int c = 0; c < 3; ++c) flow_[c][pixel] = texel_flow_[texel][c];
     });
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"flow", ExrCompression::kZip, {}});
     for (int c = 0; c < 3; ++c) layer.channels.push_back({kFlowChannels[c], flow_[c].data()});
-    frame.layers.push_back(
-        {"water", ExrCompression::kZip, {{"water.mask", finished.water_mask.data()}}});
   }
   if (options_.particles_aov) {
     // The flow texture holds GPU slots; the layer and the CSV use the ids unique over the run.
-    std::vector<float> id_of_slot(size_t{layout_.slot_count} + 1, -1.0f);
-    for (const Particle& particle : finished.particles) {
-      id_of_slot[particle.slot] = static_cast<float>(particle.id);
-    }
-    particle_id_.resize(pixels);
-    for_each_pixel([&](size_t pixel, size_t texel) {
+    std::vector<uint32_t> id_of_slot(size_t{layout_.slot_count} + 1, kNoParticleId);
+    for (const Particle& particle : finished.particles) id_of_slot[particle.slot] = particle.id;
+    particle_id_.assign(pixels, kNoParticleId);
+    for_each_water_pixel([&](size_t pixel, size_t texel) {
       const uint32_t slot = texel_slot_[texel];
-      const bool on_water = finished.water_mask[pixel] > 0.5f;
-      particle_id_[pixel] = on_water && slot <= layout_.slot_count ? id_of_slot[slot] : -1.0f;
+      if (slot <= layout_.slot_count) particle_id_[pixel] = id_of_slot[slot];
     });
-    frame.layers.push_back(
-        {"particle", ExrCompression::kZip, {{"particle.id", particle_id_.data()}}});
+    ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"particle", ExrCompression::kZip, {}});
+    layer.channels.push_back({kParticleIdChannel, nullptr, 1, particle_id_.data()});
   }
   // The water's own layers are zero off the water, which RLE packs as well as deflate does, and
   // their noisy low mantissa bytes on it defeat deflate: RLE at a third of its time.
@@ -112,13 +134,30 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
   if (options_.normal_aov) add_rgb("normal", finished.normal, kNormalChannels);
   if (options_.reflection_aov) add_rgb("reflection", finished.reflection, kReflectionChannels);
   if (options_.foam_aov) {
-    frame.layers.push_back({"foam", ExrCompression::kZip, {{"foam.Y", finished.foam.data()}}});
+    frame.layers.push_back({"foam", ExrCompression::kZip, {{kFoamChannel, finished.foam.data()}}});
+  }
+  if (options_.motion_aov) {
+    const VkExtent2D extent{width, height};
+    MotionFrame motion;
+    motion.width = width;
+    motion.height = height;
+    motion.window_depth = finished.window_depth.data();
+    motion.water_mask = finished.water_mask.data();
+    motion.previous = camera_view(finished.previous_camera, extent);
+    motion.current = camera_view(finished.camera, extent);
+    motion.next = camera_view(finished.next_camera, extent);
+    motion.boulders = finished.boulders;
+    compute_motion(motion, &motion_);
+    ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"motion", ExrCompression::kZip, {}});
+    for (int c = 0; c < 4; ++c) layer.channels.push_back({kMotionChannels[c], motion_.data() + c, 4});
   }
   frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
   frame.metadata.frame = static_cast<int>(finished.frame);
   frame.metadata.time_seconds = static_cast<float>(finished.frame / options_.fps);
   frame.metadata.seed = static_cast<int>(options_.seed);
   frame.metadata.software_version = version_string();
+  frame.metadata.frames_per_second = options_.fps;
+  frame.metadata.camera = exr_camera(finished.camera, {width, height});
   frame.metadata.scene_digest = options_.scene_digest;
   frame.metadata.fps = options_.fps;
   frame.metadata.aovs = aov_names(options_);

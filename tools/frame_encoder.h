@@ -11,6 +11,7 @@
 #include <glm/vec3.hpp>
 
 #include "capture_options.h"
+#include "motion_vectors.h"
 #include "sim/flow_textures.h"
 #include "sim/particles.h"
 #include "siviflow/renderer.h"
@@ -23,6 +24,10 @@ namespace siviflow {
 struct FinishedFrame {
   uint32_t frame = 0;
   Camera camera;
+  // With the motion AOV: the cameras of the frames before and after, and the keyed boulders.
+  Camera previous_camera;
+  Camera next_camera;
+  std::vector<MovingBoulder> boulders;
   std::vector<uint16_t> color_halves;
   std::vector<float> window_depth;
   std::vector<float> water_mask;
@@ -60,7 +65,8 @@ class FrameEncoder {
   std::vector<float> rgba_;  // the preview's
   std::vector<float> depth_;
   std::vector<float> flow_[3];
-  std::vector<float> particle_id_;
+  std::vector<uint32_t> particle_id_;
+  std::vector<float> motion_;
   std::vector<glm::vec3> texel_flow_;
   std::vector<uint32_t> texel_slot_;
 };

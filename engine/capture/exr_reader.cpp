@@ -9,6 +9,7 @@
 #include <ImfIntAttribute.h>
 #include <ImfMultiPartInputFile.h>
 #include <ImfPartType.h>
+#include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
 #include <ImfThreading.h>
 #include <ImfTileDescriptionAttribute.h>
@@ -17,6 +18,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <limits>
 #include <set>
@@ -181,6 +183,26 @@ void read_attributes(const Imf::Header& header, ExrImage* image) {
   if (auto f = image->float_attributes.find(kExrAttrTime); f != image->float_attributes.end()) {
     image->metadata.time_seconds = f->second;
   }
+  if (Imf::hasFramesPerSecond(header)) {
+    image->metadata.frames_per_second = double(Imf::framesPerSecond(header));
+  }
+  ExrCamera& camera = image->metadata.camera;
+  camera.present = Imf::hasWorldToCamera(header);
+  if (camera.present) {
+    std::memcpy(camera.world_to_camera, &Imf::worldToCamera(header)[0][0],
+                sizeof(camera.world_to_camera));
+  }
+  if (Imf::hasWorldToNDC(header)) {
+    std::memcpy(camera.world_to_ndc, &Imf::worldToNDC(header)[0][0], sizeof(camera.world_to_ndc));
+  }
+  const auto float_attribute = [image](const char* name, float* out) {
+    if (auto f = image->float_attributes.find(name); f != image->float_attributes.end()) {
+      *out = f->second;
+    }
+  };
+  float_attribute(kExrAttrFovY, &camera.fov_y_deg);
+  float_attribute(kExrAttrNear, &camera.near_plane);
+  float_attribute(kExrAttrFar, &camera.far_plane);
   if (auto s = image->string_attributes.find(kExrAttrSceneDigest);
       s != image->string_attributes.end()) {
     image->metadata.scene_digest = s->second;
@@ -241,7 +263,7 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
         return Status::error(where + ": channel '" + it.name() +
                              "' is in an earlier part too (unsupported)");
       }
-      samples += pixel_count;
+      samples += pixel_count * (channel.type == Imf::UINT ? 2 : 1);  // ids and their floats
       if (samples > kMaxReadSamples) return Status::error(where + ": too many samples");
     }
     least_bytes += least_file_bytes(channel_count * pixel_count, header.compression());
@@ -258,14 +280,25 @@ Status read_exr_impl(const std::string& path, ExrImage* out) {
       plane.type = pixel_type(it.channel().type);
       plane.compression = compression_name(header.compression());
       plane.pixels.assign(static_cast<size_t>(pixel_count), 0.0f);
-      frame_buffer.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, plane.pixels.data(), window,
-                                                      sizeof(float),
-                                                      sizeof(float) * static_cast<size_t>(width)));
+      // Identifiers are read as stored, then rounded to floats, so that both stay exact.
+      void* destination = plane.pixels.data();
+      Imf::PixelType type = Imf::FLOAT;
+      if (plane.type == ExrPixelType::kUint) {
+        plane.ids.assign(static_cast<size_t>(pixel_count), 0u);
+        destination = plane.ids.data();
+        type = Imf::UINT;
+      }
+      frame_buffer.insert(it.name(), Imf::Slice::Make(type, destination, window, 4,
+                                                      4 * static_cast<size_t>(width)));
     }
     {
       Imf::InputPart part(file, p);
       part.setFrameBuffer(frame_buffer);
       part.readPixels(window.min.y, window.max.y);
+    }
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      ExrPlane& plane = image.channels[it.name()];
+      for (size_t i = 0; i < plane.ids.size(); ++i) plane.pixels[i] = static_cast<float>(plane.ids[i]);
     }
     file.flushPartCache();  // this part's line or tile buffers go before the next part's come
   }

@@ -9,6 +9,7 @@
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
+#include <ImfStandardAttributes.h>
 #include <ImfStringAttribute.h>
 #include <ImfThreading.h>
 #include <Imath/half.h>
@@ -88,8 +89,9 @@ Status validate(const ExrFrame& frame, const std::string& what) {
     }
     for (const ExrChannel& channel : layer.channels) {
       if (channel.name.empty()) return Status::error(what + ": a data channel has no name");
-      if (channel.pixels == nullptr) {
-        return Status::error(what + ": data channel '" + channel.name + "' has no pixels");
+      if ((channel.pixels == nullptr) == (channel.ids == nullptr)) {
+        return Status::error(what + ": data channel '" + channel.name +
+                             "' needs its pixels as floats or as ids, one of the two");
       }
       if (channel.stride < 1) {
         return Status::error(what + ": data channel '" + channel.name + "' has stride " +
@@ -129,6 +131,21 @@ Imf::Header part_header(const ExrFrame& frame, ExrCompression compression,
   header.insert(kExrAttrTime, Imf::FloatAttribute(frame.metadata.time_seconds));
   header.insert(kExrAttrSeed, Imf::IntAttribute(frame.metadata.seed));
   header.insert(kExrAttrSoftware, Imf::StringAttribute(frame.metadata.software_version));
+  if (frame.metadata.frames_per_second > 0.0) {
+    Imf::addFramesPerSecond(header, Imf::Rational(frame.metadata.frames_per_second));
+  }
+  const ExrCamera& camera = frame.metadata.camera;
+  if (camera.present) {
+    Imath::M44f world_to_camera;
+    Imath::M44f world_to_ndc;
+    std::memcpy(&world_to_camera[0][0], camera.world_to_camera, sizeof(camera.world_to_camera));
+    std::memcpy(&world_to_ndc[0][0], camera.world_to_ndc, sizeof(camera.world_to_ndc));
+    Imf::addWorldToCamera(header, world_to_camera);
+    Imf::addWorldToNDC(header, world_to_ndc);
+    header.insert(kExrAttrFovY, Imf::FloatAttribute(camera.fov_y_deg));
+    header.insert(kExrAttrNear, Imf::FloatAttribute(camera.near_plane));
+    header.insert(kExrAttrFar, Imf::FloatAttribute(camera.far_plane));
+  }
   header.insert(kExrAttrSceneDigest, Imf::StringAttribute(frame.metadata.scene_digest));
   header.insert(kExrAttrFps, Imf::FloatAttribute(frame.metadata.fps));
   header.insert(kExrAttrAovs, Imf::StringAttribute(frame.metadata.aovs));
@@ -167,11 +184,13 @@ Status encode_exr_named(const ExrFrame& frame, const std::string& name,
     const ExrLayer& layer = frame.layers[i];
     headers.push_back(part_header(frame, layer.compression, layer.name));
     for (const ExrChannel& channel : layer.channels) {
-      headers.back().channels().insert(channel.name, Imf::Channel(Imf::FLOAT));
-      char* base = const_cast<char*>(reinterpret_cast<const char*>(channel.pixels));
-      const size_t pixel = sizeof(float) * static_cast<size_t>(channel.stride);
-      frame_buffers[i + 1].insert(channel.name,
-                                  Imf::Slice(Imf::FLOAT, base, pixel, pixel * width));
+      const Imf::PixelType type = channel.ids != nullptr ? Imf::UINT : Imf::FLOAT;
+      headers.back().channels().insert(channel.name, Imf::Channel(type));
+      const void* samples = channel.ids != nullptr ? static_cast<const void*>(channel.ids)
+                                                   : static_cast<const void*>(channel.pixels);
+      char* base = const_cast<char*>(static_cast<const char*>(samples));
+      const size_t pixel = 4 * static_cast<size_t>(channel.stride);  // float and uint alike
+      frame_buffers[i + 1].insert(channel.name, Imf::Slice(type, base, pixel, pixel * width));
     }
   }
 

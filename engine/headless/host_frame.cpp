@@ -80,8 +80,10 @@ Status record_view(VkCommandBuffer cmd, World& world, std::span<Renderer* const>
     inputs.color.current = color_now;
     inputs.depth.current = depth_now;
     if (!last) {
+      // As the world left them: a river that wrote its depth would otherwise make the layout
+      // change visible to the next river's depth test alone, not to its sampling.
       inputs.color.final = color_attachment;
-      inputs.depth.final = image_state(Access::DepthAttachmentRead, targets->depth.format);
+      inputs.depth.final = image_state(Access::DepthAttachmentWrite, targets->depth.format);
     }
     if (last) inputs.readback = readback;
     SIVIFLOW_TRY(renderers[i]->record(cmd, inputs));

@@ -108,10 +108,8 @@ void add_tree(glm::vec3 foot, float height, SceneGeometry* geometry) {
 // The obstacles: a boulder as wide as each footprint, slightly squat, modelled at the origin.
 void add_obstacle_boulders(const std::vector<Obstacle>& obstacles, SceneGeometry* geometry) {
   for (size_t i = 0; i < obstacles.size(); ++i) {
-    const float radius = boulder_radius(obstacles[i]);
     const uint32_t first = static_cast<uint32_t>(geometry->indices.size());
-    add_boulder(glm::vec3(0.0f), {radius, kBoulderHeightRatio * radius, 0.92f * radius},
-                i % 2 == 0 ? kGranite : kSandstone, 3.0f + static_cast<float>(i), geometry);
+    add_boulder(glm::vec3(0.0f), boulder_radii(obstacles[i]), i % 2 == 0 ? kGranite : kSandstone, 3.0f + static_cast<float>(i), geometry);
     geometry->obstacle_boulders.push_back({first, static_cast<uint32_t>(geometry->indices.size()) - first});
   }
 }

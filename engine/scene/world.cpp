@@ -119,6 +119,10 @@ struct World::Impl {
   Status declare_graph();
   gpu::SceneConstants view_constants(const glm::mat4& view_proj, const glm::vec3& camera,
                                      const glm::vec4& clip_plane, bool reverse) const;
+  // Where boulder `i` stands at time `at`: where the host placed it, or where its keys put it.
+  glm::vec3 boulder_centre(size_t i, double at) const {
+    return placed[i] ? *placed[i] : obstacle_centre_at(obstacles[i], at);
+  }
   void select_draws(const CullView& view, const gpu::SceneConstants& constants, size_t which,
                     std::vector<SceneDraw>* draws, uint32_t* triangles);
   void destroy();
@@ -282,8 +286,7 @@ void World::Impl::select_draws(const CullView& view, const gpu::SceneConstants& 
   for (const auto& entry : seen) draws->push_back(entry.second);
   for (size_t i = 0; i < obstacles.size(); ++i) {
     if (!shown[i]) continue;
-    const glm::vec3 centre = placed[i] ? *placed[i] : obstacle_centre_at(obstacles[i], time);
-    obstacle_constants[2 * i + which] = translated(constants, centre);
+    obstacle_constants[2 * i + which] = translated(constants, boulder_centre(i, time));
     draws->push_back({boulders[i].first_index, boulders[i].index_count,
                       &obstacle_constants[2 * i + which]});
   }
@@ -398,6 +401,18 @@ Status World::hide_boulder(uint32_t index) {
                        std::to_string(boulder_count()) + ")");
   }
   impl_->shown[index] = false;
+  return Status::success();
+}
+
+Status World::boulder_at(uint32_t index, double time_seconds, BoulderPose* out) const {
+  if (index >= boulder_count()) {
+    return world_error("boulder_at: no boulder " + std::to_string(index) + " (there are " +
+                       std::to_string(boulder_count()) + ")");
+  }
+  if (out == nullptr) return world_error("boulder_at: out is null");
+  out->shown = impl_->shown[index];
+  out->centre = impl_->boulder_centre(index, time_seconds);
+  out->radii = boulder_radii(impl_->obstacles[index]);
   return Status::success();
 }
 

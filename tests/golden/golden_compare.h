@@ -1,6 +1,8 @@
 // Compares a rendered EXR with a golden one within a tolerance, as llvmpipe output is not
-// bit-identical across CPUs: per channel |a - b| <= abs_tol + rel_tol * |golden|, and a small
-// fraction of pixels may fail (geometry edges). On failure a diff image is written beside.
+// bit-identical across CPUs: per channel |a - b| <= abs_tol + rel_tol * |golden| (equal
+// infinities, the sky's depth, agree), and a small fraction of pixels may fail (geometry edges).
+// The beauty's R, G, B and A are compared, and the depth and water mask where the golden has
+// them. On failure a diff image (R, G, B) is written beside.
 #pragma once
 
 #include <algorithm>
@@ -16,6 +18,7 @@ struct GoldenTolerance {
   float abs_tol = 0.02f;
   float rel_tol = 0.02f;
   double max_failing_fraction = 0.005;
+  bool beauty_only = false;  // R, G, B and A alone: a frame rendered without the AOVs
 };
 
 struct GoldenResult {
@@ -40,14 +43,17 @@ inline GoldenResult compare_with_golden(const std::string& rendered, const std::
     result.message = "size differs from the golden";
     return result;
   }
-  const std::vector<float>* channels[2][3] = {{a.find("R"), a.find("G"), a.find("B")},
-                                              {b.find("R"), b.find("G"), b.find("B")}};
-  for (const auto& image : channels) {
-    for (const std::vector<float>* channel : image) {
-      if (channel == nullptr) {
-        result.message = "an image lacks one of the R, G, B channels";
-        return result;
-      }
+  std::vector<std::string> names = {"R", "G", "B", "A"};
+  for (const char* layer : {"depth.Z", "water.A"}) {
+    if (!tol.beauty_only && b.find(layer) != nullptr) names.push_back(layer);
+  }
+  std::vector<const std::vector<float>*> channels[2];
+  for (const std::string& name : names) {
+    channels[0].push_back(a.find(name));
+    channels[1].push_back(b.find(name));
+    if (channels[0].back() == nullptr || channels[1].back() == nullptr) {
+      result.message = "an image lacks the channel " + name;
+      return result;
     }
   }
   const size_t pixels = size_t(a.width) * a.height;
@@ -55,13 +61,13 @@ inline GoldenResult compare_with_golden(const std::string& rendered, const std::
   size_t failing = 0;
   for (size_t i = 0; i < pixels; ++i) {
     bool bad = false;
-    for (int c = 0; c < 3; ++c) {
+    for (size_t c = 0; c < names.size(); ++c) {
       const float va = (*channels[0][c])[i];
       const float vb = (*channels[1][c])[i];
-      const float d = std::abs(va - vb);
+      const float d = va == vb ? 0.0f : std::abs(va - vb);
       result.max_diff = std::max(result.max_diff, d);
       bad = bad || !(d <= tol.abs_tol + tol.rel_tol * std::abs(vb));  // NaN fails too
-      diff[i * 4 + c] = std::min(1.0f, d * 10.0f);
+      if (c < 3) diff[i * 4 + c] = std::min(1.0f, d * 10.0f);
     }
     failing += bad ? 1 : 0;
   }

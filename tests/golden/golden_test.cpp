@@ -1,5 +1,6 @@
 // Golden frames: three views of the default scene at 320x180, rendered by `siviflow capture`
-// on lavapipe with validation, compared with tests/golden/*.exr within a tolerance.
+// on lavapipe with validation, compared with tests/golden/*.exr within a tolerance: the beauty
+// with its alpha, the depth and the water mask.
 // Regenerate them only on purpose: tools/scripts/update_goldens.sh.
 #include <filesystem>
 #include <string>
@@ -22,7 +23,8 @@ TEST_P(GoldenTest, DefaultSceneFrameMatchesGolden) {
   fs::remove_all(out);
   fs::create_directories(out);
   const RunResult r = run_siviflow("capture --range " + std::to_string(frame) + ":" +
-                                   std::to_string(frame + 1) + " --size 320x180 --validation --out " +
+                                   std::to_string(frame + 1) +
+                                   " --size 320x180 --aov depth,flow --validation --out " +
                                    out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   char name[32];

@@ -62,7 +62,7 @@ TEST_F(CliTest, BadSizes) {
                "--size 16000x16000 (with the AOVs asked for) needs 12825 MiB of device memory");
   // The AOVs' attachments and readback buffers count: this size fits without them, not with them.
   expect_error(run_siviflow("capture --size 4000x4000 --aov normal,reflection,foam,depth" + out),
-               "needs 2640 MiB of device memory (the renderers' images and staging, the frames' "
+               "needs 2762 MiB of device memory (the renderers' images and staging, the frames' "
                "colour, depth and readback buffers), more than the 2048 MiB budget");
 }
 
@@ -213,12 +213,14 @@ TEST_F(CliTest, FlowAndParticleAovs) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   ExrImage image;
   ASSERT_TRUE(read_exr((dir_ / "frame_00001.exr").string(), &image).ok());
-  for (const char* channel : {"flow.X", "flow.Y", "flow.Z", "water.mask", "particle.id"}) {
+  for (const char* channel : {"flow.X", "flow.Y", "flow.Z", "water.A"}) {
     ASSERT_NE(image.find(channel), nullptr) << channel;
     EXPECT_EQ(image.channels.at(channel).type, ExrPixelType::kFloat) << channel;
   }
+  ASSERT_NE(image.find("particle.I"), nullptr);
+  EXPECT_EQ(image.channels.at("particle.I").type, ExrPixelType::kUint);
   EXPECT_EQ(image.find("depth.Z"), nullptr) << "only the AOVs asked for";
-  // The CSV: its header, and ids that are exactly those the particle.id layer shows.
+  // The CSV: its header, and ids that are exactly those the particle.I layer shows.
   const std::string csv = read_file(dir_ / "frame_00001.particles.csv");
   ASSERT_EQ(csv.rfind("id,state,sx,sy,wx,wy,wz,fx,fy,fz,speed,depth,slope,fade\n", 0), 0u) << csv.substr(0, 200);
   std::set<long> csv_ids;
@@ -233,17 +235,17 @@ TEST_F(CliTest, FlowAndParticleAovs) {
     start = end + 1;
   }
   ASSERT_GT(csv_ids.size(), 10u);
-  const std::vector<float>& ids = *image.find("particle.id");
-  const std::vector<float>& mask = *image.find("water.mask");
+  const std::vector<uint32_t>& ids = image.channels.at("particle.I").ids;
+  const std::vector<float>& mask = *image.find("water.A");
   size_t water = 0;
   size_t covered = 0;
   for (size_t i = 0; i < ids.size(); ++i) {
     if (mask[i] == 0.0f) {
-      EXPECT_EQ(ids[i], -1.0f) << "pixel " << i << " is not water";
+      EXPECT_EQ(ids[i], 0u) << "pixel " << i << " is not water";
     } else {
       ++water;
       // Water pixels at the very bank may miss the river in the particles' ray cast.
-      if (ids[i] == -1.0f) continue;
+      if (ids[i] == 0u) continue;
       ++covered;
       EXPECT_TRUE(csv_ids.count(static_cast<long>(ids[i])) == 1) << "pixel " << i << " id " << ids[i];
       EXPECT_NE(image.find("flow.Z")->at(i), 0.0f) << "a particle with no flow at pixel " << i;
@@ -370,7 +372,7 @@ TEST_F(CliTest, RangeShardsEqualTheFullRun) {
     ExrImage b;
     ASSERT_TRUE(read_exr((full / name).string(), &a).ok());
     ASSERT_TRUE(read_exr((shard / name).string(), &b).ok());
-    for (const char* channel : {"R", "G", "B", "A", "particle.id"}) {
+    for (const char* channel : {"R", "G", "B", "A", "particle.I"}) {
       EXPECT_EQ(*a.find(channel), *b.find(channel)) << name << " " << channel;
     }
   }

@@ -43,7 +43,7 @@ ExrImage capture(const fs::path& scene, const fs::path& out, const std::string& 
 
 std::vector<bool> water_of(const ExrImage& image) {
   std::vector<bool> water;
-  if (const std::vector<float>* mask = image.find("water.mask")) {
+  if (const std::vector<float>* mask = image.find("water.A")) {
     for (float m : *mask) water.push_back(m > 0.5f);
   }
   return water;

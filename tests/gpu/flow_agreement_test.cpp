@@ -120,7 +120,7 @@ std::vector<WaterPixel> water_pixels(const ExrImage& image, const Camera& camera
   for (int y = 0; y < kHeight; ++y) {
     for (int x = 0; x < kWidth; ++x) {
       const size_t i = size_t(y) * kWidth + x;
-      if ((*image.find("water.mask"))[i] != 1.0f) continue;
+      if ((*image.find("water.A"))[i] != 1.0f) continue;
       const glm::vec2 flow((*image.find("flow.X"))[i], (*image.find("flow.Z"))[i]);
       if (glm::length(flow) < 0.2f) continue;  // still water: no direction to compare
       const glm::vec4 far = inverse * glm::vec4(2.0f * (x + 0.5f) / kWidth - 1.0f,
@@ -242,7 +242,7 @@ TEST_F(FlowAgreement, NextFrameFollowsTheMovedObstacle) {
 
   // The flow AOV over each re-routed particle's pixels is that particle's (new) flow.
   size_t pixels = 0;
-  const std::vector<float>& ids = *image.find("particle.id");
+  const std::vector<float>& ids = *image.find("particle.I");
   for (size_t i = 0; i < ids.size(); ++i) {
     const int id = static_cast<int>(ids[i]);
     if (std::find(rerouted.begin(), rerouted.end(), id) == rerouted.end()) continue;

@@ -52,7 +52,9 @@ TEST_F(PassTimingTest, PassesComeNamedInOrderInsideTheFrame) {
     double sum = 0.0;
     for (size_t i = 0; i < water.size(); ++i) {
       EXPECT_GE(water[i].milliseconds, 0.0) << water[i].name;
-      if (i > 0) EXPECT_GE(water[i].begin_ms, water[i - 1].begin_ms) << water[i].name;
+      if (i > 0) {
+        EXPECT_GE(water[i].begin_ms, water[i - 1].begin_ms) << water[i].name;
+      }
       sum += water[i].milliseconds;
     }
     std::vector<PassTime> world;

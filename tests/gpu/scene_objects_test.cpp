@@ -84,7 +84,7 @@ TEST_F(SceneObjectsTest, ObjectAboveTheWaterIsReflectedAndOneUnderItIsNot) {
                                  "reflection,flow");
   const ExrImage under = capture("under", object("stone.gltf", {8.5f, -1.0f, -28.0f}), kRiverCamera,
                                  "reflection,flow");
-  const std::vector<float>* mask = none.find("water.mask");
+  const std::vector<float>* mask = none.find("water.A");
   ASSERT_NE(mask, nullptr);
   size_t water = 0;
   size_t reflected = 0;
@@ -156,8 +156,8 @@ TEST_F(SceneObjectsTest, GltfRiverFlowsDownstreamAroundAnObjectObstacle) {
   size_t water = 0;
   size_t downstream = 0;
   size_t aside = 0;  // turned by more than 6 degrees
-  for (size_t i = 0; i < image.find("water.mask")->size(); ++i) {
-    if ((*image.find("water.mask"))[i] != 1.0f) continue;
+  for (size_t i = 0; i < image.find("water.A")->size(); ++i) {
+    if ((*image.find("water.A"))[i] != 1.0f) continue;
     ++water;
     const glm::vec3 flow((*image.find("flow.X"))[i], (*image.find("flow.Y"))[i], (*image.find("flow.Z"))[i]);
     downstream += (glm::length(flow) > 0.1f && flow.z > 0.9f * glm::length(flow)) ? 1 : 0;
@@ -182,7 +182,7 @@ TEST_F(SceneObjectsTest, GltfRiverHasGroundAroundIt) {
   ExrImage image;
   ASSERT_NO_FATAL_FAILURE(capture_file(scene, 1, "--aov depth,flow --validation", &image));
   const std::vector<float>& depth = *image.find("depth.Z");
-  const std::vector<float>& mask = *image.find("water.mask");
+  const std::vector<float>& mask = *image.find("water.A");
   const std::vector<float>& green = *image.find("G");
   size_t void_pixels = 0, water = 0, ground = 0, grassy = 0;
   for (size_t i = 0; i < depth.size(); ++i) {

@@ -300,6 +300,66 @@ TEST_F(ImageFilesExr, HalfBeautyIsWrittenBitForBitAndStridedChannelsAreGathered)
   }
 }
 
+// Identifiers go in as UINT and come back exact (beyond a float's 2^24), beside their floats;
+// the camera and frame rate come back as written, in OpenEXR's standard attributes.
+TEST_F(ImageFilesExr, IdentifiersAsUintAndTheCameraInStandardAttributes) {
+  TestFrame data(5, 2);
+  std::vector<uint32_t> ids(10);
+  for (uint32_t i = 0; i < ids.size(); ++i) ids[i] = i == 3 ? 0u : (1u << 24) + 1u + i;
+  ExrFrame frame = data.frame();
+  frame.layers.push_back({"particle", ExrCompression::kZip, {{"particle.I", nullptr, 1, ids.data()}}});
+  frame.metadata.frames_per_second = 24000.0 / 1001.0;
+  ExrCamera& camera = frame.metadata.camera;
+  camera.present = true;
+  for (int i = 0; i < 16; ++i) {
+    camera.world_to_camera[i] = static_cast<float>(i) * 0.5f - 1.0f;
+    camera.world_to_ndc[i] = static_cast<float>(i * i) * 0.01f;
+  }
+  camera.fov_y_deg = 47.5f;
+  camera.near_plane = 0.25f;
+  camera.far_plane = 750.0f;
+  const std::string file = path("ids.exr");
+  ASSERT_TRUE(write_exr(file, frame).ok());
+  {  // as another reader sees it: the standard attributes and types
+    Imf::MultiPartInputFile input(file.c_str());
+    const Imf::Header& header = input.header(0);
+    ASSERT_TRUE(Imf::hasWorldToCamera(header));
+    ASSERT_TRUE(Imf::hasWorldToNDC(header));
+    EXPECT_EQ(Imf::worldToCamera(header)[0][1], camera.world_to_camera[1]);  // row 0, column 1
+    EXPECT_EQ(Imf::worldToNDC(header)[3][2], camera.world_to_ndc[14]);
+    EXPECT_EQ(Imf::framesPerSecond(header).n, 24000);
+    EXPECT_EQ(Imf::framesPerSecond(header).d, 1001u);
+    EXPECT_EQ(input.header(3).channels().findChannel("particle.I")->type, Imf::UINT);
+  }
+  ExrImage image;
+  ASSERT_TRUE(read_exr(file, &image).ok());
+  const ExrPlane& plane = image.channels.at("particle.I");
+  EXPECT_EQ(plane.type, ExrPixelType::kUint);
+  EXPECT_EQ(plane.ids, ids);
+  EXPECT_EQ(plane.pixels[3], 0.0f);
+  EXPECT_EQ(plane.pixels[0], static_cast<float>(ids[0]));
+  EXPECT_TRUE(image.channels.at("depth.Z").ids.empty());
+  EXPECT_NEAR(image.metadata.frames_per_second, 23.976, 1e-3);
+  const ExrCamera& back = image.metadata.camera;
+  ASSERT_TRUE(back.present);
+  for (int i = 0; i < 16; ++i) {
+    EXPECT_EQ(back.world_to_camera[i], camera.world_to_camera[i]) << i;
+    EXPECT_EQ(back.world_to_ndc[i], camera.world_to_ndc[i]) << i;
+  }
+  EXPECT_EQ(back.fov_y_deg, 47.5f);
+  EXPECT_EQ(back.near_plane, 0.25f);
+  EXPECT_EQ(back.far_plane, 750.0f);
+
+  ExrFrame both = data.frame();
+  both.layers.push_back({"particle", ExrCompression::kZip,
+                         {{"particle.I", data.depth.data(), 1, ids.data()}}});
+  const Status s = write_exr(path("both.exr"), both);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("'particle.I' needs its pixels as floats or as ids, one of the two"),
+            std::string::npos)
+      << s.message();
+}
+
 TEST_F(ImageFilesExr, FileBytesEqualInMemoryEncoding) {
   TestFrame data(10, 4);
   std::vector<char> encoded;
@@ -368,7 +428,7 @@ TEST_F(ImageFilesExr, InvalidFramesAreRejectedWithoutFiles) {
   EXPECT_NE(s.message().find("layer 'foam' has no channels"), std::string::npos) << s.message();
 
   ExrFrame null_channel = data.frame();
-  null_channel.layers[0].channels.push_back({"water.mask", nullptr});
+  null_channel.layers[0].channels.push_back({"water.A", nullptr});
   s = write_exr(file, null_channel);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find(file), std::string::npos) << s.message();

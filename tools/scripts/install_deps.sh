@@ -11,6 +11,7 @@ packages=(
   libglfw3-dev libimgui-dev xvfb
   clang-15 libfuzzer-15-dev llvm-15
   munge slurmctld slurmd slurm-client
+  blender openimageio-tools python3
 )
 missing=()
 for p in "${packages[@]}"; do

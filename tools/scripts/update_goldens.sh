@@ -6,8 +6,8 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="${1:-$root/build/test}"
 work="$(mktemp -d)"
 for frame in 0 75 240; do
-  "$build/tools/siviflow" capture --range "$frame:$((frame + 1))" --size 320x180 --validation \
-    --preview --out "$work"
+  "$build/tools/siviflow" capture --range "$frame:$((frame + 1))" --size 320x180 \
+    --aov depth,flow --validation --preview --out "$work"
 done
 cp "$work"/frame_*.exr "$root/tests/golden/"
 echo "goldens updated; previews to look at: $work"

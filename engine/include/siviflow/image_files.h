@@ -11,12 +11,16 @@
 
 namespace siviflow {
 
-// Header attribute names of the metadata every SiViFlow EXR carries.
+// Header attribute names of the metadata every SiViFlow EXR carries (and the standard
+// worldToCamera, worldToNDC and framesPerSecond).
 inline constexpr const char* kExrAttrScene = "siviflow/scene";              // string
 inline constexpr const char* kExrAttrFrame = "siviflow/frame";              // int
 inline constexpr const char* kExrAttrTime = "siviflow/time";                // float, seconds
 inline constexpr const char* kExrAttrSeed = "siviflow/seed";                // int
 inline constexpr const char* kExrAttrSoftware = "siviflow/software_version";  // string
+inline constexpr const char* kExrAttrFovY = "siviflow/fov_y";  // float, degrees, vertical
+inline constexpr const char* kExrAttrNear = "siviflow/near";   // float, metres
+inline constexpr const char* kExrAttrFar = "siviflow/far";     // float, metres
 // What made the frame, beside the above: the scene's content ("sha256:<hex>",
 // scene_content_digest), the frame rate of its time and the AOVs asked for ("depth,flow"; "" for
 // the beauty alone). A frame without a digest is of the layout before them.
@@ -24,12 +28,14 @@ inline constexpr const char* kExrAttrSceneDigest = "siviflow/scene_digest";  // 
 inline constexpr const char* kExrAttrFps = "siviflow/fps";                  // float, frames/s
 inline constexpr const char* kExrAttrAovs = "siviflow/aovs";                // string
 
-// One data channel: width * height floats, row-major, top-left origin; written as FLOAT.
-// Names follow the layer convention, e.g. "depth.Z", "flow.X", "water.mask".
+// One data channel: width * height samples, row-major, top-left origin; floats written as
+// FLOAT, or identifiers written as UINT (exactly one of the two). Names follow the layer
+// convention, LAYER.C with a one-letter channel, e.g. "depth.Z", "flow.X", "water.A".
 struct ExrChannel {
   std::string name;
   const float* pixels = nullptr;
-  int stride = 1;  // floats from one pixel's sample to the next (4: a channel of interleaved RGBA)
+  int stride = 1;  // samples from one pixel's to the next (4: a channel of interleaved RGBA)
+  const uint32_t* ids = nullptr;
 };
 
 // The lossless compressions a part may use (OpenEXR's RLE, ZIP at deflate level 1, PIZ).
@@ -43,14 +49,30 @@ struct ExrLayer {
   std::vector<ExrChannel> channels;
 };
 
+// The camera that made the frame, in OpenEXR's standard attributes' conventions (ImfStandard-
+// Attributes.h): matrices multiply row vectors on their left (p' = p * M, Imath's order), which
+// lays their 16 floats out as glm's column-major mat4 of the same transform. Camera space is
+// x right, y up, z forward (left-handed); NDC is (0, 0) at the top-left corner of the image and
+// (1, 1) at the bottom-right, after the homogeneous divide.
+struct ExrCamera {
+  bool present = false;  // read back: the file has worldToCamera
+  float world_to_camera[16] = {};
+  float world_to_ndc[16] = {};
+  float fov_y_deg = 0.0f;  // vertical field of view
+  float near_plane = 0.0f;  // metres
+  float far_plane = 0.0f;
+};
+
 struct ExrMetadata {
   std::string scene;
   int frame = 0;
   float time_seconds = 0.0f;
   int seed = 0;
   std::string software_version;
-  std::string scene_digest;  // "" where the frame has none (the layout before it)
-  float fps = 0.0f;
+  double frames_per_second = 0.0;  // written as the standard framesPerSecond (0: not written)
+  ExrCamera camera;                // written when present
+  std::string scene_digest;        // "" where the frame has none (the layout before it)
+  float fps = 0.0f;                // as the capture's --fps (exactly: frames compare it)
   std::string aovs;
 };
 
@@ -99,6 +121,7 @@ struct ExrPlane {
   ExrPixelType type = ExrPixelType::kFloat;  // as stored in the file
   std::string compression;                   // its part's: "none", "zip", "piz", ...
   std::vector<float> pixels;                 // width * height, row-major, top-left origin
+  std::vector<uint32_t> ids;                 // kUint only: the exact values (pixels round them)
 };
 
 struct ExrImage {

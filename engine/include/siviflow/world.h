@@ -48,6 +48,14 @@ struct WorldCreateInfo {
   uint32_t queue_family_index = 0;   // with enable_timing: the family of the queue that runs it
 };
 
+// A boulder at a time: whether it is drawn, where (its obstacle's keys, or where place_boulder()
+// stood it), and the radii of the ellipsoid its bumped surface stays within 15 % of.
+struct BoulderPose {
+  bool shown = false;
+  glm::vec3 centre{0.0f};
+  glm::vec3 radii{0.0f};
+};
+
 // What the world drew in its last main view (record()) and reflection (draw_reflection()):
 // the pieces its views see, at their levels of detail, and the boulders.
 struct WorldDrawStats {
@@ -78,6 +86,8 @@ class World {
   Status place_boulder(uint32_t index, const glm::vec3& centre);
   // Draws boulder `index` no more until it is placed again (its obstacle was removed).
   Status hide_boulder(uint32_t index);
+  // Boulder `index` as record() would draw it at `time_seconds` (a capture's motion vectors).
+  Status boulder_at(uint32_t index, double time_seconds, BoulderPose* out) const;
 
   // The host has waited until the GPU finished the commands last recorded for this slot.
   Status begin_frame(uint32_t slot);
