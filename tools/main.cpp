@@ -27,8 +27,8 @@ void print_usage() {
 // lavapipe's rasterizer mallocs and frees tens of megabytes of bins per frame on its queue
 // thread; with glibc's default trim threshold every free hands them back to the kernel
 // (madvise) and the next frame faults them in again (about 3300 page faults a frame at 720p).
-// This process keeps them: the library itself never changes its host's allocator (README,
-// "Frame cost").
+// This process keeps them: the library itself never changes its host's allocator (docs/
+// embedding.md, "On lavapipe: keep freed memory in the process").
 constexpr int kKeptFreeBytes = 256 << 20;
 
 }  // namespace
@@ -45,6 +45,13 @@ int main(int argc, char** argv) {
     return siviflow::cli::kExitOk;
   }
   if (command == "--version" || command == "version") {
+    if (argc == 3 && (std::string_view(argv[2]) == "--help" || std::string_view(argv[2]) == "-h")) {
+      std::printf(
+          "usage: siviflow version\n"
+          "  Prints the version (also 'siviflow --version'), as captured frames record it in\n"
+          "  siviflow/software_version.\n");
+      return siviflow::cli::kExitOk;
+    }
     if (argc > 2) {
       return siviflow::cli::fail(command, siviflow::cli::unexpected_argument(argv[2]).message());
     }
