@@ -1,10 +1,11 @@
 # Installs the build into a scratch prefix; checks that every installed header lies under
 # include/siviflow and compiles alone against the prefix (tests/consumer/headers); builds the
-# examples from their installed copies (share/siviflow/examples: embed, a first frame; and
-# modern_frame, HDR, reverse-Z, jitter, motion, reactive and depth, each checked) against the
-# prefix, at C++17, runs them, and checks the embed binary needs no file-format library; and the
-# installed tool checks each installed example scene as it would render it (--dry-run: the scene
-# came with every file it loads).
+# examples from their installed copies (share/siviflow/examples: embed, a frame loop with two
+# frames in flight; and modern_frame, HDR, reverse-Z, jitter, motion, reactive and depth, each
+# checked) against the prefix, at C++17, runs them, and checks the embed binary needs no
+# file-format library; the installed tool checks each installed example scene as it would render
+# it (--dry-run: the scene came with every file it loads); and the installed guides' links resolve
+# among the installed files.
 file(REMOVE_RECURSE ${WORK})
 set(prefix ${WORK}/prefix)
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD} --prefix ${prefix}
@@ -66,6 +67,13 @@ foreach(scene IN LISTS scenes)
     message(FATAL_ERROR "the installed example scene ${scene} does not check: ${output}")
   endif()
 endforeach()
+
+# The installed guides link only to what is installed beside them.
+execute_process(COMMAND ${CHECK_DOCS} links ${prefix}/share/doc/siviflow
+                RESULT_VARIABLE rc OUTPUT_VARIABLE output ERROR_VARIABLE output)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the installed documentation links to what is not installed: ${output}")
+endif()
 
 # The binary of an engine that links siviflow::water alone needs no file-format library.
 execute_process(COMMAND readelf -d ${WORK}/embed/embed_example OUTPUT_VARIABLE dynamic
