@@ -34,9 +34,16 @@ foreach(example embed modern_frame)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/tools/examples/${example}
           DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples)
 endforeach()
-# The example scene files, with the glTF files they load (README, "Scene files").
+# The example scene files, with the glTF files they load (docs/scenes.md), and their schema.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/scenes
         DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples)
+install(FILES ${PROJECT_SOURCE_DIR}/engine/scene/scene.schema.json
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow)
+# The guides, the licence and the changes, where a distribution looks for them.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/LICENSE
+              ${PROJECT_SOURCE_DIR}/CHANGELOG.md ${PROJECT_SOURCE_DIR}/CONTRIBUTING.md
+              ${PROJECT_SOURCE_DIR}/third_party_notes.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
 
 file(WRITE ${PROJECT_BINARY_DIR}/siviflowConfig.cmake.in [=[
 @PACKAGE_INIT@

@@ -49,7 +49,7 @@ void print_help() {
       "  --out DIR      existing folder to write into (required)\n"
       "  --seed S       simulation seed, recorded in the EXR metadata (default 1)\n"
       "  --fps F        frames per second of scene time (default 30)\n"
-      "  --aov LIST     comma list of extra EXR layers (the README's table has each one's units):\n"
+      "  --aov LIST     comma list of extra EXR layers (docs/output.md has each one's units):\n"
       "                 depth      depth.Z: view-axis distance in metres to the nearest surface,\n"
       "                            water included; +inf where only sky is seen\n"
       "                 flow       flow.X/Y/Z: the flow texture upsampled (nearest) to the output,\n"

@@ -59,7 +59,7 @@ inline bool water_layers(const CaptureOptions& options) {
 // The particle layer's id where no particle's texel covers visible water (ids start at 1).
 inline constexpr uint32_t kNoParticleId = 0;
 
-// The EXR channels of the AOVs (the README's table says what each holds). Every channel is
+// The EXR channels of the AOVs (docs/output.md's table says what each holds). Every channel is
 // LAYER.C with a one-letter C: Blender's reader drops a layer with a longer one.
 inline constexpr const char* kDepthChannel = "depth.Z";
 inline constexpr const char* kWaterMaskChannel = "water.A";

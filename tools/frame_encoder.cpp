@@ -73,7 +73,7 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
   const uint32_t width = options_.size.width;
   const uint32_t height = options_.size.height;
   const size_t pixels = size_t{width} * height;
-  // Each layer's compression suits its data (why, with figures: the README's capture section).
+  // Each layer's compression suits its data (why, with figures: docs/output.md).
   ExrFrame frame;
   frame.width = static_cast<int>(width);
   frame.height = static_cast<int>(height);

@@ -31,8 +31,8 @@ EVERY_AOV = "depth,flow,particles,normal,reflection,foam,motion"
 FRAME_RANGE = "3:4"  # not the first frame: the camera has moved, so motion is not zero
 FRAME_NAME = "frame_00003.exr"
 
-# Every part of a frame with every AOV (README, "EXR layers"): its channels and their types in
-# the order they are written. The beauty comes first; the others in any order.
+# Every part of a frame with every AOV (docs/output.md, "The frame's layers"): its channels and
+# their types in the order they are written. The beauty comes first; the others in any order.
 PARTS = {
     "rgba": [("R", "half"), ("G", "half"), ("B", "half"), ("A", "half")],
     "depth": [("depth.Z", "float")],
@@ -49,7 +49,8 @@ PARTS = {
 # The layers that are zero (or id 0) off the water.
 WATER_LAYERS = ["flow", "particle", "normal", "reflection", "foam"]
 
-# The default scene's river is level at y = 0 (README, "Space"); the issue asks within 1 cm.
+# The default scene's river is level at y = 0 (docs/embedding.md, "Space"); the issue asks
+# within 1 cm.
 WATER_LEVEL = 0.0
 REPROJECT_TOLERANCE_M = 0.01
 

@@ -67,8 +67,8 @@ glm::mat4 matrix(const float (&m)[16]) {
 // OpenEXR's row-vector convention, p * M, is glm's M * p on the same 16 floats.
 glm::vec4 transformed(const float (&m)[16], glm::vec4 p) { return matrix(m) * p; }
 
-// The README's worked example: the world point a pixel's depth (distance along the view axis)
-// puts it at, from worldToCamera and worldToNDC alone.
+// The worked example of docs/output.md: the world point a pixel's depth (distance along the view
+// axis) puts it at, from worldToCamera and worldToNDC alone.
 glm::vec3 world_point(const ExrImage& image, int x, int y, float depth) {
   const ExrCamera& camera = image.metadata.camera;
   const glm::mat4 camera_to_world = glm::inverse(matrix(camera.world_to_camera));
@@ -171,9 +171,9 @@ TEST_F(CaptureLayersTest, TheCameraTravelsWithThePixels) {
   EXPECT_NEAR(pixel_of(image, target + up * half).y, 0.0f, 1e-2f) << "the top edge at fov / 2";
 }
 
-// The README's worked example turns depth back into the world: every water pixel's point lies on
-// the water surface (the default river is flat at y = 0) within 1 cm, where 32-bit depth resolves
-// that well (the nearest 60 m).
+// The worked example of docs/output.md turns depth back into the world: every water pixel's point
+// lies on the water surface (the default river is flat at y = 0) within 1 cm, where 32-bit depth
+// resolves that well (the nearest 60 m).
 TEST_F(CaptureLayersTest, DepthReprojectsWaterOntoItsSurface) {
   const ExrImage image = capture("depth", "--frames 1 --size 320x180 --aov depth,flow", 0);
   const std::vector<float>& depth = *image.find("depth.Z");

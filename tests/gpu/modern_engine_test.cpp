@@ -444,7 +444,7 @@ TEST_F(BareHostTest, DefaultRiverLiesWhereTheReadmeSays) {
   std::unique_ptr<Renderer> renderer;
   ASSERT_TRUE(Renderer::create(bare_info(*context_), &renderer).ok());
   const Renderer::Bounds b = renderer->river_bounds();
-  // README, "Where the water is": level at y = 0, x -20.7 .. 19.0, z -122.2 .. 123.0.
+  // docs/embedding.md, "Space": level at y = 0, x -20.7 .. 19.0, z -122.2 .. 123.0.
   EXPECT_NEAR(b.min.x, -20.7f, 0.1f);
   EXPECT_NEAR(b.max.x, 19.0f, 0.1f);
   EXPECT_NEAR(b.min.y, 0.0f, 1e-3f);

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes rivers.gltf and rivers.bin beside this script: two river surfaces as SiViFlow reads them
-(README, "Scene files"), each a strip of quads from bank to bank, one row of vertices per
+(docs/scenes.md, "Rivers from glTF"), each a strip of quads from bank to bank, one row of vertices per
 cross-section, vertex 0 on the left bank of the upstream section, the water level at y = 0.
 
   Bend     a river 10 m wide swinging 8 m either side of x = 0 over 120 m along +Z
