@@ -30,7 +30,7 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/engine/include/siviflow
 install(FILES ${PROJECT_BINARY_DIR}/include/siviflow/version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/siviflow)
 # The examples, as source a host builds against the installed package.
-foreach(example embed modern_frame)
+foreach(example embed modern_frame window_host)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/tools/examples/${example}
           DESTINATION ${CMAKE_INSTALL_DATADIR}/siviflow/examples)
 endforeach()

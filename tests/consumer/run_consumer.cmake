@@ -1,8 +1,9 @@
 # Installs the build into a scratch prefix; checks that every installed header lies under
 # include/siviflow and compiles alone against the prefix (tests/consumer/headers); builds the
 # examples from their installed copies (share/siviflow/examples: embed, a frame loop with two
-# frames in flight; and modern_frame, HDR, reverse-Z, jitter, motion, reactive and depth, each
-# checked) against the prefix, at C++17, runs them, and checks the embed binary needs no
+# frames in flight; modern_frame, HDR, reverse-Z, jitter, motion, reactive and depth, each
+# checked; and window_host, built here and run under Xvfb by the window tier) against the
+# prefix, at C++17, runs them, and checks the embed binary needs no
 # file-format library; the installed tool checks each installed example scene as it would render
 # it (--dry-run: the scene came with every file it loads); and the installed guides' links resolve
 # among the installed files.
@@ -32,8 +33,8 @@ if(NOT rc EQUAL 0)
 endif()
 
 # Each example as a host gets it, in a target at C++17 (the package raises it to what it needs):
-# built from its installed copy against the prefix, and run.
-function(build_and_run example program)
+# built from its installed copy against the prefix (and run, below).
+function(build_example example)
   set(build ${WORK}/${example})
   execute_process(COMMAND ${CMAKE_COMMAND} -S ${prefix}/share/siviflow/examples/${example}
                           -B ${build} -G Ninja -DCMAKE_PREFIX_PATH=${prefix}
@@ -46,13 +47,17 @@ function(build_and_run example program)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "building the installed example ${example} failed")
   endif()
-  execute_process(COMMAND ${build}/${program} RESULT_VARIABLE rc)
+endfunction()
+function(build_and_run example program)
+  build_example(${example})
+  execute_process(COMMAND ${WORK}/${example}/${program} RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "the example ${example} failed")
   endif()
 endfunction()
 build_and_run(embed embed_example)
 build_and_run(modern_frame modern_frame)
+build_example(window_host)  # run by the window tier, which has a display (installed_window_host)
 
 file(GLOB scenes ${prefix}/share/siviflow/examples/scenes/*.json)
 list(LENGTH scenes scene_count)
