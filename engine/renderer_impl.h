@@ -106,6 +106,7 @@ struct Renderer::Impl {
   Status remove_obstacle(uint32_t id);
   Status set_occluders(const OccluderMesh& mesh);
   Status set_look(const WaterLook& new_look);
+  Status query_water(std::span<const glm::vec3> points, std::span<WaterSample> out) const;
   Status simulate(const View& host_view, double time_seconds);
   // The frame prepared was recorded (or simulated without rendering): the next one's motion
   // starts from it.

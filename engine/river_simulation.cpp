@@ -131,7 +131,13 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   field_.depth = mesh_.depth;
   field_.slope = slope_;
   field_.foam = foam_;
-  return Status::success();
+  return WaterQuery::build(field_, &water_query_);
+}
+
+void RiverFlow::query(std::span<const glm::vec3> points, std::span<WaterSample> out) const {
+  std::vector<DryFootprint> footprints;
+  dry_footprints(&footprints);
+  for (size_t i = 0; i < points.size(); ++i) out[i] = water_query_.sample(points[i], footprints);
 }
 
 void RiverFlow::refresh_velocity() {

@@ -17,6 +17,7 @@
 #include "sim/foam.h"
 #include "sim/particles.h"
 #include "sim/triangle_bvh.h"
+#include "sim/water_query.h"
 #include "siviflow/sim/obstacle.h"
 #include "siviflow/sim/procedural_river.h"
 #include "siviflow/sim/river_surface.h"
@@ -74,6 +75,11 @@ class RiverFlow {
   Status move_obstacle(size_t index, const glm::vec3& centre);
   Status remove_obstacle(size_t index);
 
+  // The water at each river-space point (sim/water_query.h), from the flow as it stands: each
+  // sample's obstacle is the flow's obstacle index plus one, 0 outside every footprint. Reads
+  // only; safe beside other reads, not beside a call that changes the obstacles or the time.
+  void query(std::span<const glm::vec3> points, std::span<WaterSample> out) const;
+
   const RiverMesh& mesh() const { return mesh_; }
   // The surface, its flow and what the particles read per vertex (spans into this object).
   const RiverFlowField& field() const { return field_; }
@@ -103,6 +109,7 @@ class RiverFlow {
   bool has_keys_ = false;            // some obstacle moves: re-solve as time goes
   RiverFlowField field_;
   std::shared_ptr<const TriangleBvh> bvh_;
+  WaterQuery water_query_;
   std::shared_ptr<const TriangleBvh> occluders_;  // owns its mesh (aliasing)
   uint64_t full_solves_ = 0;
 };

@@ -34,7 +34,12 @@
 // mutex, a queue hand-off), say begin_frame and update on a simulation thread and record on the
 // render thread. Renderers that share a river (CreateInfo::share_river_with) share its flow,
 // obstacles and occluders, so their calls must not overlap either; renderers of different
-// rivers are independent. The log callback runs on the thread of the call that logs.
+// rivers are independent. The one exception: query_water only reads, so it may run on any
+// thread (a physics thread) at the same time as record() and as other query_water calls, of
+// this renderer or of those sharing its river, but not with a call that changes the flow
+// (begin_frame, update and simulate, which move keyed obstacles; add_, move_ and
+// remove_obstacle; set_look; resize; destroying the renderer). The log callback runs on the thread of the
+// call that logs.
 #pragma once
 
 #include <cstdint>
@@ -48,6 +53,7 @@
 #include <glm/vec3.hpp>
 #include <vulkan/vulkan.h>
 
+#include "siviflow/sim/water_sample.h"
 #include "siviflow/water_look.h"
 #include "siviflow/water_river.h"
 #include "siviflow/status.h"
@@ -364,6 +370,18 @@ class Renderer {
   // Moves obstacle `id` to `centre`, its polygon turned to `rotation_rad`.
   Status move_obstacle(uint32_t id, const glm::vec3& centre, float rotation_rad = 0.0f);
   Status remove_obstacle(uint32_t id);
+
+  // Gameplay's view of the water: for each point of the host's world, whether it lies over the
+  // river surface and outside every obstacle's footprint, the surface point above or below it
+  // (along the river's up axis) and its macro normal, the flow there (m/s), the depth to the bed,
+  // the foam the material shows (this renderer's WaterLook::foam_amount in), and the obstacle
+  // whose footprint holds it (siviflow/sim/water_sample.h), all in the host's world. CPU only,
+  // from the solved flow as it stands (runtime obstacles count from the call that placed them,
+  // keyed ones from the last update), not from the GPU; about a microsecond a point, one binary
+  // search in the cells the river covers whatever its length; deterministic. `out` holds at
+  // least as many samples as `points`. A point that is not finite, or a short `out`, is an error
+  // naming it, and nothing is written. Threads: see the top of this file.
+  Status query_water(std::span<const glm::vec3> points, std::span<WaterSample> out) const;
 
   // The host's geometry that can stand between a camera and the water (ground, buildings,
   // props; not the obstacles, which the renderer knows): particles are made only on water a
