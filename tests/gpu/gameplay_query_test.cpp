@@ -195,6 +195,19 @@ TEST_F(GameplayQueryTest, MovedObstacleDeflectsAFloatReleasedAfterTheMove) {
   EXPECT_GT(deflected.back().z, in_path.z + rock.radius) << "the float did not get past it";
 }
 
+// docs/embedding.md quotes the three statements in the middle.
+TEST_F(GameplayQueryTest, TheGuidesDriftExampleRuns) {
+  const std::unique_ptr<Renderer> water = make();
+  ASSERT_NE(water, nullptr);
+  const float frame_seconds = 1.0f / 60.0f;
+  std::vector<siviflow::FloatingBody> crates = {{{2.0f, 0.0f, -60.0f}}, {{-1.0f, 0.0f, -64.0f}}};
+  auto ask = [&](std::span<const glm::vec3> p, std::span<siviflow::WaterSample> s) {
+    return water->query_water(p, s);
+  };
+  siviflow::Status moved = siviflow::drift_bodies(crates, frame_seconds, ask);
+  EXPECT_TRUE(moved.ok()) << moved.message();
+}
+
 TEST_F(GameplayQueryTest, BadPointsAreRefusedByNameAndNothingIsWritten) {
   const std::unique_ptr<Renderer> water = make();
   ASSERT_NE(water, nullptr);

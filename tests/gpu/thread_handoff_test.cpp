@@ -1,12 +1,15 @@
 // The threading contract of renderer.h, held under ThreadSanitizer (the CI builds this test with
 // -DSIVIFLOW_SANITIZE=thread and runs it as the `thread` tier): a host that calls begin_frame and
 // update on a simulation thread and records on its render thread, handing each frame over in
-// order, gets the same pixels as one thread; and a renderer of another river simulating on its own
-// thread meanwhile changes neither. lavapipe is not instrumented, so what TSan judges is our
+// order, gets the same pixels as one thread; a renderer of another river simulating on its own
+// thread meanwhile changes neither; and a physics thread querying the water while the render
+// thread records gets the answers one thread gets, and changes no pixel. lavapipe is not instrumented, so what TSan judges is our
 // library's own memory across the host's threads.
+#include <atomic>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
+#include <shared_mutex>
 #include <thread>
 #include <vector>
 
@@ -117,6 +120,46 @@ TEST_F(ThreadHandoffTest, AnotherRiverSimulatesOnItsOwnThreadMeanwhile) {
   const std::vector<Frame> second = render(kFrames, kFrames + 2);
   expect_same_frames({first.end() - 2, first.end()}, second, kFrames);
   renderer_.swap(other);
+}
+
+TEST_F(ThreadHandoffTest, QueriesOnAPhysicsThreadWhileTheRenderThreadRecords) {
+  const std::vector<Frame> one_thread = render(0, kFrames);
+
+  ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
+  std::vector<glm::vec3> points;
+  for (float z = -100.0f; z <= 100.0f; z += 2.5f) {
+    for (float x = -20.0f; x <= 19.0f; x += 1.5f) points.push_back({x, 1.0f, z});
+  }
+  std::vector<WaterSample> expected(points.size());
+  ASSERT_TRUE(renderer_->query_water(points, expected).ok());
+  // The host's rule: queries never overlap the calls that change the flow (begin_frame and
+  // update, where the keyed boulder moves); they do overlap record and the GPU's work.
+  std::shared_mutex flow_changes;
+  run_cpu_part_ = [&](const std::function<void()>& part) {
+    std::unique_lock lock(flow_changes);
+    part();
+  };
+  std::atomic<bool> done{false};
+  size_t rounds = 0, differing = 0;
+  Status queried;
+  std::thread physics([&] {
+    std::vector<WaterSample> samples(points.size());
+    while (!done.load() && queried.ok()) {
+      std::shared_lock lock(flow_changes);
+      queried = renderer_->query_water(points, samples);
+      for (size_t i = 0; i < points.size(); ++i) {
+        differing += samples[i].velocity != expected[i].velocity || samples[i].wet != expected[i].wet;
+      }
+      ++rounds;
+    }
+  });
+  const std::vector<Frame> with_queries = render(0, kFrames);
+  done = true;
+  physics.join();
+  ASSERT_TRUE(queried.ok()) << queried.message();
+  EXPECT_GT(rounds, 0u);
+  EXPECT_EQ(differing, 0u);  // the keyed boulder rolls in only after 1 s: the flow stays put
+  expect_same_frames(one_thread, with_queries, 0);
 }
 
 }  // namespace
