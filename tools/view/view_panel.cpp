@@ -40,6 +40,7 @@ PanelActions draw_panel(const PanelStats& stats, PanelState* state) {
   ImGui::Begin("SiViFlow");
   ImGui::Text("%.1f fps  %ux%u  %s", stats.fps, stats.width, stats.height, stats.present_mode);
   ImGui::Text("particles %zu  obstacles %zu", stats.particles, stats.obstacles);
+  ImGui::TextWrapped("%s", stats.cursor_water.c_str());
   table("GPU per pass", stats.gpu_ms);
   table("CPU per stage", stats.cpu_ms);
 

@@ -19,6 +19,7 @@ struct PanelStats {
   std::vector<std::pair<std::string, double>> cpu_ms;  // per stage, this frame
   size_t particles = 0;
   size_t obstacles = 0;
+  std::string cursor_water;  // the water under the cursor (Renderer::query_water), or why none
   const char* present_mode = "";
   unsigned width = 0;
   unsigned height = 0;

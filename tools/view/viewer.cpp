@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <backends/imgui_impl_glfw.h>
@@ -17,6 +18,7 @@
 #include "siviflow/atomic_file.h"
 #include "siviflow/scene_file.h"
 #include "siviflow/scene_river.h"
+#include "siviflow/text_format.h"
 #include "siviflow/world.h"
 #include "view/fly_camera.h"
 #include "view/frame_slots.h"
@@ -82,6 +84,8 @@ class Viewer {
   void build_panel(uint32_t slot, const std::vector<std::pair<std::string, double>>& cpu_ms);
   Status write_flow_report() const;
   View current_view() const;
+  // The first river's water under the cursor, as the panel shows it.
+  std::string water_under_cursor() const;
 
   // Input handlers: the window's callbacks and the input script both call these.
   void on_cursor(double x, double y);
@@ -389,6 +393,21 @@ void Viewer::apply_script_events() {
   }
 }
 
+std::string Viewer::water_under_cursor() const {
+  const std::optional<glm::vec3> hit = obstacles_.hit_water(pixel_ray(current_view(), cursor_));
+  if (!hit) return "cursor: not over the water";
+  for (const Renderer* renderer : renderer_list_) {
+    WaterSample s;
+    if (!renderer->query_water({&*hit, 1}, {&s, 1}).ok() || !s.on_surface) continue;
+    if (!s.wet) return text_format("cursor: in an obstacle's footprint (id %u)", s.obstacle);
+    return text_format("cursor: water at y %.2f m, flow %.2f m/s (x %.2f, z %.2f), depth %.2f m, "
+                       "foam %.2f",
+                       double(s.surface.y), double(glm::length(s.velocity)), double(s.velocity.x),
+                       double(s.velocity.z), double(s.depth), double(s.foam));
+  }
+  return "cursor: not over the water";
+}
+
 View Viewer::current_view() const {
   const Camera camera = panel_.follow_path ? world_->scene_camera(sim_time_) : fly_.camera();
   return camera_view(camera, extent_);
@@ -560,6 +579,7 @@ void Viewer::build_panel(uint32_t slot, const std::vector<std::pair<std::string,
     stats_.particles += particle_field(*renderer).particles().size();
   }
   stats_.obstacles = obstacles_.placed(sim_time_).size();
+  stats_.cursor_water = water_under_cursor();
   stats_.present_mode = present_mode_name(swapchain_.present_mode());
   stats_.width = extent_.width;
   stats_.height = extent_.height;
