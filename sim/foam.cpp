@@ -92,10 +92,6 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   neighbours.resize(kept);
   neighbours.shrink_to_fit();
   field.ring_ = std::move(neighbours);
-  field.upstream_vertex_.assign(count * 3, 0);
-  field.upstream_weight_.assign(count * 3, 0.0f);
-  field.source_.assign(count, 0.0f);
-  field.scratch_.assign(count, 0.0f);
   *out = std::move(field);
   return Status::success();
 }
@@ -108,6 +104,11 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
   for (size_t v = 0; v < count; ++v) {
     section_speed_[section_[v]] += std::hypot(velocity[v].x, velocity[v].z) / float(section_size_[section_[v]]);
   }
+  // Per vertex: where the flow came from one step earlier (3 vertices and their weights; all 0
+  // weights when that point is off the river), and its own foam source.
+  std::vector<uint32_t> upstream_vertex(count * 3, 0);
+  std::vector<float> upstream_weight(count * 3, 0.0f);
+  std::vector<float> source(count, 0.0f);
   for (size_t v = 0; v < count; ++v) {
     // Least-squares horizontal velocity gradient over the one-ring: G = (sum du dx^T)(sum dx dx^T)^-1.
     float axx = 0.0f, axz = 0.0f, azz = 0.0f;
@@ -151,14 +152,14 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
     const float bank = p.bank_strength * std::exp(-bank_distance[v] / p.bank_width_m) *
                        std::min(section_speed / p.bank_speed_full, 1.0f);
     const float relative_gradient = gradient / std::max(section_speed, p.min_section_speed);
-    source_[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
+    source[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
                            lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
 
     // Where this vertex's water was one step ago: cast down onto the surface there.
     const glm::vec3 back = positions_[v] - p.step_s * glm::vec3(velocity[v].x, 0.0f, velocity[v].z);
     RayHit hit;
-    float* weight = &upstream_weight_[v * 3];
-    uint32_t* from = &upstream_vertex_[v * 3];
+    float* weight = &upstream_weight[v * 3];
+    uint32_t* from = &upstream_vertex[v * 3];
     if (bvh_->intersect(back + glm::vec3(0.0f, kRayHeight, 0.0f), {0.0f, -1.0f, 0.0f},
                         2.0f * kRayHeight, &hit)) {
       for (int c = 0; c < 3; ++c) from[c] = bvh_->triangle_vertex(hit.triangle, c);
@@ -172,16 +173,17 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
   }
   // Steady transport: each step the foam moves one step downstream and decays.
   const float decay = std::exp(-p.step_s / p.lifetime_s);
-  std::copy(source_.begin(), source_.end(), foam.begin());
+  std::copy(source.begin(), source.end(), foam.begin());
+  std::vector<float> next(count);
   for (uint32_t step = 0; step < p.steps; ++step) {
     for (size_t v = 0; v < count; ++v) {
-      const uint32_t* from = &upstream_vertex_[v * 3];
-      const float* weight = &upstream_weight_[v * 3];
+      const uint32_t* from = &upstream_vertex[v * 3];
+      const float* weight = &upstream_weight[v * 3];
       const float carried = weight[0] * foam[from[0]] + weight[1] * foam[from[1]] +
                             weight[2] * foam[from[2]];
-      scratch_[v] = std::max(source_[v], decay * carried);
+      next[v] = std::max(source[v], decay * carried);
     }
-    std::copy(scratch_.begin(), scratch_.end(), foam.begin());
+    std::copy(next.begin(), next.end(), foam.begin());
   }
 }
 

@@ -62,7 +62,7 @@ class FoamField {
 
   // Foam per vertex in [0, 1] for the flow `velocity` (m/s per vertex); `bank_distance`: each
   // vertex's distance to the nearer margin along its section (metres). Writes `foam` (sized to
-  // the vertices).
+  // the vertices). Its scratch (32 bytes a vertex) lives only during the call.
   void compute(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
                std::span<float> foam);
 
@@ -75,14 +75,8 @@ class FoamField {
   FoamParams params_;
   std::vector<uint32_t> ring_start_;  // per vertex: first of its neighbours in ring_
   std::vector<uint32_t> ring_;        // one-ring neighbours (by shared triangle)
-  // Per vertex: where the flow came from one step earlier (3 vertices and their weights; all 0
-  // weights when that point is off the river).
-  std::vector<uint32_t> upstream_vertex_;
-  std::vector<float> upstream_weight_;
   std::vector<float> section_speed_;  // per section: its vertices' mean speed
   std::vector<uint32_t> section_size_;
-  std::vector<float> source_;
-  std::vector<float> scratch_;
 };
 
 }  // namespace siviflow
