@@ -670,8 +670,10 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     if (glm::dot(normal, up) < 0.0) std::swap(tri[1], tri[2]);
   }
 
-  s.node_of_vertex_ = std::move(node_of_vertex);
-  s.node_vertex_ = std::move(node_vertex);
+  if (node_count != vertex_count) {  // else both maps are the identity: not worth 8 bytes a vertex
+    s.node_of_vertex_ = std::move(node_of_vertex);
+    s.node_vertex_ = std::move(node_vertex);
+  }
   s.node_positions_ = std::move(pos);
   s.triangles_ = std::move(tris);
   s.node_tri_start_ = std::move(node_tris.start);
