@@ -107,27 +107,38 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   for (const Obstacle& obstacle : obstacles) has_keys_ = has_keys_ || !obstacle.keys.empty();
   SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
   full_solves_ = 1;
+  const RiverSurface& surface = flow_.surface();
   const size_t count = mesh_.positions.size();
-  velocity_.resize(count);
-  speed_.resize(count);
+  per_node_ = !surface.welded() && std::ranges::equal(surface.triangles(), mesh_.indices);
+  std::span<const uint32_t> section = surface.node_section();
+  if (per_node_) {
+    mesh_.positions = {};
+    mesh_.indices = {};
+    field_.positions = surface.node_positions();
+    field_.indices = surface.triangles();
+    field_.flow = flow_.node_velocity();
+  } else {
+    section_copy_.resize(count);
+    for (size_t v = 0; v < count; ++v) section_copy_[v] = section[surface.node_of(v)];
+    section = section_copy_;
+    velocity_copy_.resize(count);
+    field_.positions = mesh_.positions;
+    field_.indices = mesh_.indices;
+    field_.flow = velocity_copy_;
+  }
   foam_.resize(count);
   bank_distance_.resize(count);
-  section_.resize(count);
   for (size_t v = 0; v < count; ++v) {
-    const RiverVertex vertex = flow_.surface().vertex(v);
+    const RiverVertex vertex = surface.vertex(v);
     bank_distance_[v] = std::min(vertex.d_left, vertex.d_right);
-    section_[v] = vertex.section;
   }
   auto bvh = std::make_shared<TriangleBvh>();
-  SIVIFLOW_TRY(TriangleBvh::build(mesh_.positions, mesh_.indices, bvh.get()));
+  SIVIFLOW_TRY(TriangleBvh::build(field_.positions, field_.indices, bvh.get()));
   bvh_ = std::move(bvh);
-  SIVIFLOW_TRY(FoamField::create(mesh_.positions, mesh_.indices, section_, bvh_.get(), FoamParams{},
-                                 &foam_field_));
+  SIVIFLOW_TRY(FoamField::create(field_.positions, field_.indices, section, bvh_.get(),
+                                 FoamParams{}, &foam_field_));
   refresh_velocity();
-  field_.positions = mesh_.positions;
-  field_.indices = mesh_.indices;
-  field_.flow = velocity_;
-  field_.speed = speed_;
+  // No speed: the particles take |flow|, as it would have held.
   field_.depth = mesh_.depth;
   field_.slope = slope_;
   field_.foam = foam_;
@@ -135,11 +146,8 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
 }
 
 void RiverFlow::refresh_velocity() {
-  for (size_t v = 0; v < velocity_.size(); ++v) {
-    velocity_[v] = flow_.velocity(v);
-    speed_[v] = glm::length(velocity_[v]);
-  }
-  foam_field_.compute(velocity_, bank_distance_, foam_);
+  for (size_t v = 0; v < velocity_copy_.size(); ++v) velocity_copy_[v] = flow_.velocity(v);
+  foam_field_.compute(field_.flow, bank_distance_, foam_);
 }
 
 Status RiverFlow::set_time(double time_seconds) {

@@ -74,7 +74,9 @@ class RiverFlow {
   Status move_obstacle(size_t index, const glm::vec3& centre);
   Status remove_obstacle(size_t index);
 
-  const RiverMesh& mesh() const { return mesh_; }
+  // The river's mesh, in the host's vertex order.
+  std::span<const glm::vec3> positions() const { return field_.positions; }
+  std::span<const uint32_t> indices() const { return field_.indices; }
   // The surface, its flow and what the particles read per vertex (spans into this object).
   const RiverFlowField& field() const { return field_; }
   std::shared_ptr<const TriangleBvh> bvh() const { return bvh_; }
@@ -91,13 +93,16 @@ class RiverFlow {
   // Re-reads the solved velocity per vertex and derives the foam from it.
   void refresh_velocity();
 
+  // A mesh the surface welded nothing of and wound as it came (the procedural river's) is read
+  // from the surface: positions, indices, section and velocity per vertex are then its per-node
+  // arrays, and mesh_ keeps only the depth; else mesh_, section_copy_ and velocity_copy_.
+  bool per_node_ = false;
   RiverMesh mesh_;
   StreamFunction flow_;
-  std::vector<glm::vec3> velocity_;  // per vertex, m/s
-  std::vector<float> speed_;
+  std::vector<glm::vec3> velocity_copy_;  // per vertex, m/s
   std::vector<float> slope_;         // riverbed slope under the vertex (rise over run)
   std::vector<float> bank_distance_;  // to the nearer margin along the section, metres
-  std::vector<uint32_t> section_;    // per vertex
+  std::vector<uint32_t> section_copy_;
   std::vector<float> foam_;          // 0..1 per vertex (sim/foam.h)
   FoamField foam_field_;
   bool has_keys_ = false;            // some obstacle moves: re-solve as time goes

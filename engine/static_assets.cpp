@@ -18,7 +18,7 @@ uint32_t StaticAssets::add_image(ImageSpec spec) {
 Status StaticAssets::create(const GpuContext& gpu) {
   staging_handle_ = upload_graph_.import_buffer({"static staging", 0}, ResourceState{});
   for (StaticBuffer& b : buffers_) {
-    SIVIFLOW_TRY(create_buffer(gpu, b.spec.bytes.size(),
+    SIVIFLOW_TRY(create_buffer(gpu, b.spec.source().size(),
                                b.spec.usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, b.spec.name,
                                &b.buffer));
     const BufferHandle handle = upload_graph_.import_buffer(
@@ -58,7 +58,7 @@ void StaticAssets::destroy(const GpuContext& gpu) {
 Status StaticAssets::stage(const GpuContext& gpu) {
   VkDeviceSize total = 0;
   for (const StaticImage& i : images_) total += i.spec.texels.size();
-  for (const StaticBuffer& b : buffers_) total += b.spec.bytes.size();
+  for (const StaticBuffer& b : buffers_) total += b.spec.source().size();
   SIVIFLOW_TRY(create_buffer(gpu, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true,
                              "static staging", &staging_));
   auto* bytes = static_cast<uint8_t*>(staging_.mapped);
@@ -74,11 +74,13 @@ Status StaticAssets::stage(const GpuContext& gpu) {
     i.spec.texels = std::vector<uint8_t>();  // the staging copy is the only one needed now
   }
   for (size_t n = 0; n < buffers_.size(); ++n) {
-    std::vector<uint8_t>& source = buffers_[n].spec.bytes;
+    BufferSpec& spec = buffers_[n].spec;
+    const std::span<const uint8_t> source = spec.source();
     std::memcpy(bytes + offset, source.data(), source.size());
     uploads_.buffers[n].staging_offset = offset;
     offset += source.size();
-    source = std::vector<uint8_t>();
+    spec.bytes = std::vector<uint8_t>();
+    spec.borrowed = {};
   }
   return Status::success();
 }
