@@ -33,11 +33,25 @@ Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh,
   return Status::success();
 }
 
+namespace {
+
+// Whether the surface's positions and triangles are the mesh's own: it welded nothing and kept
+// the winding (the procedural river's mesh).
+bool surface_is_mesh(const RiverSurface& surface, std::span<const uint32_t> indices) {
+  return !surface.welded() && std::ranges::equal(surface.triangles(), indices);
+}
+
+}  // namespace
+
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   RiverInput input;
   SIVIFLOW_TRY(procedural_river_mesh(river, &input.mesh, &input.slope));
   SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, RiverSurfaceOptions{},
                                    &input.surface));
+  if (surface_is_mesh(input.surface, input.mesh.indices)) {
+    input.mesh.positions = {};
+    input.mesh.indices = {};
+  }
   *out = std::move(input);
   return Status::success();
 }
@@ -66,13 +80,15 @@ Status river_input_from(const WaterRiver& river, RiverInput* out) {
     }
   }
   RiverInput input;
-  input.mesh.positions.assign(river.positions.begin(), river.positions.end());
-  input.mesh.indices.assign(river.indices.begin(), river.indices.end());
+  const Status built =
+      RiverSurface::build(river.positions, river.indices, RiverSurfaceOptions{}, &input.surface);
+  if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
+  if (!surface_is_mesh(input.surface, river.indices)) {
+    input.mesh.positions.assign(river.positions.begin(), river.positions.end());
+    input.mesh.indices.assign(river.indices.begin(), river.indices.end());
+  }
   input.mesh.depth.assign(river.depth.begin(), river.depth.end());
   input.slope.assign(river.slope.begin(), river.slope.end());
-  const Status built = RiverSurface::build(input.mesh.positions, input.mesh.indices,
-                                           RiverSurfaceOptions{}, &input.surface);
-  if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
   *out = std::move(input);
   return Status::success();
 }
@@ -108,12 +124,10 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
   full_solves_ = 1;
   const RiverSurface& surface = flow_.surface();
-  const size_t count = mesh_.positions.size();
-  per_node_ = !surface.welded() && std::ranges::equal(surface.triangles(), mesh_.indices);
+  const size_t count = surface.vertex_count();
+  per_node_ = mesh_.positions.empty();
   std::span<const uint32_t> section = surface.node_section();
   if (per_node_) {
-    mesh_.positions = {};
-    mesh_.indices = {};
     field_.positions = surface.node_positions();
     field_.indices = surface.triangles();
     field_.flow = flow_.node_velocity();

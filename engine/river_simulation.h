@@ -27,7 +27,9 @@
 namespace siviflow {
 
 // What the simulation runs on: the river's mesh (positions, indices, depth), the riverbed slope
-// under each vertex (rise over run), and the surface built from the mesh (built once).
+// under each vertex (rise over run), and the surface built from the mesh (built once). The mesh
+// has no positions and indices when the surface's are the same (it welded nothing and kept the
+// winding): one copy of a long river, not two.
 struct RiverInput {
   RiverMesh mesh;
   std::vector<float> slope;
@@ -93,9 +95,9 @@ class RiverFlow {
   // Re-reads the solved velocity per vertex and derives the foam from it.
   void refresh_velocity();
 
-  // A mesh the surface welded nothing of and wound as it came (the procedural river's) is read
-  // from the surface: positions, indices, section and velocity per vertex are then its per-node
-  // arrays, and mesh_ keeps only the depth; else mesh_, section_copy_ and velocity_copy_.
+  // A mesh the surface welded nothing of and wound as it came (RiverInput) is read from the
+  // surface: positions, indices, section and velocity per vertex are then its per-node arrays;
+  // else mesh_, section_copy_ and velocity_copy_.
   bool per_node_ = false;
   RiverMesh mesh_;
   StreamFunction flow_;
