@@ -246,6 +246,14 @@ RiverVertex RiverSurface::node(uint32_t n) const {
   return v;
 }
 
+size_t RiverSurface::memory_bytes() const {
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return bytes(node_of_vertex_) + bytes(node_vertex_) + bytes(node_positions_) +
+         bytes(node_section_) + bytes(node_bank_) + bytes(node_d_left_) + bytes(node_d_right_) +
+         bytes(triangles_) + bytes(node_tri_start_) + bytes(node_tri_list_) + bytes(sections_) +
+         bytes(section_nodes_);
+}
+
 Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                            const RiverSurfaceOptions& options, RiverSurface* out) {
   // --- Sizes, before anything is allocated or read.

@@ -225,6 +225,14 @@ void StreamFunction::update_node_velocity(uint32_t n) {
   node_velocity_[n] = v;
 }
 
+size_t StreamFunction::memory_bytes() const {
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return surface_.memory_bytes() + bytes(psi_) + bytes(wet_) + bytes(node_velocity_) +
+         bytes(triangle_area2_) + bytes(obstacles_) + bytes(state_) + bytes(active_) +
+         node_grid_.memory_bytes() + triangle_grid_.memory_bytes() + bytes(node_stamp_) +
+         bytes(triangle_stamp_) + bytes(scratch_nodes_) + bytes(scratch_triangles_);
+}
+
 void StreamFunction::solve_full() {
   const size_t nodes = surface_.node_count();
   psi_.resize(nodes);

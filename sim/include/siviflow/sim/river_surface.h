@@ -99,6 +99,8 @@ class RiverSurface {
   float widest_section() const { return widest_; }
   // Length of the bounding-box diagonal: the scale the geometric tolerances are relative to.
   float extent() const { return extent_; }
+  // Bytes of its arrays: what a long river costs to keep.
+  size_t memory_bytes() const;
 
  private:
   std::vector<uint32_t> node_of_vertex_;  // both empty when nothing was welded

@@ -73,6 +73,8 @@ class StreamFunction {
   // Re-solves every vertex for the obstacles where they are now.
   void solve_full();
   const FlowUpdateStats& last_update() const { return stats_; }
+  // Bytes of its arrays, the surface's included (the obstacle grids only once obstacles came).
+  size_t memory_bytes() const;
 
   // --- Per input vertex.
   double psi(size_t vertex) const { return psi_[surface_.node_of(vertex)]; }
