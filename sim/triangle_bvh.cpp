@@ -98,7 +98,9 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     refs[t] = {b.lo, b.hi, t};
     root_box.grow(b);
   }
-  bvh.nodes_.reserve(2 * (tri_count / kLeafTriangles) + 1);
+  // A binary tree over n triangles has at most 2n - 1 nodes: reserved, it never reallocates (a
+  // doubling held both copies at once); pages never written cost no memory.
+  bvh.nodes_.reserve(2 * tri_count - 1);
   bvh.nodes_.push_back({root_box.lo, 0, root_box.hi, 0});
 
   std::vector<BuildTask> tasks{{0, 0, static_cast<uint32_t>(tri_count), 0}};
@@ -202,9 +204,10 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     tasks.push_back({left + 1, mid, task.end, task.depth + 1});
     tasks.push_back({left, task.begin, mid, task.depth + 1});
   }
-  bvh.nodes_.shrink_to_fit();
   bvh.order_.resize(tri_count);
   for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
+  refs = std::vector<Ref>();  // before the nodes' copy to their size
+  bvh.nodes_.shrink_to_fit();
   *out = std::move(bvh);
   return Status::success();
 }
