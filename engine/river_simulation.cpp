@@ -149,8 +149,10 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   auto bvh = std::make_shared<TriangleBvh>();
   SIVIFLOW_TRY(TriangleBvh::build(field_.positions, field_.indices, bvh.get()));
   bvh_ = std::move(bvh);
+  VertexTriangles around;  // the surface's, when its nodes are the vertices
+  if (per_node_) around = {surface.node_triangle_start(), surface.node_triangle_list()};
   SIVIFLOW_TRY(FoamField::create(field_.positions, field_.indices, section, bvh_.get(),
-                                 FoamParams{}, &foam_field_));
+                                 FoamParams{}, &foam_field_, around));
   refresh_velocity();
   // No speed: the particles take |flow|, as it would have held.
   field_.depth = mesh_.depth;

@@ -34,7 +34,7 @@ glm::vec3 barycentric_xz(const glm::vec3& p, const glm::vec3& a, const glm::vec3
 
 Status FoamField::create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                          std::span<const uint32_t> section, const TriangleBvh* bvh,
-                         const FoamParams& params, FoamField* out) {
+                         const FoamParams& params, FoamField* out, VertexTriangles around) {
   if (bvh == nullptr) return Status::error("FoamField: no ray-cast structure");
   if (section.size() != positions.size()) return Status::error("FoamField: a section per vertex");
   if (!(params.gradient_full > params.gradient_onset) || !(params.lifetime_s > 0.0f) ||
@@ -60,39 +60,26 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   const size_t count = positions.size();
   const size_t corners = indices.empty() ? count : indices.size();
   const auto corner = [&](size_t i) { return indices.empty() ? uint32_t(i) : indices[i]; };
-  // One-ring neighbours through the triangles, each listed once: counted, filled, then sorted
-  // and deduplicated in place (a vector per vertex cost a million allocations on a long river).
-  std::vector<uint32_t> fill(count + 1, 0);
   for (size_t i = 0; i < corners; ++i) {
     if (corner(i) >= count) return Status::error("FoamField: index out of range");
-    fill[corner(i) + 1] += 2;
   }
-  for (size_t v = 0; v < count; ++v) fill[v + 1] += fill[v];
-  std::vector<uint32_t> neighbours(fill.back());
-  for (size_t t = 0; t + 2 < corners; t += 3) {
-    const uint32_t v[3] = {corner(t), corner(t + 1), corner(t + 2)};
-    for (int i = 0; i < 3; ++i) {
-      neighbours[fill[v[i]]++] = v[(i + 1) % 3];
-      neighbours[fill[v[i]]++] = v[(i + 2) % 3];
+  field.indices_ = indices;
+  if (around.start.empty()) {
+    // Counted, then filled in triangle order.
+    field.own_start_.assign(count + 1, 0);
+    for (size_t i = 0; i < corners; ++i) ++field.own_start_[corner(i) + 1];
+    for (size_t v = 0; v < count; ++v) field.own_start_[v + 1] += field.own_start_[v];
+    field.own_list_.resize(corners);
+    std::vector<uint32_t> fill(field.own_start_.begin(), field.own_start_.end() - 1);
+    for (size_t i = 0; i < corners; ++i) {
+      field.own_list_[fill[corner(i)]++] = static_cast<uint32_t>(i / 3);
     }
+  } else if (around.start.size() != count + 1 || around.start.back() != around.list.size()) {
+    return Status::error("FoamField: the triangles around the vertices do not fit the mesh");
   }
-  field.ring_start_.reserve(count + 1);
-  uint32_t begin = 0;
-  uint32_t kept = 0;
-  for (size_t v = 0; v < count; ++v) {
-    const auto first = neighbours.begin() + begin;
-    const auto last = neighbours.begin() + fill[v];
-    std::sort(first, last);
-    field.ring_start_.push_back(kept);
-    kept = static_cast<uint32_t>(
-        std::copy(first, std::unique(first, last), neighbours.begin() + kept) - neighbours.begin());
-    begin = fill[v];
-  }
-  field.ring_start_.push_back(kept);
-  neighbours.resize(kept);
-  neighbours.shrink_to_fit();
-  field.ring_ = std::move(neighbours);
   *out = std::move(field);
+  // Spans into the moved vectors: a vector's move keeps its storage.
+  out->around_ = around.start.empty() ? VertexTriangles{out->own_start_, out->own_list_} : around;
   return Status::success();
 }
 
@@ -109,12 +96,23 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
   std::vector<uint32_t> upstream_vertex(count * 3, 0);
   std::vector<float> upstream_weight(count * 3, 0.0f);
   std::vector<float> source(count, 0.0f);
+  const auto corner = [&](size_t i) { return indices_.empty() ? uint32_t(i) : indices_[i]; };
+  std::vector<uint32_t> ring;
   for (size_t v = 0; v < count; ++v) {
+    // The one-ring through the triangles, each neighbour once, ascending.
+    ring.clear();
+    for (uint32_t k = around_.start[v]; k < around_.start[v + 1]; ++k) {
+      const size_t t = around_.list[k];
+      for (size_t c = 3 * t; c < 3 * t + 3; ++c) {
+        if (corner(c) != v) ring.push_back(corner(c));
+      }
+    }
+    std::sort(ring.begin(), ring.end());
+    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
     // Least-squares horizontal velocity gradient over the one-ring: G = (sum du dx^T)(sum dx dx^T)^-1.
     float axx = 0.0f, axz = 0.0f, azz = 0.0f;
     float bxx = 0.0f, bxz = 0.0f, bzx = 0.0f, bzz = 0.0f;
-    for (uint32_t k = ring_start_[v]; k < ring_start_[v + 1]; ++k) {
-      const uint32_t j = ring_[k];
+    for (const uint32_t j : ring) {
       const float dx = positions_[j].x - positions_[v].x;
       const float dz = positions_[j].z - positions_[v].z;
       const float dux = velocity[j].x - velocity[v].x;

@@ -90,6 +90,9 @@ class RiverSurface {
   std::span<const uint32_t> node_triangles(uint32_t n) const {
     return {node_tri_list_.data() + node_tri_start_[n], node_tri_start_[n + 1] - node_tri_start_[n]};
   }
+  // The same for every node at once: node n's are list[start[n] .. start[n + 1]).
+  std::span<const uint32_t> node_triangle_start() const { return node_tri_start_; }
+  std::span<const uint32_t> node_triangle_list() const { return node_tri_list_; }
 
   std::span<const RiverSection> sections() const { return sections_; }
   // Nodes of section k, from the left shore to the right shore.
