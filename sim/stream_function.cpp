@@ -71,15 +71,6 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
     }
   }
 
-  // Triangle areas (2x, as the P1 gradient wants them).
-  const auto pos = s.node_positions();
-  const auto tri = s.triangles();
-  f.triangle_area2_.resize(tris);
-  for (size_t t = 0; t < tris; ++t) {
-    const DVec3 a(pos[tri[3 * t]]), b(pos[tri[3 * t + 1]]), c(pos[tri[3 * t + 2]]);
-    f.triangle_area2_[t] = static_cast<float>(glm::length(glm::cross(b - a, c - a)));
-  }
-
   // No obstacles yet: the field is the obstacle-free one.
   f.psi_.resize(nodes);
   for (uint32_t n = 0; n < nodes; ++n) {
@@ -183,16 +174,20 @@ bool StreamFunction::influences(const ObstacleState& st, size_t obstacle, uint32
   return footprint_distance(obstacles_[obstacle], xz(st.centre), xz(p)) < s;
 }
 
-glm::vec3 StreamFunction::triangle_velocity(uint32_t t) const {
+StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t) const {
   const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
   const auto pos = surface_.node_positions();
   const DVec3 a(pos[tri[0]]), b(pos[tri[1]]), c(pos[tri[2]]);
+  // 2 x area, as the P1 gradient wants it, rounded to float as the velocities are.
+  const auto area2 = static_cast<float>(glm::length(glm::cross(b - a, c - a)));
   const double pa = psi_[tri[0]];
   // grad(psi) x n = sum_i psi_i e_i / (2 area), e_i the edge opposite vertex i, counter-clockwise
   // about n; the edges sum to zero, so psi_a drops out (and with it the rounding of large psi).
   const DVec3 g = (psi_[tri[1]] - pa) * (a - c) + (psi_[tri[2]] - pa) * (b - a);
-  return glm::vec3(g / double{triangle_area2_[t]});
+  return {area2, glm::vec3(g / double{area2})};
 }
+
+glm::vec3 StreamFunction::triangle_velocity(uint32_t t) const { return triangle_flow(t).velocity; }
 
 glm::vec3 StreamFunction::bank_tangent(uint32_t n) const {
   const Bank bank = surface_.node_bank()[n];
@@ -216,8 +211,9 @@ void StreamFunction::update_node_velocity(uint32_t n) {
   DVec3 sum(0.0);
   double area = 0.0;
   for (const uint32_t t : surface_.node_triangles(n)) {
-    sum += double{triangle_area2_[t]} * DVec3(triangle_velocity(t));
-    area += triangle_area2_[t];
+    const TriangleFlow flow = triangle_flow(t);
+    sum += double{flow.area2} * DVec3(flow.velocity);
+    area += flow.area2;
   }
   glm::vec3 v(sum / area);
   const glm::vec3 tangent = bank_tangent(n);
@@ -228,7 +224,7 @@ void StreamFunction::update_node_velocity(uint32_t n) {
 size_t StreamFunction::memory_bytes() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return surface_.memory_bytes() + bytes(psi_) + bytes(wet_) + bytes(node_velocity_) +
-         bytes(triangle_area2_) + bytes(obstacles_) + bytes(state_) + bytes(active_) +
+         bytes(obstacles_) + bytes(state_) + bytes(active_) +
          node_grid_.memory_bytes() + triangle_grid_.memory_bytes() + bytes(node_stamp_) +
          bytes(triangle_stamp_) + bytes(scratch_nodes_) + bytes(scratch_triangles_);
 }
@@ -256,8 +252,9 @@ void StreamFunction::build_grids() {
   }
   // Cells of about two triangle edges hold a few vertices each in the river, whatever its shape.
   double mean_area2 = 0.0;
-  for (const float a : triangle_area2_) mean_area2 += a;
-  mean_area2 /= static_cast<double>(std::max<size_t>(triangle_area2_.size(), 1));
+  const size_t tris = surface_.triangle_count();
+  for (uint32_t t = 0; t < tris; ++t) mean_area2 += triangle_flow(t).area2;
+  mean_area2 /= static_cast<double>(std::max<size_t>(tris, 1));
   const double cell = std::max(2.0 * std::sqrt(mean_area2), 1e-6 * surface_.extent());
   const size_t max_cells = static_cast<size_t>(kMaxGridCellsPerVertex * static_cast<double>(pos.size())) + 16;
   node_grid_.init(lo, hi, cell, max_cells);

@@ -110,6 +110,11 @@ class StreamFunction {
 
   double evaluate(uint32_t node, bool use_obstacles, bool* wet) const;
   bool influences(const ObstacleState& state, size_t obstacle, uint32_t node) const;
+  struct TriangleFlow {
+    float area2;         // 2 x area
+    glm::vec3 velocity;  // grad(psi) x n
+  };
+  TriangleFlow triangle_flow(uint32_t t) const;
   void update_node_velocity(uint32_t n);
   // Unit, downstream, on a bank node (its section's shore); zero elsewhere.
   glm::vec3 bank_tangent(uint32_t n) const;
@@ -121,12 +126,11 @@ class StreamFunction {
 
   RiverSurface surface_;
   FlowParams params_;
-  // Only what a re-solve cannot cheaply recompute is kept per node or triangle: the obstacle-free
-  // psi, the triangle velocities, the node areas and bank tangents are derived when needed.
+  // Only what a re-solve cannot cheaply recompute is kept per node: the obstacle-free psi, the
+  // triangles' areas and velocities, the node areas and bank tangents are derived when needed.
   std::vector<double> psi_;
   std::vector<uint8_t> wet_;
   std::vector<glm::vec3> node_velocity_;
-  std::vector<float> triangle_area2_;        // 2 x area of every triangle
   std::vector<Obstacle> obstacles_;
   std::vector<ObstacleState> state_;
   std::vector<uint32_t> active_;             // obstacles in the water, ascending
