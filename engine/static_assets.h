@@ -53,7 +53,8 @@ class StaticAssets {
   // Before create(): each returns the asset's index.
   uint32_t add_buffer(BufferSpec spec);
   uint32_t add_image(ImageSpec spec);
-  // Creates every buffer and image and declares their upload.
+  // Creates every buffer and image and declares their upload; a buffer in memory the host maps
+  // (a unified-memory device's) is filled here instead, and its bytes freed.
   Status create(const GpuContext& gpu);
   void destroy(const GpuContext& gpu);
 
@@ -91,6 +92,7 @@ class StaticAssets {
     Image image;
   };
   std::vector<StaticBuffer> buffers_;
+  std::vector<uint32_t> staged_buffers_;  // those copied from staging, in uploads_.buffers' order
   std::vector<StaticImage> images_;
   FrameGraph upload_graph_;
   BufferHandle staging_handle_;
