@@ -48,10 +48,14 @@ Status SharedRiver::create(const DeviceTable& table, const VkAllocationCallbacks
   river->scene_obstacle_count = river->flow.obstacle_count();
   river->cut_into_chunks();
   StaticAssets& assets = river->assets;
-  assets.add_buffer({"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
-                     {}, byte_view(river->flow.positions())});
-  assets.add_buffer({"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
-                     {}, byte_view(river->flow.indices())});
+  StaticAssets::BufferSpec vertices{"river vertices", Access::VertexBufferRead,
+                                    VK_BUFFER_USAGE_VERTEX_BUFFER_BIT};
+  vertices.borrowed = byte_view(river->flow.positions());
+  assets.add_buffer(std::move(vertices));
+  StaticAssets::BufferSpec indices{"river indices", Access::IndexBufferRead,
+                                   VK_BUFFER_USAGE_INDEX_BUFFER_BIT};
+  indices.borrowed = byte_view(river->flow.indices());
+  assets.add_buffer(std::move(indices));
   WaterNormalMap normal_map = make_water_normal_map();
   assets.add_image({"water normal map", kNormalMapFormat, {normal_map.size, normal_map.size},
                     std::move(normal_map.texels), std::move(normal_map.mip_offsets)});
@@ -102,8 +106,7 @@ void SharedRiver::add_water_heights() {
   // edge of a vertex: samples farther than both (at the largest tile) are no tile's. Steps go
   // along the axes, so a distance d takes up to d sqrt(2) / spacing of them, plus one for the
   // vertex's own sample.
-  const float reach =
-      (kMaxTileSizeM + longest_edge_xz(surface, flow.indices())) * std::sqrt(2.0f);
+  const float reach = (kMaxTileSizeM + longest_edge_xz(surface, flow.indices())) * std::sqrt(2.0f);
   const auto reach_steps = static_cast<uint32_t>(std::ceil(reach / heights.spacing)) + 1;
   std::vector<float> texels(heights.heights.size());
   for (size_t i = 0; i < texels.size(); ++i) {

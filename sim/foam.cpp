@@ -151,7 +151,7 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
                        std::min(section_speed / p.bank_speed_full, 1.0f);
     const float relative_gradient = gradient / std::max(section_speed, p.min_section_speed);
     source[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
-                           lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
+                          lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
 
     // Where this vertex's water was one step ago: cast down onto the surface there.
     const glm::vec3 back = positions_[v] - p.step_s * glm::vec3(velocity[v].x, 0.0f, velocity[v].z);

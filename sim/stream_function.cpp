@@ -197,7 +197,8 @@ glm::vec3 StreamFunction::bank_tangent(uint32_t n) const {
   const size_t prev = k == 0 ? 0 : k - 1;
   const size_t next = std::min(k + 1, sections.size() - 1);
   auto shore = [&](size_t j) {
-    return bank == Bank::kLeft ? surface_.section_nodes(j).front() : surface_.section_nodes(j).back();
+    return bank == Bank::kLeft ? surface_.section_nodes(j).front()
+                               : surface_.section_nodes(j).back();
   };
   const auto pos = surface_.node_positions();
   return glm::vec3(glm::normalize(DVec3(pos[shore(next)]) - DVec3(pos[shore(prev)])));
@@ -224,9 +225,9 @@ void StreamFunction::update_node_velocity(uint32_t n) {
 size_t StreamFunction::memory_bytes() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return surface_.memory_bytes() + bytes(psi_) + bytes(wet_) + bytes(node_velocity_) +
-         bytes(obstacles_) + bytes(state_) + bytes(active_) +
-         node_grid_.memory_bytes() + triangle_grid_.memory_bytes() + bytes(node_stamp_) +
-         bytes(triangle_stamp_) + bytes(scratch_nodes_) + bytes(scratch_triangles_);
+         bytes(obstacles_) + bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
+         triangle_grid_.memory_bytes() + bytes(node_stamp_) + bytes(triangle_stamp_) +
+         bytes(scratch_nodes_) + bytes(scratch_triangles_);
 }
 
 void StreamFunction::solve_full() {

@@ -123,7 +123,8 @@ TEST_F(FoamTest, SharedAdjacencyGivesTheSameFoam) {
   ASSERT_FALSE(surface.welded());
   const VertexTriangles around{surface.node_triangle_start(), surface.node_triangle_list()};
   ASSERT_TRUE(FoamField::create(mesh_.positions, mesh_.indices, section_, &bvh_, FoamParams{},
-                                &field_, around).ok());
+                                &field_, around)
+                  .ok());
   EXPECT_EQ(foam(), own);
   FoamField field;
   const VertexTriangles short_start{around.start.first(around.start.size() - 1), around.list};
