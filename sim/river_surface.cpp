@@ -302,6 +302,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   std::vector<uint32_t> node_of_vertex(vertex_count);
   std::vector<uint32_t> node_vertex;
   std::vector<glm::vec3> pos;
+  pos.reserve(vertex_count);  // kept: grown by doubling, it held up to twice its size
   {
     const size_t table_size = std::bit_ceil(2 * vertex_count);
     std::vector<uint32_t> table(table_size, kUnset);
@@ -682,6 +683,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     s.node_of_vertex_ = std::move(node_of_vertex);
     s.node_vertex_ = std::move(node_vertex);
   }
+  pos.shrink_to_fit();  // a copy only where vertices were welded
   s.node_positions_ = std::move(pos);
   s.triangles_ = std::move(tris);
   s.node_tri_start_ = std::move(node_tris.start);
