@@ -455,7 +455,7 @@ float Renderer::Impl::visible_water_level() {
   for (const Particle& p : simulation.particle_field().particles()) {
     if (p.live()) heights.push_back(p.world.y);
   }
-  if (heights.empty()) return river->flow.mesh().positions.front().y;  // no water on screen
+  if (heights.empty()) return river->flow.positions().front().y;  // no water on screen
   const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
   std::nth_element(heights.begin(), middle, heights.end());
   return *middle;

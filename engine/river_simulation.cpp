@@ -33,11 +33,25 @@ Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh,
   return Status::success();
 }
 
+namespace {
+
+// Whether the surface's positions and triangles are the mesh's own: it welded nothing and kept
+// the winding (the procedural river's mesh).
+bool surface_is_mesh(const RiverSurface& surface, std::span<const uint32_t> indices) {
+  return !surface.welded() && std::ranges::equal(surface.triangles(), indices);
+}
+
+}  // namespace
+
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   RiverInput input;
   SIVIFLOW_TRY(procedural_river_mesh(river, &input.mesh, &input.slope));
   SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, RiverSurfaceOptions{},
                                    &input.surface));
+  if (surface_is_mesh(input.surface, input.mesh.indices)) {
+    input.mesh.positions = {};
+    input.mesh.indices = {};
+  }
   *out = std::move(input);
   return Status::success();
 }
@@ -66,13 +80,15 @@ Status river_input_from(const WaterRiver& river, RiverInput* out) {
     }
   }
   RiverInput input;
-  input.mesh.positions.assign(river.positions.begin(), river.positions.end());
-  input.mesh.indices.assign(river.indices.begin(), river.indices.end());
+  const Status built =
+      RiverSurface::build(river.positions, river.indices, RiverSurfaceOptions{}, &input.surface);
+  if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
+  if (!surface_is_mesh(input.surface, river.indices)) {
+    input.mesh.positions.assign(river.positions.begin(), river.positions.end());
+    input.mesh.indices.assign(river.indices.begin(), river.indices.end());
+  }
   input.mesh.depth.assign(river.depth.begin(), river.depth.end());
   input.slope.assign(river.slope.begin(), river.slope.end());
-  const Status built = RiverSurface::build(input.mesh.positions, input.mesh.indices,
-                                           RiverSurfaceOptions{}, &input.surface);
-  if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
   *out = std::move(input);
   return Status::success();
 }
@@ -107,27 +123,38 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   for (const Obstacle& obstacle : obstacles) has_keys_ = has_keys_ || !obstacle.keys.empty();
   SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
   full_solves_ = 1;
-  const size_t count = mesh_.positions.size();
-  velocity_.resize(count);
-  speed_.resize(count);
+  const RiverSurface& surface = flow_.surface();
+  const size_t count = surface.vertex_count();
+  per_node_ = mesh_.positions.empty();
+  std::span<const uint32_t> section = surface.node_section();
+  if (per_node_) {
+    field_.positions = surface.node_positions();
+    field_.indices = surface.triangles();
+    field_.flow = flow_.node_velocity();
+  } else {
+    section_copy_.resize(count);
+    for (size_t v = 0; v < count; ++v) section_copy_[v] = section[surface.node_of(v)];
+    section = section_copy_;
+    velocity_copy_.resize(count);
+    field_.positions = mesh_.positions;
+    field_.indices = mesh_.indices;
+    field_.flow = velocity_copy_;
+  }
   foam_.resize(count);
   bank_distance_.resize(count);
-  section_.resize(count);
   for (size_t v = 0; v < count; ++v) {
-    const RiverVertex vertex = flow_.surface().vertex(v);
+    const RiverVertex vertex = surface.vertex(v);
     bank_distance_[v] = std::min(vertex.d_left, vertex.d_right);
-    section_[v] = vertex.section;
   }
   auto bvh = std::make_shared<TriangleBvh>();
-  SIVIFLOW_TRY(TriangleBvh::build(mesh_.positions, mesh_.indices, bvh.get()));
+  SIVIFLOW_TRY(TriangleBvh::build(field_.positions, field_.indices, bvh.get()));
   bvh_ = std::move(bvh);
-  SIVIFLOW_TRY(FoamField::create(mesh_.positions, mesh_.indices, section_, bvh_.get(), FoamParams{},
-                                 &foam_field_));
+  VertexTriangles around;  // the surface's, when its nodes are the vertices
+  if (per_node_) around = {surface.node_triangle_start(), surface.node_triangle_list()};
+  SIVIFLOW_TRY(FoamField::create(field_.positions, field_.indices, section, bvh_.get(),
+                                 FoamParams{}, &foam_field_, around));
   refresh_velocity();
-  field_.positions = mesh_.positions;
-  field_.indices = mesh_.indices;
-  field_.flow = velocity_;
-  field_.speed = speed_;
+  // No speed: the particles take |flow|, as it would have held.
   field_.depth = mesh_.depth;
   field_.slope = slope_;
   field_.foam = foam_;
@@ -141,11 +168,8 @@ void RiverFlow::query(std::span<const glm::vec3> points, std::span<WaterSample> 
 }
 
 void RiverFlow::refresh_velocity() {
-  for (size_t v = 0; v < velocity_.size(); ++v) {
-    velocity_[v] = flow_.velocity(v);
-    speed_[v] = glm::length(velocity_[v]);
-  }
-  foam_field_.compute(velocity_, bank_distance_, foam_);
+  for (size_t v = 0; v < velocity_copy_.size(); ++v) velocity_copy_[v] = flow_.velocity(v);
+  foam_field_.compute(field_.flow, bank_distance_, foam_);
 }
 
 Status RiverFlow::set_time(double time_seconds) {

@@ -28,7 +28,9 @@
 namespace siviflow {
 
 // What the simulation runs on: the river's mesh (positions, indices, depth), the riverbed slope
-// under each vertex (rise over run), and the surface built from the mesh (built once).
+// under each vertex (rise over run), and the surface built from the mesh (built once). The mesh
+// has no positions and indices when the surface's are the same (it welded nothing and kept the
+// winding): one copy of a long river, not two.
 struct RiverInput {
   RiverMesh mesh;
   std::vector<float> slope;
@@ -80,7 +82,9 @@ class RiverFlow {
   // only; safe beside other reads, not beside a call that changes the obstacles or the time.
   void query(std::span<const glm::vec3> points, std::span<WaterSample> out) const;
 
-  const RiverMesh& mesh() const { return mesh_; }
+  // The river's mesh, in the host's vertex order.
+  std::span<const glm::vec3> positions() const { return field_.positions; }
+  std::span<const uint32_t> indices() const { return field_.indices; }
   // The surface, its flow and what the particles read per vertex (spans into this object).
   const RiverFlowField& field() const { return field_; }
   std::shared_ptr<const TriangleBvh> bvh() const { return bvh_; }
@@ -97,13 +101,16 @@ class RiverFlow {
   // Re-reads the solved velocity per vertex and derives the foam from it.
   void refresh_velocity();
 
+  // A mesh the surface welded nothing of and wound as it came (RiverInput) is read from the
+  // surface: positions, indices, section and velocity per vertex are then its per-node arrays;
+  // else mesh_, section_copy_ and velocity_copy_.
+  bool per_node_ = false;
   RiverMesh mesh_;
   StreamFunction flow_;
-  std::vector<glm::vec3> velocity_;  // per vertex, m/s
-  std::vector<float> speed_;
+  std::vector<glm::vec3> velocity_copy_;  // per vertex, m/s
   std::vector<float> slope_;         // riverbed slope under the vertex (rise over run)
   std::vector<float> bank_distance_;  // to the nearer margin along the section, metres
-  std::vector<uint32_t> section_;    // per vertex
+  std::vector<uint32_t> section_copy_;
   std::vector<float> foam_;          // 0..1 per vertex (sim/foam.h)
   FoamField foam_field_;
   bool has_keys_ = false;            // some obstacle moves: re-solve as time goes

@@ -25,8 +25,7 @@ constexpr uint32_t kMaxWaterHeightSamples = 2048;
 constexpr uint32_t kChunkTriangles = 1024;  // per axis: 16 MiB at most, samples widen beyond
 
 // The longest triangle edge of a mesh, seen from above.
-float longest_edge_xz(const std::vector<glm::vec3>& positions,
-                      const std::vector<uint32_t>& indices) {
+float longest_edge_xz(std::span<const glm::vec3> positions, std::span<const uint32_t> indices) {
   float longest = 0.0f;
   for (size_t t = 0; t + 2 < indices.size(); t += 3) {
     for (int e = 0; e < 3; ++e) {
@@ -47,13 +46,16 @@ Status SharedRiver::create(const DeviceTable& table, const VkAllocationCallbacks
   river->gpu = make_gpu_context(river->table, callbacks);
   SIVIFLOW_TRY(river->flow.create(std::move(input), flow, std::move(obstacles)));
   river->scene_obstacle_count = river->flow.obstacle_count();
-  const RiverMesh& surface = river->flow.mesh();
   river->cut_into_chunks();
   StaticAssets& assets = river->assets;
-  assets.add_buffer({"river vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
-                     bytes_of(surface.positions)});
-  assets.add_buffer({"river indices", Access::IndexBufferRead, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
-                     bytes_of(surface.indices)});
+  StaticAssets::BufferSpec vertices{"river vertices", Access::VertexBufferRead,
+                                    VK_BUFFER_USAGE_VERTEX_BUFFER_BIT};
+  vertices.borrowed = byte_view(river->flow.positions());
+  assets.add_buffer(std::move(vertices));
+  StaticAssets::BufferSpec indices{"river indices", Access::IndexBufferRead,
+                                   VK_BUFFER_USAGE_INDEX_BUFFER_BIT};
+  indices.borrowed = byte_view(river->flow.indices());
+  assets.add_buffer(std::move(indices));
   WaterNormalMap normal_map = make_water_normal_map();
   assets.add_image({"water normal map", kNormalMapFormat, {normal_map.size, normal_map.size},
                     std::move(normal_map.texels), std::move(normal_map.mip_offsets)});
@@ -68,16 +70,17 @@ SharedRiver::~SharedRiver() {
 }
 
 void SharedRiver::cut_into_chunks() {
-  const RiverMesh& surface = flow.mesh();
-  const auto count = static_cast<uint32_t>(surface.indices.size());
+  const std::span<const glm::vec3> positions = flow.positions();
+  const std::span<const uint32_t> indices = flow.indices();
+  const auto count = static_cast<uint32_t>(indices.size());
   for (uint32_t first = 0; first < count; first += 3 * kChunkTriangles) {
     Chunk chunk;
     chunk.indices = {first, std::min(3 * kChunkTriangles, count - first)};
     chunk.lo = glm::vec3(std::numeric_limits<float>::max());
     chunk.hi = glm::vec3(std::numeric_limits<float>::lowest());
     for (uint32_t i = first; i < first + chunk.indices.index_count; ++i) {
-      chunk.lo = glm::min(chunk.lo, surface.positions[surface.indices[i]]);
-      chunk.hi = glm::max(chunk.hi, surface.positions[surface.indices[i]]);
+      chunk.lo = glm::min(chunk.lo, positions[indices[i]]);
+      chunk.hi = glm::max(chunk.hi, positions[indices[i]]);
     }
     chunks.push_back(chunk);
   }
@@ -86,7 +89,7 @@ void SharedRiver::cut_into_chunks() {
 // The water height under every tile centre the water material may read (shaders/shared.h),
 // for any tile size the look allows.
 void SharedRiver::add_water_heights() {
-  const std::vector<glm::vec3>& surface = flow.mesh().positions;
+  const std::span<const glm::vec3> surface = flow.positions();
   const WaterHeights heights =
       water_heights(surface, kWaterHeightSpacing, kWaterHeightMargin, kMaxWaterHeightSamples);
   heights_origin = heights.origin;
@@ -103,8 +106,7 @@ void SharedRiver::add_water_heights() {
   // edge of a vertex: samples farther than both (at the largest tile) are no tile's. Steps go
   // along the axes, so a distance d takes up to d sqrt(2) / spacing of them, plus one for the
   // vertex's own sample.
-  const float reach =
-      (kMaxTileSizeM + longest_edge_xz(surface, flow.mesh().indices)) * std::sqrt(2.0f);
+  const float reach = (kMaxTileSizeM + longest_edge_xz(surface, flow.indices())) * std::sqrt(2.0f);
   const auto reach_steps = static_cast<uint32_t>(std::ceil(reach / heights.spacing)) + 1;
   std::vector<float> texels(heights.heights.size());
   for (size_t i = 0; i < texels.size(); ++i) {

@@ -17,13 +17,24 @@ uint32_t StaticAssets::add_image(ImageSpec spec) {
 
 Status StaticAssets::create(const GpuContext& gpu) {
   staging_handle_ = upload_graph_.import_buffer({"static staging", 0}, ResourceState{});
-  for (StaticBuffer& b : buffers_) {
-    SIVIFLOW_TRY(create_buffer(gpu, b.spec.bytes.size(),
-                               b.spec.usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, b.spec.name,
-                               &b.buffer));
+  for (uint32_t n = 0; n < buffers_.size(); ++n) {
+    StaticBuffer& b = buffers_[n];
+    const std::span<const uint8_t> source = b.spec.source();
+    SIVIFLOW_TRY(create_device_buffer(gpu, source.size(),
+                                      b.spec.usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, b.spec.name,
+                                      &b.buffer));
+    if (b.buffer.mapped != nullptr) {
+      // The device's memory is the host's: filled in place, no staging copy. The first submit
+      // that reads it makes the host's writes visible.
+      std::memcpy(b.buffer.mapped, source.data(), source.size());
+      b.spec.bytes = std::vector<uint8_t>();
+      b.spec.borrowed = {};
+      continue;
+    }
     const BufferHandle handle = upload_graph_.import_buffer(
         {b.spec.name, b.buffer.size}, ResourceState{}, state_of(b.spec.read_as));
     uploads_.buffers.push_back({0, handle, b.buffer.size});
+    staged_buffers_.push_back(n);
   }
   std::vector<ImageHandle> handles;
   for (const StaticImage& i : images_) {
@@ -58,7 +69,7 @@ void StaticAssets::destroy(const GpuContext& gpu) {
 Status StaticAssets::stage(const GpuContext& gpu) {
   VkDeviceSize total = 0;
   for (const StaticImage& i : images_) total += i.spec.texels.size();
-  for (const StaticBuffer& b : buffers_) total += b.spec.bytes.size();
+  for (const uint32_t n : staged_buffers_) total += buffers_[n].spec.source().size();
   SIVIFLOW_TRY(create_buffer(gpu, total, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, /*host_visible=*/true,
                              "static staging", &staging_));
   auto* bytes = static_cast<uint8_t*>(staging_.mapped);
@@ -73,12 +84,14 @@ Status StaticAssets::stage(const GpuContext& gpu) {
     offset += i.spec.texels.size();
     i.spec.texels = std::vector<uint8_t>();  // the staging copy is the only one needed now
   }
-  for (size_t n = 0; n < buffers_.size(); ++n) {
-    std::vector<uint8_t>& source = buffers_[n].spec.bytes;
+  for (size_t upload_index = 0; upload_index < staged_buffers_.size(); ++upload_index) {
+    BufferSpec& spec = buffers_[staged_buffers_[upload_index]].spec;
+    const std::span<const uint8_t> source = spec.source();
     std::memcpy(bytes + offset, source.data(), source.size());
-    uploads_.buffers[n].staging_offset = offset;
+    uploads_.buffers[upload_index].staging_offset = offset;
     offset += source.size();
-    source = std::vector<uint8_t>();
+    spec.bytes = std::vector<uint8_t>();
+    spec.borrowed = {};
   }
   return Status::success();
 }
@@ -86,8 +99,9 @@ Status StaticAssets::stage(const GpuContext& gpu) {
 Status StaticAssets::record_upload(const DeviceTable& table, VkCommandBuffer cmd) {
   FrameBindings bindings;
   bindings.bind_buffer(staging_handle_, staging_.buffer);
-  for (size_t n = 0; n < buffers_.size(); ++n) {
-    bindings.bind_buffer(uploads_.buffers[n].destination, buffers_[n].buffer.buffer);
+  for (size_t upload_index = 0; upload_index < staged_buffers_.size(); ++upload_index) {
+    bindings.bind_buffer(uploads_.buffers[upload_index].destination,
+                         buffers_[staged_buffers_[upload_index]].buffer.buffer);
   }
   size_t upload = 0;
   for (const StaticImage& i : images_) {

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -20,9 +21,13 @@ namespace siviflow {
 
 // The bytes of a contiguous container, for a static upload.
 template <typename Items>
+std::span<const uint8_t> byte_view(const Items& items) {
+  return {reinterpret_cast<const uint8_t*>(items.data()), items.size() * sizeof(items[0])};
+}
+template <typename Items>
 std::vector<uint8_t> bytes_of(const Items& items) {
-  const auto* first = reinterpret_cast<const uint8_t*>(items.data());
-  return std::vector<uint8_t>(first, first + items.size() * sizeof(items[0]));
+  const std::span<const uint8_t> bytes = byte_view(items);
+  return std::vector<uint8_t>(bytes.begin(), bytes.end());
 }
 
 class StaticAssets {
@@ -32,6 +37,10 @@ class StaticAssets {
     Access read_as = Access::VertexBufferRead;  // how the frame graph reads it
     VkBufferUsageFlags usage = 0;
     std::vector<uint8_t> bytes;  // kept until staged
+    // Instead of `bytes`: the owner's, unchanged and alive until staged (a long river's mesh is
+    // not copied for its upload).
+    std::span<const uint8_t> borrowed;
+    std::span<const uint8_t> source() const { return borrowed.empty() ? bytes : borrowed; }
   };
   struct ImageSpec {
     const char* name = "";
@@ -44,7 +53,8 @@ class StaticAssets {
   // Before create(): each returns the asset's index.
   uint32_t add_buffer(BufferSpec spec);
   uint32_t add_image(ImageSpec spec);
-  // Creates every buffer and image and declares their upload.
+  // Creates every buffer and image and declares their upload; a buffer in memory the host maps
+  // (a unified-memory device's) is filled here instead, and its bytes freed.
   Status create(const GpuContext& gpu);
   void destroy(const GpuContext& gpu);
 
@@ -82,6 +92,7 @@ class StaticAssets {
     Image image;
   };
   std::vector<StaticBuffer> buffers_;
+  std::vector<uint32_t> staged_buffers_;  // those copied from staging, in uploads_.buffers' order
   std::vector<StaticImage> images_;
   FrameGraph upload_graph_;
   BufferHandle staging_handle_;

@@ -34,7 +34,7 @@ glm::vec3 barycentric_xz(const glm::vec3& p, const glm::vec3& a, const glm::vec3
 
 Status FoamField::create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                          std::span<const uint32_t> section, const TriangleBvh* bvh,
-                         const FoamParams& params, FoamField* out) {
+                         const FoamParams& params, FoamField* out, VertexTriangles around) {
   if (bvh == nullptr) return Status::error("FoamField: no ray-cast structure");
   if (section.size() != positions.size()) return Status::error("FoamField: a section per vertex");
   if (!(params.gradient_full > params.gradient_onset) || !(params.lifetime_s > 0.0f) ||
@@ -60,43 +60,26 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   const size_t count = positions.size();
   const size_t corners = indices.empty() ? count : indices.size();
   const auto corner = [&](size_t i) { return indices.empty() ? uint32_t(i) : indices[i]; };
-  // One-ring neighbours through the triangles, each listed once: counted, filled, then sorted
-  // and deduplicated in place (a vector per vertex cost a million allocations on a long river).
-  std::vector<uint32_t> fill(count + 1, 0);
   for (size_t i = 0; i < corners; ++i) {
     if (corner(i) >= count) return Status::error("FoamField: index out of range");
-    fill[corner(i) + 1] += 2;
   }
-  for (size_t v = 0; v < count; ++v) fill[v + 1] += fill[v];
-  std::vector<uint32_t> neighbours(fill.back());
-  for (size_t t = 0; t + 2 < corners; t += 3) {
-    const uint32_t v[3] = {corner(t), corner(t + 1), corner(t + 2)};
-    for (int i = 0; i < 3; ++i) {
-      neighbours[fill[v[i]]++] = v[(i + 1) % 3];
-      neighbours[fill[v[i]]++] = v[(i + 2) % 3];
+  field.indices_ = indices;
+  if (around.start.empty()) {
+    // Counted, then filled in triangle order.
+    field.own_start_.assign(count + 1, 0);
+    for (size_t i = 0; i < corners; ++i) ++field.own_start_[corner(i) + 1];
+    for (size_t v = 0; v < count; ++v) field.own_start_[v + 1] += field.own_start_[v];
+    field.own_list_.resize(corners);
+    std::vector<uint32_t> fill(field.own_start_.begin(), field.own_start_.end() - 1);
+    for (size_t i = 0; i < corners; ++i) {
+      field.own_list_[fill[corner(i)]++] = static_cast<uint32_t>(i / 3);
     }
+  } else if (around.start.size() != count + 1 || around.start.back() != around.list.size()) {
+    return Status::error("FoamField: the triangles around the vertices do not fit the mesh");
   }
-  field.ring_start_.reserve(count + 1);
-  uint32_t begin = 0;
-  uint32_t kept = 0;
-  for (size_t v = 0; v < count; ++v) {
-    const auto first = neighbours.begin() + begin;
-    const auto last = neighbours.begin() + fill[v];
-    std::sort(first, last);
-    field.ring_start_.push_back(kept);
-    kept = static_cast<uint32_t>(
-        std::copy(first, std::unique(first, last), neighbours.begin() + kept) - neighbours.begin());
-    begin = fill[v];
-  }
-  field.ring_start_.push_back(kept);
-  neighbours.resize(kept);
-  neighbours.shrink_to_fit();
-  field.ring_ = std::move(neighbours);
-  field.upstream_vertex_.assign(count * 3, 0);
-  field.upstream_weight_.assign(count * 3, 0.0f);
-  field.source_.assign(count, 0.0f);
-  field.scratch_.assign(count, 0.0f);
   *out = std::move(field);
+  // Spans into the moved vectors: a vector's move keeps its storage.
+  out->around_ = around.start.empty() ? VertexTriangles{out->own_start_, out->own_list_} : around;
   return Status::success();
 }
 
@@ -108,12 +91,28 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
   for (size_t v = 0; v < count; ++v) {
     section_speed_[section_[v]] += std::hypot(velocity[v].x, velocity[v].z) / float(section_size_[section_[v]]);
   }
+  // Per vertex: where the flow came from one step earlier (3 vertices and their weights; all 0
+  // weights when that point is off the river), and its own foam source.
+  std::vector<uint32_t> upstream_vertex(count * 3, 0);
+  std::vector<float> upstream_weight(count * 3, 0.0f);
+  std::vector<float> source(count, 0.0f);
+  const auto corner = [&](size_t i) { return indices_.empty() ? uint32_t(i) : indices_[i]; };
+  std::vector<uint32_t> ring;
   for (size_t v = 0; v < count; ++v) {
+    // The one-ring through the triangles, each neighbour once, ascending.
+    ring.clear();
+    for (uint32_t k = around_.start[v]; k < around_.start[v + 1]; ++k) {
+      const size_t t = around_.list[k];
+      for (size_t c = 3 * t; c < 3 * t + 3; ++c) {
+        if (corner(c) != v) ring.push_back(corner(c));
+      }
+    }
+    std::sort(ring.begin(), ring.end());
+    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
     // Least-squares horizontal velocity gradient over the one-ring: G = (sum du dx^T)(sum dx dx^T)^-1.
     float axx = 0.0f, axz = 0.0f, azz = 0.0f;
     float bxx = 0.0f, bxz = 0.0f, bzx = 0.0f, bzz = 0.0f;
-    for (uint32_t k = ring_start_[v]; k < ring_start_[v + 1]; ++k) {
-      const uint32_t j = ring_[k];
+    for (const uint32_t j : ring) {
       const float dx = positions_[j].x - positions_[v].x;
       const float dz = positions_[j].z - positions_[v].z;
       const float dux = velocity[j].x - velocity[v].x;
@@ -151,14 +150,14 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
     const float bank = p.bank_strength * std::exp(-bank_distance[v] / p.bank_width_m) *
                        std::min(section_speed / p.bank_speed_full, 1.0f);
     const float relative_gradient = gradient / std::max(section_speed, p.min_section_speed);
-    source_[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
-                           lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
+    source[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
+                          lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
 
     // Where this vertex's water was one step ago: cast down onto the surface there.
     const glm::vec3 back = positions_[v] - p.step_s * glm::vec3(velocity[v].x, 0.0f, velocity[v].z);
     RayHit hit;
-    float* weight = &upstream_weight_[v * 3];
-    uint32_t* from = &upstream_vertex_[v * 3];
+    float* weight = &upstream_weight[v * 3];
+    uint32_t* from = &upstream_vertex[v * 3];
     if (bvh_->intersect(back + glm::vec3(0.0f, kRayHeight, 0.0f), {0.0f, -1.0f, 0.0f},
                         2.0f * kRayHeight, &hit)) {
       for (int c = 0; c < 3; ++c) from[c] = bvh_->triangle_vertex(hit.triangle, c);
@@ -172,16 +171,17 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
   }
   // Steady transport: each step the foam moves one step downstream and decays.
   const float decay = std::exp(-p.step_s / p.lifetime_s);
-  std::copy(source_.begin(), source_.end(), foam.begin());
+  std::copy(source.begin(), source.end(), foam.begin());
+  std::vector<float> next(count);
   for (uint32_t step = 0; step < p.steps; ++step) {
     for (size_t v = 0; v < count; ++v) {
-      const uint32_t* from = &upstream_vertex_[v * 3];
-      const float* weight = &upstream_weight_[v * 3];
+      const uint32_t* from = &upstream_vertex[v * 3];
+      const float* weight = &upstream_weight[v * 3];
       const float carried = weight[0] * foam[from[0]] + weight[1] * foam[from[1]] +
                             weight[2] * foam[from[2]];
-      scratch_[v] = std::max(source_[v], decay * carried);
+      next[v] = std::max(source[v], decay * carried);
     }
-    std::copy(scratch_.begin(), scratch_.end(), foam.begin());
+    std::copy(next.begin(), next.end(), foam.begin());
   }
 }
 

@@ -51,18 +51,31 @@ struct FoamParams {
   uint32_t steps = 30;           // transport steps: the wake is followed for steps * step_s
 };
 
+// The triangles around each vertex, in CSR form: vertex v's are list[start[v] .. start[v + 1]).
+struct VertexTriangles {
+  std::span<const uint32_t> start;  // one per vertex, and one past the last
+  std::span<const uint32_t> list;
+};
+
 class FoamField {
  public:
-  // Adjacency and scratch for the mesh (indices: 3 per triangle; empty, every 3 positions are
-  // one). `section`: each vertex's cross-section (river_surface.h). `bvh` is built on the same
-  // positions and indices; it and the spans outlive this object.
+  // For the mesh (indices: 3 per triangle; empty, every 3 positions are one). `section`: each
+  // vertex's cross-section (river_surface.h). `bvh` is built on the same positions and indices.
+  // `around`: the triangles around each vertex where the caller keeps them (a river surface's,
+  // when its nodes are the vertices); empty, the field builds its own. The spans and `bvh`
+  // outlive this object.
   static Status create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                        std::span<const uint32_t> section, const TriangleBvh* bvh,
-                       const FoamParams& params, FoamField* out);
+                       const FoamParams& params, FoamField* out, VertexTriangles around = {});
+  FoamField() = default;
+  FoamField(FoamField&&) = default;  // around_ may point into own_*: moves keep, copies would not
+  FoamField& operator=(FoamField&&) = default;
+  FoamField(const FoamField&) = delete;
+  FoamField& operator=(const FoamField&) = delete;
 
   // Foam per vertex in [0, 1] for the flow `velocity` (m/s per vertex); `bank_distance`: each
   // vertex's distance to the nearer margin along its section (metres). Writes `foam` (sized to
-  // the vertices).
+  // the vertices). Its scratch (32 bytes a vertex) lives only during the call.
   void compute(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
                std::span<float> foam);
 
@@ -70,19 +83,17 @@ class FoamField {
 
  private:
   std::span<const glm::vec3> positions_;
+  std::span<const uint32_t> indices_;
   std::span<const uint32_t> section_;
   const TriangleBvh* bvh_ = nullptr;
   FoamParams params_;
-  std::vector<uint32_t> ring_start_;  // per vertex: first of its neighbours in ring_
-  std::vector<uint32_t> ring_;        // one-ring neighbours (by shared triangle)
-  // Per vertex: where the flow came from one step earlier (3 vertices and their weights; all 0
-  // weights when that point is off the river).
-  std::vector<uint32_t> upstream_vertex_;
-  std::vector<float> upstream_weight_;
+  // The one-ring of a vertex is gathered from its triangles when needed: a long river keeps no
+  // neighbour lists.
+  VertexTriangles around_;
+  std::vector<uint32_t> own_start_;  // around_, when the caller gave none
+  std::vector<uint32_t> own_list_;
   std::vector<float> section_speed_;  // per section: its vertices' mean speed
   std::vector<uint32_t> section_size_;
-  std::vector<float> source_;
-  std::vector<float> scratch_;
 };
 
 }  // namespace siviflow

@@ -8,6 +8,7 @@
 
 #include <glm/common.hpp>
 #include <glm/gtc/constants.hpp>
+#include <glm/vec2.hpp>
 
 #include "siviflow/sim/river_tuning.h"
 #include "siviflow/text_format.h"
@@ -164,7 +165,6 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
   mesh.vertices_across = across;
   const size_t vertex_count = size_t{section_count} * across;
   mesh.positions.reserve(vertex_count);
-  mesh.uvs.reserve(vertex_count);
   mesh.depth.reserve(vertex_count);
   const float y = water_level();
   size_t seg = 1;
@@ -187,7 +187,6 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
       const double offset = half_width * (1.0 - 2.0 * t);
       const glm::vec3 p(float(x + offset * left.x), y, float(z + offset * left.y));
       mesh.positions.push_back(p);
-      mesh.uvs.emplace_back(float(t), float(target));
       mesh.depth.push_back(depth_at(p.x, p.z));
     }
   }

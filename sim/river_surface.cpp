@@ -246,6 +246,14 @@ RiverVertex RiverSurface::node(uint32_t n) const {
   return v;
 }
 
+size_t RiverSurface::memory_bytes() const {
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return bytes(node_of_vertex_) + bytes(node_vertex_) + bytes(node_positions_) +
+         bytes(node_section_) + bytes(node_bank_) + bytes(node_d_left_) + bytes(node_d_right_) +
+         bytes(triangles_) + bytes(node_tri_start_) + bytes(node_tri_list_) + bytes(sections_) +
+         bytes(section_nodes_);
+}
+
 Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                            const RiverSurfaceOptions& options, RiverSurface* out) {
   // --- Sizes, before anything is allocated or read.
@@ -294,6 +302,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   std::vector<uint32_t> node_of_vertex(vertex_count);
   std::vector<uint32_t> node_vertex;
   std::vector<glm::vec3> pos;
+  pos.reserve(vertex_count);  // kept: grown by doubling, it held up to twice its size
   {
     const size_t table_size = std::bit_ceil(2 * vertex_count);
     std::vector<uint32_t> table(table_size, kUnset);
@@ -670,8 +679,11 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     if (glm::dot(normal, up) < 0.0) std::swap(tri[1], tri[2]);
   }
 
-  s.node_of_vertex_ = std::move(node_of_vertex);
-  s.node_vertex_ = std::move(node_vertex);
+  if (node_count != vertex_count) {  // else both maps are the identity: not worth 8 bytes a vertex
+    s.node_of_vertex_ = std::move(node_of_vertex);
+    s.node_vertex_ = std::move(node_vertex);
+  }
+  pos.shrink_to_fit();  // a copy only where vertices were welded
   s.node_positions_ = std::move(pos);
   s.triangles_ = std::move(tris);
   s.node_tri_start_ = std::move(node_tris.start);

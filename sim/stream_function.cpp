@@ -71,44 +71,14 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
     }
   }
 
-  // Triangle areas (2x, as the P1 gradient wants them) and the bank tangents.
-  f.node_area_.assign(nodes, 0.0);
-  const auto pos = s.node_positions();
-  const auto tri = s.triangles();
-  std::vector<float> area2(tris);
-  for (size_t t = 0; t < tris; ++t) {
-    const DVec3 a(pos[tri[3 * t]]), b(pos[tri[3 * t + 1]]), c(pos[tri[3 * t + 2]]);
-    area2[t] = static_cast<float>(glm::length(glm::cross(b - a, c - a)));
-  }
-  for (uint32_t n = 0; n < nodes; ++n) {
-    double sum = 0.0;
-    for (const uint32_t t : s.node_triangles(n)) sum += area2[t];
-    f.node_area_[n] = sum;
-  }
-  f.bank_tangent_.assign(nodes, glm::vec3(0.0f));
-  const auto sections = s.sections();
-  for (size_t k = 0; k < sections.size(); ++k) {
-    const size_t prev = k == 0 ? 0 : k - 1;
-    const size_t next = std::min(k + 1, sections.size() - 1);
-    for (const bool left : {true, false}) {
-      auto shore = [&](size_t j) { return left ? s.section_nodes(j).front() : s.section_nodes(j).back(); };
-      const DVec3 d = DVec3(pos[shore(next)]) - DVec3(pos[shore(prev)]);
-      f.bank_tangent_[shore(k)] = glm::vec3(glm::normalize(d));
-    }
-  }
-  f.triangle_area2_ = std::move(area2);
-
-  f.psi_free_.resize(nodes);
+  // No obstacles yet: the field is the obstacle-free one.
+  f.psi_.resize(nodes);
   for (uint32_t n = 0; n < nodes; ++n) {
     bool wet = true;
-    f.psi_free_[n] = f.evaluate(n, false, &wet);
+    f.psi_[n] = f.evaluate(n, false, &wet);
   }
-  // No obstacles yet: the field is the obstacle-free one, only the velocities remain.
-  f.psi_ = f.psi_free_;
   f.wet_.assign(nodes, 1);
-  f.triangle_velocity_.resize(tris);
   f.node_velocity_.resize(nodes);
-  for (uint32_t t = 0; t < tris; ++t) f.update_triangle(t);
   for (uint32_t n = 0; n < nodes; ++n) f.update_node_velocity(n);
   f.stats_ = {nodes, tris, nodes};
   *out = std::move(f);
@@ -182,7 +152,13 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
       add(footprint_distance(obstacles_[j], xz(st.centre), pn), st.psi);
     }
   }
-  return den > 0.0 ? num / den : psi_free_[n];
+  if (den > 0.0) return num / den;
+  return use_obstacles ? node_psi_free(n) : 0.0;  // every weight underflowed
+}
+
+double StreamFunction::node_psi_free(uint32_t n) const {
+  bool wet = true;
+  return evaluate(n, false, &wet);
 }
 
 bool StreamFunction::influences(const ObstacleState& st, size_t obstacle, uint32_t n) const {
@@ -198,15 +174,34 @@ bool StreamFunction::influences(const ObstacleState& st, size_t obstacle, uint32
   return footprint_distance(obstacles_[obstacle], xz(st.centre), xz(p)) < s;
 }
 
-void StreamFunction::update_triangle(uint32_t t) {
+StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t) const {
   const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
   const auto pos = surface_.node_positions();
   const DVec3 a(pos[tri[0]]), b(pos[tri[1]]), c(pos[tri[2]]);
+  // 2 x area, as the P1 gradient wants it, rounded to float as the velocities are.
+  const auto area2 = static_cast<float>(glm::length(glm::cross(b - a, c - a)));
   const double pa = psi_[tri[0]];
   // grad(psi) x n = sum_i psi_i e_i / (2 area), e_i the edge opposite vertex i, counter-clockwise
   // about n; the edges sum to zero, so psi_a drops out (and with it the rounding of large psi).
   const DVec3 g = (psi_[tri[1]] - pa) * (a - c) + (psi_[tri[2]] - pa) * (b - a);
-  triangle_velocity_[t] = glm::vec3(g / double{triangle_area2_[t]});
+  return {area2, glm::vec3(g / double{area2})};
+}
+
+glm::vec3 StreamFunction::triangle_velocity(uint32_t t) const { return triangle_flow(t).velocity; }
+
+glm::vec3 StreamFunction::bank_tangent(uint32_t n) const {
+  const Bank bank = surface_.node_bank()[n];
+  if (bank == Bank::kNone) return glm::vec3(0.0f);
+  const auto sections = surface_.sections();
+  const size_t k = surface_.node_section()[n];
+  const size_t prev = k == 0 ? 0 : k - 1;
+  const size_t next = std::min(k + 1, sections.size() - 1);
+  auto shore = [&](size_t j) {
+    return bank == Bank::kLeft ? surface_.section_nodes(j).front()
+                               : surface_.section_nodes(j).back();
+  };
+  const auto pos = surface_.node_positions();
+  return glm::vec3(glm::normalize(DVec3(pos[shore(next)]) - DVec3(pos[shore(prev)])));
 }
 
 void StreamFunction::update_node_velocity(uint32_t n) {
@@ -215,13 +210,24 @@ void StreamFunction::update_node_velocity(uint32_t n) {
     return;
   }
   DVec3 sum(0.0);
+  double area = 0.0;
   for (const uint32_t t : surface_.node_triangles(n)) {
-    sum += double{triangle_area2_[t]} * DVec3(triangle_velocity_[t]);
+    const TriangleFlow flow = triangle_flow(t);
+    sum += double{flow.area2} * DVec3(flow.velocity);
+    area += flow.area2;
   }
-  glm::vec3 v(sum / node_area_[n]);
-  const glm::vec3 tangent = bank_tangent_[n];
+  glm::vec3 v(sum / area);
+  const glm::vec3 tangent = bank_tangent(n);
   if (tangent != glm::vec3(0.0f)) v = glm::dot(v, tangent) * tangent;  // a bank is a streamline
   node_velocity_[n] = v;
+}
+
+size_t StreamFunction::memory_bytes() const {
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return surface_.memory_bytes() + bytes(psi_) + bytes(wet_) + bytes(node_velocity_) +
+         bytes(obstacles_) + bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
+         triangle_grid_.memory_bytes() + bytes(node_stamp_) + bytes(triangle_stamp_) +
+         bytes(scratch_nodes_) + bytes(scratch_triangles_);
 }
 
 void StreamFunction::solve_full() {
@@ -233,10 +239,8 @@ void StreamFunction::solve_full() {
     psi_[n] = evaluate(n, true, &wet);
     wet_[n] = wet ? 1 : 0;
   }
-  const size_t tris = surface_.triangle_count();
-  for (uint32_t t = 0; t < tris; ++t) update_triangle(t);
   for (uint32_t n = 0; n < nodes; ++n) update_node_velocity(n);
-  stats_ = {nodes, tris, nodes};
+  stats_ = {nodes, surface_.triangle_count(), nodes};
 }
 
 void StreamFunction::build_grids() {
@@ -249,8 +253,9 @@ void StreamFunction::build_grids() {
   }
   // Cells of about two triangle edges hold a few vertices each in the river, whatever its shape.
   double mean_area2 = 0.0;
-  for (const float a : triangle_area2_) mean_area2 += a;
-  mean_area2 /= static_cast<double>(std::max<size_t>(triangle_area2_.size(), 1));
+  const size_t tris = surface_.triangle_count();
+  for (uint32_t t = 0; t < tris; ++t) mean_area2 += triangle_flow(t).area2;
+  mean_area2 /= static_cast<double>(std::max<size_t>(tris, 1));
   const double cell = std::max(2.0 * std::sqrt(mean_area2), 1e-6 * surface_.extent());
   const size_t max_cells = static_cast<size_t>(kMaxGridCellsPerVertex * static_cast<double>(pos.size())) + 16;
   node_grid_.init(lo, hi, cell, max_cells);
@@ -277,8 +282,8 @@ StreamFunction::ObstacleState StreamFunction::place(size_t obstacle, const glm::
                                      xz(pos[tri[3 * t + 2]])};
   };
   auto interpolate = [&](uint32_t t, const glm::dvec3& bary) {
-    return bary.x * psi_free_[tri[3 * t]] + bary.y * psi_free_[tri[3 * t + 1]] +
-           bary.z * psi_free_[tri[3 * t + 2]];
+    return bary.x * node_psi_free(tri[3 * t]) + bary.y * node_psi_free(tri[3 * t + 1]) +
+           bary.z * node_psi_free(tri[3 * t + 2]);
   };
 
   // Wet footprint: the triangles it overlaps, and their span along the river.
@@ -489,7 +494,6 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
       if (triangle_stamp_[t] != gen) {
         triangle_stamp_[t] = gen;
         scratch_triangles_.push_back(t);
-        update_triangle(t);
       }
     }
   }

@@ -56,8 +56,20 @@ GpuContext make_gpu_context(const DeviceTable& table, const VkAllocationCallback
   return gpu;
 }
 
-Status create_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags usage,
-                     bool host_visible, const char* debug_name, Buffer* out) {
+namespace {
+
+enum class BufferMemory { kDeviceLocal, kHostVisible, kMappedIfUnified };
+
+// Whether the device's memory is the host's: no heap apart from device-local ones.
+bool unified_memory(const VkPhysicalDeviceMemoryProperties& props) {
+  for (uint32_t i = 0; i < props.memoryHeapCount; ++i) {
+    if ((props.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) == 0) return false;
+  }
+  return true;
+}
+
+Status make_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags usage,
+                   BufferMemory memory, const char* debug_name, Buffer* out) {
   const DeviceTable& vk = *gpu.table;
   *out = Buffer{};
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -69,15 +81,23 @@ Status create_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlag
   out->size = size;
   VkMemoryRequirements requirements;
   vk.vkGetBufferMemoryRequirements(vk.device, out->buffer, &requirements);
-  const VkMemoryPropertyFlags wanted =
-      host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-                   : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+  constexpr VkMemoryPropertyFlags kHost =
+      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  VkMemoryPropertyFlags wanted = memory == BufferMemory::kHostVisible
+                                     ? kHost
+                                     : VkMemoryPropertyFlags{VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT};
+  uint32_t shared_type = 0;
+  if (memory == BufferMemory::kMappedIfUnified && unified_memory(gpu.memory_properties) &&
+      find_memory_type(gpu.memory_properties, requirements.memoryTypeBits, wanted | kHost,
+                       &shared_type)) {
+    wanted |= kHost;
+  }
   Status status = allocate(gpu, requirements, wanted, debug_name, &out->memory);
   if (status.ok()) {
     result = vk.vkBindBufferMemory(vk.device, out->buffer, out->memory, 0);
     if (result != VK_SUCCESS) status = vk_failure("vkBindBufferMemory", debug_name, result);
   }
-  if (status.ok() && host_visible) {
+  if (status.ok() && (wanted & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) != 0) {
     result = vk.vkMapMemory(vk.device, out->memory, 0, VK_WHOLE_SIZE, 0, &out->mapped);
     if (result != VK_SUCCESS) status = vk_failure("vkMapMemory", debug_name, result);
   }
@@ -87,6 +107,20 @@ Status create_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlag
   }
   set_name(gpu, VK_OBJECT_TYPE_BUFFER, reinterpret_cast<uint64_t>(out->buffer), debug_name);
   return Status::success();
+}
+
+}  // namespace
+
+Status create_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags usage,
+                     bool host_visible, const char* debug_name, Buffer* out) {
+  return make_buffer(gpu, size, usage,
+                     host_visible ? BufferMemory::kHostVisible : BufferMemory::kDeviceLocal,
+                     debug_name, out);
+}
+
+Status create_device_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags usage,
+                            const char* debug_name, Buffer* out) {
+  return make_buffer(gpu, size, usage, BufferMemory::kMappedIfUnified, debug_name, out);
 }
 
 void destroy_buffer(const GpuContext& gpu, Buffer* buffer) {
@@ -122,16 +156,17 @@ Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,
   out->extent = extent;
   VkMemoryRequirements requirements;
   vk.vkGetImageMemoryRequirements(vk.device, out->image, &requirements);
-  Status status = allocate(gpu, requirements, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, debug_name,
-                           &out->memory);
+  Status status =
+      allocate(gpu, requirements, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, debug_name, &out->memory);
   if (status.ok()) {
     result = vk.vkBindImageMemory(vk.device, out->image, out->memory, 0);
     if (result != VK_SUCCESS) status = vk_failure("vkBindImageMemory", debug_name, result);
   }
   // Views only for images that shaders or attachments use; copy-only images have none.
   constexpr VkImageUsageFlags kViewUsages =
-      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-      VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT;
+      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
+      VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
+      VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT;
   if (status.ok() && (usage & kViewUsages) != 0) {
     VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     view.image = out->image;

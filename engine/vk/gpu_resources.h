@@ -36,6 +36,11 @@ GpuContext make_gpu_context(const DeviceTable& table, const VkAllocationCallback
 // host_visible: the memory is HOST_VISIBLE|HOST_COHERENT and mapped for the buffer's lifetime.
 Status create_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags usage,
                      bool host_visible, const char* debug_name, Buffer* out);
+// A device-local buffer, also mapped where the device's memory is the host's (every heap
+// device-local, one type also HOST_VISIBLE|HOST_COHERENT: lavapipe, integrated GPUs), so that
+// the host can fill it in place; elsewhere `mapped` stays null and it is filled by a copy.
+Status create_device_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags usage,
+                            const char* debug_name, Buffer* out);
 void destroy_buffer(const GpuContext& gpu, Buffer* buffer);
 
 Status create_image(const GpuContext& gpu, VkFormat format, VkExtent2D extent,

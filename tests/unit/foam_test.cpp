@@ -113,6 +113,27 @@ TEST_F(FoamTest, TheWakeFollowsAMovedBoulder) {
   EXPECT_GT(after[at(0.0f, 43.0f)], 0.4f) << "behind the boulder's new place";
 }
 
+// The river surface's triangles around its nodes (what a long river shares instead of building
+// its own) give the same foam, bit for bit, as the field's own adjacency; a mismatched one is
+// refused.
+TEST_F(FoamTest, SharedAdjacencyGivesTheSameFoam) {
+  ASSERT_TRUE(flow_.set_obstacles({boulder(20.0f)}).ok());
+  const std::vector<float> own = foam();
+  const RiverSurface& surface = flow_.surface();
+  ASSERT_FALSE(surface.welded());
+  const VertexTriangles around{surface.node_triangle_start(), surface.node_triangle_list()};
+  ASSERT_TRUE(FoamField::create(mesh_.positions, mesh_.indices, section_, &bvh_, FoamParams{},
+                                &field_, around)
+                  .ok());
+  EXPECT_EQ(foam(), own);
+  FoamField field;
+  const VertexTriangles short_start{around.start.first(around.start.size() - 1), around.list};
+  const Status status = FoamField::create(mesh_.positions, mesh_.indices, section_, &bvh_,
+                                          FoamParams{}, &field, short_start);
+  EXPECT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("around"), std::string::npos) << status.message();
+}
+
 TEST(FoamParamsTest, BadParametersAreRefused) {
   FoamParams lifeless, no_lee, too_much_front;
   lifeless.lifetime_s = 0.0f;

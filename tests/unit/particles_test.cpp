@@ -17,6 +17,7 @@
 
 #include "sim/flow_textures.h"
 #include "sim/triangle_bvh.h"
+#include "siviflow/sim/procedural_river.h"
 #include "unit/particle_scenes.h"
 
 namespace siviflow {
@@ -134,6 +135,63 @@ TEST(TriangleBvh, NearestVertexIsTheBruteForceOne) {
     for (int k = 0; k < 3; ++k) is_corner |= bvh.triangle_vertex(hit.triangle, k) == near_corner;
     EXPECT_TRUE(is_corner);
   }
+}
+
+// The closest hit of rays of every slope over a meandering procedural river (whose triangles
+// the build sorts on every axis) is the brute-force one: the same triangle (ties: the lower)
+// at the same t.
+TEST(TriangleBvh, ClosestHitIsTheBruteForceOne) {
+  ProceduralRiverParams params;
+  params.length = 300.0f;
+  params.section_spacing = 2.0f;
+  RiverMesh r;
+  ASSERT_TRUE(ProceduralRiver(params).generate_mesh(&r).ok());
+  TriangleBvh bvh;
+  ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
+  // Moeller-Trumbore as the hierarchy computes it, over every triangle.
+  const auto brute = [&](const glm::vec3& o, const glm::vec3& d, float t_max, RayHit* hit) {
+    bool found = false;
+    for (uint32_t tri = 0; tri < r.indices.size() / 3; ++tri) {
+      const glm::vec3& v0 = r.positions[r.indices[3 * tri]];
+      const glm::vec3 e1 = r.positions[r.indices[3 * tri + 1]] - v0;
+      const glm::vec3 e2 = r.positions[r.indices[3 * tri + 2]] - v0;
+      const glm::vec3 p = glm::cross(d, e2);
+      const float det = glm::dot(e1, p);
+      if (det == 0.0f || !std::isfinite(det) || !std::isfinite(1.0f / det)) continue;
+      const float inv_det = 1.0f / det;
+      const glm::vec3 s = o - v0;
+      const float u = glm::dot(s, p) * inv_det;
+      if (u < 0.0f || u > 1.0f) continue;
+      const glm::vec3 q = glm::cross(s, e1);
+      const float v = glm::dot(d, q) * inv_det;
+      if (v < 0.0f || u + v > 1.0f) continue;
+      const float t = glm::dot(e2, q) * inv_det;
+      if (t < 0.0f || t > t_max || (found && t >= hit->t)) continue;
+      found = true;
+      hit->t = t;
+      hit->triangle = tri;
+    }
+    return found;
+  };
+  uint64_t state = 7;
+  const auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<float>(state >> 40) * 0x1.0p-24f;
+  };
+  int hits = 0;
+  for (int n = 0; n < 400; ++n) {
+    const glm::vec3& at = r.positions[static_cast<size_t>(next() * float(r.positions.size() - 1))];
+    const glm::vec3 origin = at + glm::vec3(8.0f * next() - 4.0f, 3.0f, 8.0f * next() - 4.0f);
+    const glm::vec3 direction(4.0f * next() - 2.0f, -1.0f, 4.0f * next() - 2.0f);
+    RayHit got, want;
+    const bool hit = bvh.intersect(origin, direction, 10.0f, &got);
+    ASSERT_EQ(hit, brute(origin, direction, 10.0f, &want)) << n;
+    if (!hit) continue;
+    ++hits;
+    EXPECT_EQ(got.triangle, want.triangle) << n;
+    EXPECT_EQ(got.t, want.t) << n;
+  }
+  EXPECT_GT(hits, 200);
 }
 
 TEST(TriangleBvh, AnyHitAgreesWithTheClosestHitOverTheSegment) {

@@ -36,7 +36,6 @@ TEST(ProceduralRiver, MeshFollowsCentrelineAndWidth) {
   ASSERT_TRUE(river.generate_mesh(&mesh).ok());
   ASSERT_EQ(mesh.positions.size(), size_t{mesh.section_count} * 9);
   ASSERT_EQ(mesh.indices.size(), size_t{mesh.section_count - 1} * 8 * 6);
-  ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());
   ASSERT_EQ(mesh.depth.size(), mesh.positions.size());
   // The end sections are centred on the ends of the centreline.
   const size_t last = mesh.positions.size() - 9;

@@ -132,6 +132,28 @@ TEST(RiverSurface, NonIndexedAndSplitVerticesAreWelded) {
   }
 }
 
+// Without welding both vertex-node maps are the identity: none is kept, and the per-vertex
+// accessors still answer.
+TEST(RiverSurface, UnweldedMeshKeepsNoVertexMaps) {
+  const TestMesh m = test::straight_channel(6.0f, 12.0f, 7, 4);
+  TestMesh soup;
+  for (const uint32_t i : m.indices) soup.positions.push_back(m.positions[i]);
+  RiverSurface indexed, welded;
+  ASSERT_TRUE(build(m, &indexed).ok());
+  ASSERT_TRUE(build(soup, &welded).ok());
+  EXPECT_FALSE(indexed.welded());
+  EXPECT_TRUE(welded.welded());
+  EXPECT_EQ(indexed.vertex_count(), m.positions.size());
+  for (uint32_t v = 0; v < m.positions.size(); ++v) {
+    EXPECT_EQ(indexed.node_of(v), v);
+    EXPECT_EQ(indexed.vertex_of_node(v), v);
+    EXPECT_EQ(indexed.node_positions()[v], m.positions[v]);
+  }
+  // The soup's surface holds its two maps (4 bytes a vertex, 4 a node) beyond the indexed one's.
+  EXPECT_GE(welded.memory_bytes(),
+            indexed.memory_bytes() + 4 * (soup.positions.size() + welded.node_count()));
+}
+
 TEST(RiverSurface, BendFlowDirectionIsPerpendicularToRadialSections) {
   const TestMesh m = test::bend(20.0f, 30.0f, 1.5707963f, 31, 5);
   RiverSurface s;

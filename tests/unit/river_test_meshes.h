@@ -170,7 +170,7 @@ inline double triangle_flux(const StreamFunction& flow, size_t k, size_t from, s
     const glm::vec3& u = pos[nodes[i]];
     const glm::vec3& w = pos[nodes[i + 1]];
     const uint32_t t = triangle_on_edge(s, nodes[i], nodes[i + 1]);
-    const glm::dvec3 v(flow.triangle_velocity()[t]);
+    const glm::dvec3 v(flow.triangle_velocity(t));
     flux += glm::dot(v, segment_normal(u, w)) * glm::distance(glm::dvec3(u), glm::dvec3(w));
   }
   return flux;

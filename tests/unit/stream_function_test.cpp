@@ -58,7 +58,7 @@ void expect_conserves_discharge(const StreamFunction& flow, double vertex_tolera
         const uint32_t b = shore(k + 1);
         const glm::dvec3 along = glm::normalize(glm::dvec3(pos[b] - pos[a]));
         const glm::dvec3 normal = glm::cross(glm::dvec3(0, 1, 0), along);
-        const glm::dvec3 vt(flow.triangle_velocity()[test::triangle_on_edge(s, a, b)]);
+        const glm::dvec3 vt(flow.triangle_velocity(test::triangle_on_edge(s, a, b)));
         EXPECT_NEAR(glm::dot(vt, normal), 0.0, 1e-5 * (glm::length(vt) + 1e-3)) << "section " << k;
       }
       // The vertex velocity on a bank slides along the bank (its local tangent).
@@ -369,6 +369,31 @@ TEST(StreamFunctionObstacle, BadObstacles) {
   EXPECT_FALSE(flow.set_time(NAN).ok());
 }
 
+// --- Memory -------------------------------------------------------------------------------------
+
+// A long river's flow keeps only what a re-solve needs per node and triangle: the obstacle-free
+// psi, the triangles' areas and velocities, node areas and bank tangents are derived when asked
+// (no vertex maps either: the procedural mesh welds nothing). About 81 bytes a node for the
+// surface and 21 for the flow on a 13-vertex-wide strip; they held 89 and 79 before.
+TEST(StreamFunctionMemory, KeepsNoBuildOnlyArrays) {
+  ProceduralRiverParams params;
+  params.length = 2000.0f;
+  RiverMesh mesh;
+  ASSERT_TRUE(ProceduralRiver(params).generate_mesh(&mesh).ok());
+  RiverSurface surface;
+  ASSERT_TRUE(RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok());
+  const double nodes = static_cast<double>(surface.node_count());
+  const double surface_bytes = static_cast<double>(surface.memory_bytes());
+  EXPECT_LE(surface_bytes / nodes, 84.0);
+  StreamFunction flow;
+  ASSERT_TRUE(StreamFunction::create(std::move(surface), {20.0f}, &flow).ok());
+  EXPECT_LE((static_cast<double>(flow.memory_bytes()) - surface_bytes) / nodes, 24.0);
+  // What is derived equals what was stored: the obstacle-free psi is psi without obstacles.
+  for (uint32_t n = 0; n < flow.surface().node_count(); n += 97) {
+    EXPECT_EQ(flow.node_psi_free(n), flow.node_psi()[n]);
+  }
+}
+
 // --- Incremental re-solves -----------------------------------------------------------------------
 
 void expect_same_field(const StreamFunction& a, const StreamFunction& b) {
@@ -379,8 +404,8 @@ void expect_same_field(const StreamFunction& a, const StreamFunction& b) {
     vel_diff += a.node_velocity()[n] != b.node_velocity()[n];
     wet_diff += a.node_wet()[n] != b.node_wet()[n];
   }
-  for (size_t t = 0; t < a.triangle_velocity().size(); ++t) {
-    tri_diff += a.triangle_velocity()[t] != b.triangle_velocity()[t];
+  for (uint32_t t = 0; t < a.surface().triangle_count(); ++t) {
+    tri_diff += a.triangle_velocity(t) != b.triangle_velocity(t);
   }
   EXPECT_EQ(psi_diff, 0u);
   EXPECT_EQ(vel_diff, 0u);

@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <vector>
 
-#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "siviflow/status.h"
@@ -34,7 +33,6 @@ struct ProceduralRiverParams {
 struct RiverMesh {
   std::vector<glm::vec3> positions;  // vertex k * vertices_across + j: section k, j = 0 on the left
   std::vector<uint32_t> indices;     // triangles, counter-clockwise seen from +Y
-  std::vector<glm::vec2> uvs;        // u across (0 left bank .. 1 right bank), v along, metres
   std::vector<float> depth;          // water depth under each vertex, metres, >= 0
   uint32_t section_count = 0;
   uint32_t vertices_across = 0;

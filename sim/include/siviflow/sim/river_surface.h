@@ -63,9 +63,13 @@ class RiverSurface {
                       const RiverSurfaceOptions& options, RiverSurface* out);
 
   // --- Per input vertex (the accessor order of the mesh) ---
-  size_t vertex_count() const { return node_of_vertex_.size(); }
-  uint32_t node_of(size_t vertex) const { return node_of_vertex_[vertex]; }
-  RiverVertex vertex(size_t vertex) const { return node(node_of_vertex_[vertex]); }
+  size_t vertex_count() const { return welded() ? node_of_vertex_.size() : node_count(); }
+  uint32_t node_of(size_t vertex) const {
+    return welded() ? node_of_vertex_[vertex] : static_cast<uint32_t>(vertex);
+  }
+  RiverVertex vertex(size_t vertex) const { return node(node_of(vertex)); }
+  // Whether some input vertices were welded; if not, node n is input vertex n.
+  bool welded() const { return !node_of_vertex_.empty(); }
 
   // --- Per node (welded vertex); every index below is a node index ---
   size_t node_count() const { return node_positions_.size(); }
@@ -76,7 +80,7 @@ class RiverSurface {
   std::span<const float> node_d_left() const { return node_d_left_; }
   std::span<const float> node_d_right() const { return node_d_right_; }
   // The first input vertex welded into node n (what error messages call "vertex").
-  uint32_t vertex_of_node(uint32_t n) const { return node_vertex_[n]; }
+  uint32_t vertex_of_node(uint32_t n) const { return welded() ? node_vertex_[n] : n; }
 
   // Triangles in node indices, wound counter-clockwise seen from the river's upper side
   // (downstream x (left shore - right shore)), whatever the input winding was.
@@ -86,6 +90,9 @@ class RiverSurface {
   std::span<const uint32_t> node_triangles(uint32_t n) const {
     return {node_tri_list_.data() + node_tri_start_[n], node_tri_start_[n + 1] - node_tri_start_[n]};
   }
+  // The same for every node at once: node n's are list[start[n] .. start[n + 1]).
+  std::span<const uint32_t> node_triangle_start() const { return node_tri_start_; }
+  std::span<const uint32_t> node_triangle_list() const { return node_tri_list_; }
 
   std::span<const RiverSection> sections() const { return sections_; }
   // Nodes of section k, from the left shore to the right shore.
@@ -95,9 +102,11 @@ class RiverSurface {
   float widest_section() const { return widest_; }
   // Length of the bounding-box diagonal: the scale the geometric tolerances are relative to.
   float extent() const { return extent_; }
+  // Bytes of its arrays: what a long river costs to keep.
+  size_t memory_bytes() const;
 
  private:
-  std::vector<uint32_t> node_of_vertex_;
+  std::vector<uint32_t> node_of_vertex_;  // both empty when nothing was welded
   std::vector<uint32_t> node_vertex_;
   std::vector<glm::vec3> node_positions_;
   std::vector<uint32_t> node_section_;

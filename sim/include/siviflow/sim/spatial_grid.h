@@ -22,6 +22,9 @@ class XzGrid {
 
   bool empty() const { return cell_start_.empty(); }
   double cell_size() const { return cell_; }
+  size_t memory_bytes() const {
+    return (cell_start_.capacity() + items_.capacity()) * sizeof(uint32_t);
+  }
 
   // Calls f(item) for every item of every cell overlapping [lo, hi]; a triangle spanning several
   // cells is reported once per cell. Items of one cell come in ascending order.

@@ -73,6 +73,8 @@ class StreamFunction {
   // Re-solves every vertex for the obstacles where they are now.
   void solve_full();
   const FlowUpdateStats& last_update() const { return stats_; }
+  // Bytes of its arrays, the surface's included (the obstacle grids only once obstacles came).
+  size_t memory_bytes() const;
 
   // --- Per input vertex.
   double psi(size_t vertex) const { return psi_[surface_.node_of(vertex)]; }
@@ -81,10 +83,11 @@ class StreamFunction {
 
   // --- Per node (RiverSurface node indices) and per triangle (RiverSurface::triangles()).
   std::span<const double> node_psi() const { return psi_; }
-  std::span<const double> node_psi_free() const { return psi_free_; }  // without obstacles
+  double node_psi_free(uint32_t n) const;  // without obstacles
   std::span<const glm::vec3> node_velocity() const { return node_velocity_; }
   std::span<const uint8_t> node_wet() const { return wet_; }
-  std::span<const glm::vec3> triangle_velocity() const { return triangle_velocity_; }
+  // Computed when asked (a long river cannot keep 12 bytes per triangle for it).
+  glm::vec3 triangle_velocity(uint32_t t) const;
 
   // --- Per obstacle.
   glm::vec3 obstacle_centre(size_t i) const { return state_[i].centre; }
@@ -107,8 +110,14 @@ class StreamFunction {
 
   double evaluate(uint32_t node, bool use_obstacles, bool* wet) const;
   bool influences(const ObstacleState& state, size_t obstacle, uint32_t node) const;
-  void update_triangle(uint32_t t);
+  struct TriangleFlow {
+    float area2;         // 2 x area
+    glm::vec3 velocity;  // grad(psi) x n
+  };
+  TriangleFlow triangle_flow(uint32_t t) const;
   void update_node_velocity(uint32_t n);
+  // Unit, downstream, on a bank node (its section's shore); zero elsewhere.
+  glm::vec3 bank_tangent(uint32_t n) const;
   void build_grids();
   ObstacleState place(size_t obstacle, const glm::vec3& centre) const;
   void refresh_active();
@@ -117,14 +126,11 @@ class StreamFunction {
 
   RiverSurface surface_;
   FlowParams params_;
-  std::vector<double> psi_free_;
+  // Only what a re-solve cannot cheaply recompute is kept per node: the obstacle-free psi, the
+  // triangles' areas and velocities, the node areas and bank tangents are derived when needed.
   std::vector<double> psi_;
   std::vector<uint8_t> wet_;
-  std::vector<glm::vec3> triangle_velocity_;
   std::vector<glm::vec3> node_velocity_;
-  std::vector<float> triangle_area2_;        // 2 x area of every triangle
-  std::vector<double> node_area_;            // sum of 2 x area of the node's triangles
-  std::vector<glm::vec3> bank_tangent_;      // unit, downstream, on bank nodes; zero elsewhere
   std::vector<Obstacle> obstacles_;
   std::vector<ObstacleState> state_;
   std::vector<uint32_t> active_;             // obstacles in the water, ascending
