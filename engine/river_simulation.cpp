@@ -158,7 +158,8 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   field_.depth = mesh_.depth;
   field_.slope = slope_;
   field_.foam = foam_;
-  return WaterQuery::build(field_, &water_query_);
+  water_query_ = WaterQuery(field_, bvh_.get());
+  return Status::success();
 }
 
 void RiverFlow::query(std::span<const glm::vec3> points, std::span<WaterSample> out) const {

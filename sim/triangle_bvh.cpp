@@ -230,6 +230,47 @@ size_t TriangleBvh::memory_bytes() const {
   return nodes_.capacity() * sizeof(Node) + order_.capacity() * sizeof(uint32_t);
 }
 
+uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
+  if (nodes_.empty()) return UINT32_MAX;
+  // A point this close outside a triangle (in barycentric weight) still lies on it: the edge
+  // two triangles share must belong to one of them whatever the rounding.
+  constexpr double kEdgeTolerance = 1e-9;
+  const auto holds = [&](const Node& n) {
+    return x >= n.lo.x && x <= n.hi.x && z >= n.lo.z && z <= n.hi.z;
+  };
+  uint32_t stack[kStackSize];
+  int top = 0;
+  if (!holds(nodes_[0])) return UINT32_MAX;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (n.count == 0) {  // the left child is searched first
+      if (holds(nodes_[n.first + 1])) stack[top++] = n.first + 1;
+      if (holds(nodes_[n.first])) stack[top++] = n.first;
+      continue;
+    }
+    for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+      const uint32_t tri = order_[i];
+      const glm::vec3& a = positions_[triangle_vertex(tri, 0)];
+      const glm::vec3& b = positions_[triangle_vertex(tri, 1)];
+      const glm::vec3& c = positions_[triangle_vertex(tri, 2)];
+      const double e0x = double(b.x) - a.x, e0z = double(b.z) - a.z;
+      const double e1x = double(c.x) - a.x, e1z = double(c.z) - a.z;
+      const double px = x - a.x, pz = z - a.z;
+      const double det = e0x * e1z - e1x * e0z;
+      if (det == 0.0) continue;
+      const double v = (px * e1z - e1x * pz) / det;
+      const double w = (e0x * pz - px * e0z) / det;
+      const double u = 1.0 - v - w;
+      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance) {
+        *weights = glm::clamp(glm::dvec3(u, v, w), 0.0, 1.0);
+        return tri;
+      }
+    }
+  }
+  return UINT32_MAX;
+}
+
 template <bool kAnyHit>
 bool TriangleBvh::trace(const glm::vec3& origin, const glm::vec3& direction, float t_min,
                         float t_max, RayHit* hit) const {

@@ -50,6 +50,11 @@ class TriangleBvh {
   bool any_hit(const glm::vec3& origin, const glm::vec3& direction, float t_min,
                float t_max) const;
 
+  // The triangle whose projection on the XZ plane holds (x, z) (the first the traversal meets
+  // where several do: the same every time), with its barycentric weights; UINT32_MAX when none
+  // does. In doubles: far from the origin a float difference would lose the centimetres.
+  uint32_t locate_xz(double x, double z, glm::dvec3* weights) const;
+
   // The vertex nearest to `p` (ties: the lower index) among the vertices within `radius` of it;
   // when none is, the nearest corner of `hint_triangle` (usually the triangle `p` lies on).
   uint32_t nearest_vertex(const glm::vec3& p, float radius, uint32_t hint_triangle) const;

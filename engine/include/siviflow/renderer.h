@@ -377,8 +377,8 @@ class Renderer {
   // the foam the material shows (this renderer's WaterLook::foam_amount in), and the obstacle
   // whose footprint holds it (siviflow/sim/water_sample.h), all in the host's world. CPU only,
   // from the solved flow as it stands (runtime obstacles count from the call that placed them,
-  // keyed ones from the last update), not from the GPU; about a microsecond a point, one binary
-  // search in the cells the river covers whatever its length; deterministic. `out` holds at
+  // keyed ones from the last update), not from the GPU; a walk down the surface's bounding volume
+  // hierarchy a point (O(log n), well under a microsecond); deterministic. `out` holds at
   // least as many samples as `points`. A point that is not finite, or a short `out`, is an error
   // naming it, and nothing is written. Threads: see the top of this file.
   Status query_water(std::span<const glm::vec3> points, std::span<WaterSample> out) const;
