@@ -7,9 +7,9 @@
 
 #include <glm/vec3.hpp>
 
-#include "particles.h"
+#include "sim/particles.h"
 #include "siviflow/sim/water_sample.h"
-#include "triangle_bvh.h"
+#include "sim/triangle_bvh.h"
 
 namespace siviflow {
 
