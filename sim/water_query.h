@@ -8,8 +8,8 @@
 #include <glm/vec3.hpp>
 
 #include "sim/particles.h"
-#include "siviflow/sim/water_sample.h"
 #include "sim/triangle_bvh.h"
+#include "siviflow/sim/water_sample.h"
 
 namespace siviflow {
 
