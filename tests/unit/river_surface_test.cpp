@@ -130,17 +130,8 @@ TEST(RiverSurface, NonIndexedAndSplitVerticesAreWelded) {
     EXPECT_EQ(x.bank, y.bank);
     EXPECT_EQ(x.d_left, y.d_left);
   }
-}
-
-// Without welding both vertex-node maps are the identity: none is kept, and the per-vertex
-// accessors still answer.
-TEST(RiverSurface, UnweldedMeshKeepsNoVertexMaps) {
-  const TestMesh m = test::straight_channel(6.0f, 12.0f, 7, 4);
-  TestMesh soup;
-  for (const uint32_t i : m.indices) soup.positions.push_back(m.positions[i]);
-  RiverSurface indexed, welded;
-  ASSERT_TRUE(build(m, &indexed).ok());
-  ASSERT_TRUE(build(soup, &welded).ok());
+  // Without welding both vertex-node maps are the identity: none is kept, and the per-vertex
+  // accessors still answer.
   EXPECT_FALSE(indexed.welded());
   EXPECT_TRUE(welded.welded());
   EXPECT_EQ(indexed.vertex_count(), m.positions.size());
