@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <span>
-#include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
