@@ -2,7 +2,8 @@
 // the water's normal pattern (the `normal` AOV) is tracked between frames a few frames apart by
 // phase correlation in a small window around each particle, and its motion compared with the
 // particle's flow projected to the screen, for both materials: Tiled Directional Flow and the
-// two-phase flow-map baseline.
+// two-phase flow-map baseline. Floating bodies drifted by the gameplay queries (siviflow/drift.h)
+// move the way the ripples under them do.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +16,7 @@
 
 #include "phase_correlation.h"
 #include "renderer_inspect.h"
+#include "siviflow/drift.h"
 #include "shaders/shared.h"
 #include "sim/flow_textures.h"
 #include "straight_channel.h"
@@ -34,6 +36,13 @@ struct Motion {
   glm::dvec2 measured;  // pixels over kApart frames
   glm::dvec2 expected;  // the particle's flow over the same time, projected
   double boulder_distance;  // metres from the boulder's centre
+};
+
+// A float's screen motion over kApart frames and the ripples' under it.
+struct FloatMotion {
+  glm::vec3 release{0.0f};
+  glm::dvec2 measured{0.0};
+  glm::dvec2 drifted{0.0};
 };
 
 struct Summary {
@@ -129,7 +138,8 @@ class RippleMotionTest : public StraightChannelTest {
     set_camera({0.0f, 9.0f, -4.5f}, {0.0f, 0.0f, 2.5f}, kView);
     const Status status = create_channel(make_create_info(kView.width, kView.height), kBoulder, look);
     EXPECT_TRUE(status.ok()) << status.message();
-    const std::vector<Frame> frames = render_still(0, kFirst + 2 * kApart + 1);
+    frames_ = render_still(0, kFirst + 2 * kApart + 1);
+    const std::vector<Frame>& frames = frames_;
     EXPECT_EQ(frames.size(), kFirst + 2 * kApart + 1);
     if (frames.size() != kFirst + 2 * kApart + 1) return {};
     std::vector<Motion> all = motions(frames[kFirst], frames[kFirst + kApart]);
@@ -146,6 +156,58 @@ class RippleMotionTest : public StraightChannelTest {
     }
     return {angles.size(), median(angles), median(ratios), near.size(), median(near)};
   }
+
+  // Floats released across the channel, upstream of the boulder, beside it and past it, drifted
+  // through the frames measure() rendered by the renderer's own queries; their motion over
+  // kApart frames from each of kApart + 1 frames on, and the ripples' under them (the median of
+  // those shifts: one window can lock onto the wrong peak).
+  std::vector<FloatMotion> float_motions() const {
+    const WaterQueryFunction ask = [this](std::span<const glm::vec3> p, std::span<WaterSample> s) {
+      return renderer_->query_water(p, s);
+    };
+    std::vector<FloatMotion> out;
+    for (const glm::vec3 release : {glm::vec3(-1.5f, 0.0f, -2.0f), glm::vec3(1.5f, 0.0f, -2.0f),
+                                    glm::vec3(-2.2f, 0.0f, 0.5f), glm::vec3(2.2f, 0.0f, 0.5f),
+                                    glm::vec3(-3.0f, 0.0f, 2.0f), glm::vec3(3.0f, 0.0f, 2.0f),
+                                    glm::vec3(-1.5f, 0.0f, 3.0f), glm::vec3(1.5f, 0.0f, 3.0f)}) {
+      std::vector<FloatingBody> body(1);
+      body[0].position = release;
+      body[0].radius = 0.1f;
+      body[0].drag = 40.0f;  // a leaf: it takes the water's velocity within a frame
+      body[0].velocity = ask_velocity(release);
+      std::vector<glm::vec3> path{release};  // at frames kFirst, kFirst + 1, ...
+      for (uint32_t i = 0; i < 2 * kApart; ++i) {
+        EXPECT_TRUE(drift_bodies(body, float(1.0 / kFps), ask).ok());
+        path.push_back(body[0].position);
+      }
+      EXPECT_FALSE(body[0].stranded) << "a float released at x " << release.x << ", z " << release.z;
+      FloatMotion motion;
+      motion.release = release;
+      std::vector<double> xs, ys;
+      for (uint32_t i = 0; i <= kApart; ++i) {
+        const glm::dvec2 from = pixel_of(path[i]);
+        motion.drifted += (pixel_of(path[i + kApart]) - from) / double(kApart + 1);
+        glm::dvec2 shift;
+        if (!track(frames_[kFirst + i], frames_[kFirst + i + kApart], from, &shift)) continue;
+        xs.push_back(shift.x);
+        ys.push_back(shift.y);
+      }
+      EXPECT_GE(xs.size(), kApart) << "no water round the float released at x " << release.x
+                                   << ", z " << release.z;
+      if (xs.empty()) continue;
+      motion.measured = {median(xs), median(ys)};
+      out.push_back(motion);
+    }
+    return out;
+  }
+
+  glm::vec3 ask_velocity(const glm::vec3& at) const {
+    WaterSample sample;
+    EXPECT_TRUE(renderer_->query_water(std::span(&at, 1), std::span(&sample, 1)).ok());
+    return sample.velocity;
+  }
+
+  std::vector<Frame> frames_;  // measure()'s
 };
 
 void expect_moves_with_the_flow(const char* material, const Summary& s) {
@@ -161,6 +223,24 @@ void expect_moves_with_the_flow(const char* material, const Summary& s) {
 
 TEST_F(RippleMotionTest, TiledDirectionalFlowRipplesMoveWithTheFlow) {
   expect_moves_with_the_flow("tiled directional flow", measure(WaterMaterial::kTiledDirectionalFlow));
+  // The floats go where the ripples under them go.
+  const std::vector<FloatMotion> floats = float_motions();
+  EXPECT_EQ(floats.size(), 8u);
+  for (const FloatMotion& f : floats) {
+    const double cosine = glm::dot(f.measured, f.drifted) /
+                          std::max(glm::length(f.measured) * glm::length(f.drifted), 1e-9);
+    const double angle = glm::degrees(std::acos(std::clamp(cosine, -1.0, 1.0)));
+    std::printf("float released at x %.1f, z %.1f: drifted (%.2f, %.2f) px, ripples (%.2f, %.2f) "
+                "px, %.1f deg apart\n",
+                double(f.release.x), double(f.release.z), f.drifted.x, f.drifted.y, f.measured.x,
+                f.measured.y, angle);
+    // Where the flow turns round the boulder within a tile, the ripples' tolerance (as for the
+    // particles above).
+    const bool near = glm::distance(glm::vec2(f.release.x, f.release.z), glm::vec2(kBoulder.x, kBoulder.z)) <
+                      2.5f * kBoulderRadius;
+    EXPECT_LT(angle, near ? 15.0 : 10.0)
+        << "the float released at x " << f.release.x << ", z " << f.release.z;
+  }
 }
 
 TEST_F(RippleMotionTest, FlowMapRipplesMoveWithTheFlow) {
