@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <exception>
 #include <memory>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -21,6 +22,7 @@
 #include "siviflow/headless_context.h"
 #include "siviflow/host_frame.h"
 #include "siviflow/renderer.h"
+#include "siviflow/scene_floats.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
@@ -166,7 +168,7 @@ struct SlotTargets {
   Camera camera;
   Camera previous_camera;  // with the motion AOV, and the boulders that move about this frame
   Camera next_camera;
-  std::vector<MovingBoulder> boulders;
+  std::vector<MovingBoulder> boulders;  // and the floats, as ellipsoids that hold them
   std::vector<Particle> particles;  // as simulated for this frame
 };
 
@@ -187,6 +189,10 @@ class Capture {
  private:
   // With the motion AOV: the neighbouring frames' cameras and the boulders moving about `frame`.
   Status record_motion(uint32_t frame, SlotTargets* slot) const;
+  // Moves the scene's floats on from `frame` to the next, through the water as updated for
+  // `frame`; with a slot, first stands them in the world where they are at `frame` and, with the
+  // motion AOV, adds them to the slot's moving bodies.
+  Status step_floats(uint32_t frame, SlotTargets* slot);
   // Copies the slot's frame out of its readback buffers into `finished` (its buffers reused).
   void copy_out(const SlotTargets& slot, FinishedFrame* finished) const;
   void report_progress(uint32_t done_count);
@@ -198,6 +204,8 @@ class Capture {
   std::vector<std::unique_ptr<Renderer>> rivers_;  // one water renderer per river of the scene
   std::vector<Renderer*> river_renderers_;
   Renderer* renderer_ = nullptr;  // the last river's: it reads the frame back
+  std::optional<SceneFloats> floats_;  // the scene's floats, if it has any
+  std::vector<FloatPose> floats_before_;  // as they were in the frame before
 
   uint32_t frames_to_write_ = 0;  // the range, less the complete frames a resume keeps
   std::chrono::steady_clock::time_point started_;  // of the first rendered frame
@@ -244,13 +252,24 @@ Status Capture::run() {
     river_renderers_.push_back(rivers_.back().get());
   }
   renderer_ = river_renderers_.back();
+  if (scene != nullptr && !scene->floats.empty()) {
+    std::vector<WaterQueryFunction> queries;
+    for (Renderer* river : river_renderers_) {
+      queries.push_back([river](std::span<const glm::vec3> p, std::span<WaterSample> s) {
+        return river->query_water(p, s);
+      });
+    }
+    floats_.emplace();
+    SIVIFLOW_TRY(SceneFloats::create(*scene, std::move(queries), &*floats_));
+  }
   const VkExtent2D extent{options_.size.width, options_.size.height};
-  // The particles carry state from frame to frame: a shard starting at frame A first advances
-  // the simulation through frames 0..A-1, without rendering, so that its frames equal a full run's.
+  // The particles and floats carry state from frame to frame: a shard starting at frame A first
+  // advances them through frames 0..A-1, without rendering, so that its frames equal a full run's.
   for (uint32_t frame = 0; frame < options_.first_frame; ++frame) {
     const double time = static_cast<double>(frame) / options_.fps;
     const View view = camera_view(world_->scene_camera(time), extent);
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->simulate(view, time));
+    SIVIFLOW_TRY(step_floats(frame, nullptr));
   }
 
   std::vector<SlotTargets> slots(kFramesInFlight);
@@ -276,6 +295,7 @@ Status Capture::run() {
     if (!render[frame - options_.first_frame]) {  // complete already: only its simulation
       const View view = camera_view(world_->scene_camera(time), extent);
       for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->simulate(view, time));
+      SIVIFLOW_TRY(step_floats(frame, nullptr));
       continue;
     }
     const uint32_t index = rendered++ % kFramesInFlight;
@@ -295,6 +315,7 @@ Status Capture::run() {
     if (options_.motion_aov) SIVIFLOW_TRY(record_motion(frame, &slot));
     const View view = camera_view(slot.camera, extent);
     for (Renderer* river : river_renderers_) SIVIFLOW_TRY(river->update(view, time));
+    SIVIFLOW_TRY(step_floats(frame, &slot));
     const std::span<const Particle> particles = particle_field(*renderer_).particles();
     slot.particles.assign(particles.begin(), particles.end());
     ReadbackTargets readback;
@@ -342,6 +363,28 @@ Status Capture::record_motion(uint32_t frame, SlotTargets* slot) const {
     if (!now.shown || (then.centre == now.centre && later.centre == now.centre)) continue;
     slot->boulders.push_back({then.centre, now.centre, later.centre, now.radii});
   }
+  return Status::success();
+}
+
+Status Capture::step_floats(uint32_t frame, SlotTargets* slot) {
+  if (!floats_) return Status::success();
+  const std::vector<FloatPose> now(floats_->poses().begin(), floats_->poses().end());
+  SIVIFLOW_TRY(floats_->advance(static_cast<double>(frame + 1) / options_.fps));
+  const std::span<const FloatPose> next = floats_->poses();
+  for (uint32_t i = 0; slot != nullptr && i < now.size(); ++i) {
+    if (!now[i].shown) {
+      SIVIFLOW_TRY(world_->hide_float(i));
+      continue;
+    }
+    SIVIFLOW_TRY(world_->place_float(i, now[i].centre, now[i].heading));
+    if (!options_.motion_aov) continue;
+    const bool before_shown = !floats_before_.empty() && floats_before_[i].shown;
+    glm::vec3 reach;
+    SIVIFLOW_TRY(world_->float_reach(i, &reach));
+    slot->boulders.push_back(
+        {before_shown ? floats_before_[i].centre : now[i].centre, now[i].centre, next[i].centre, reach});
+  }
+  floats_before_ = now;
   return Status::success();
 }
 

@@ -488,6 +488,48 @@ Status parse_objects(const Reader& r, const Json& v, const std::string& folder,
   return Status::success();
 }
 
+Status parse_floats(const Reader& r, const Json& v, std::vector<SceneFloat>* out) {
+  SIVIFLOW_TRY(r.array(v, "floats", kMaxSceneFloats));
+  for (size_t i = 0; i < v.size(); ++i) {
+    const std::string path = element("floats", i);
+    const Json& o = v[i];
+    SIVIFLOW_TRY(r.object(o, path));
+    SIVIFLOW_TRY(r.keys(o, path, {"mesh", "release_point", "release_time", "radius", "drag"}));
+    FloatMesh mesh = FloatMesh::kLog;
+    if (const Json* x = find(o, "mesh")) {
+      std::string name;
+      SIVIFLOW_TRY(r.string(*x, join(path, "mesh"), &name));
+      if (name == "leaf") {
+        mesh = FloatMesh::kLeaf;
+      } else if (name != "log") {
+        return r.fail(join(path, "mesh"), "'" + name + "' is not a float mesh (\"log\" or \"leaf\")");
+      }
+    }
+    SceneFloat parsed = scene_float_defaults(mesh);
+    const Json* point = find(o, "release_point");
+    if (!point) return r.fail(path, "missing required key 'release_point' ([x, z] on a river)");
+    float xz[2];
+    SIVIFLOW_TRY(r.floats(*point, join(path, "release_point"), 2, xz));
+    parsed.release_point = {xz[0], xz[1]};
+    if (const Json* x = find(o, "release_time")) {
+      SIVIFLOW_TRY(r.number(*x, join(path, "release_time"), &parsed.release_time));
+      if (parsed.release_time < 0.0) {
+        return r.fail(join(path, "release_time"),
+                      text_format("%g must not be negative", parsed.release_time));
+      }
+    }
+    if (const Json* x = find(o, "radius")) SIVIFLOW_TRY(r.positive(*x, join(path, "radius"), &parsed.radius));
+    if (const Json* x = find(o, "drag")) {
+      SIVIFLOW_TRY(r.real(*x, join(path, "drag"), &parsed.drag));
+      if (parsed.drag < 0.0f) {
+        return r.fail(join(path, "drag"), text_format("%g must not be negative", double(parsed.drag)));
+      }
+    }
+    out->push_back(parsed);
+  }
+  return Status::success();
+}
+
 Status parse_camera(const Reader& r, const Json& v, SceneCamera* out) {
   SIVIFLOW_TRY(r.object(v, "camera"));
   SIVIFLOW_TRY(r.keys(v, "camera", {"fov_y_deg", "keys"}));
@@ -567,8 +609,8 @@ Status parse_root(const Reader& r, const Json& root, const std::string& file,
   }
   SIVIFLOW_TRY(
       r.keys(root, "",
-             {"$schema", "version", "river", "rivers", "flow", "obstacles", "objects", "camera",
-              "render", "look"}));
+             {"$schema", "version", "river", "rivers", "flow", "obstacles", "objects", "floats",
+              "camera", "render", "look"}));
   if (const Json* schema = find(root, "$schema"); schema && !schema->is_string()) {
     return r.fail("$schema", "must be a string");
   }
@@ -597,6 +639,7 @@ Status parse_root(const Reader& r, const Json& root, const std::string& file,
     SIVIFLOW_TRY(parse_obstacles(r, *x, &scene.obstacles));
   if (const Json* x = find(root, "objects"))
     SIVIFLOW_TRY(parse_objects(r, *x, folder, &scene.objects));
+  if (const Json* x = find(root, "floats")) SIVIFLOW_TRY(parse_floats(r, *x, &scene.floats));
   if (const Json* x = find(root, "camera")) SIVIFLOW_TRY(parse_camera(r, *x, &scene.camera));
   if (const Json* x = find(root, "render")) SIVIFLOW_TRY(parse_render(r, *x, &scene.render));
   if (const Json* x = find(root, "look")) SIVIFLOW_TRY(parse_look(r, *x, &scene.look));
@@ -605,6 +648,15 @@ Status parse_root(const Reader& r, const Json& root, const std::string& file,
 }
 
 }  // namespace
+
+// A log floats heavy and long, a leaf small and quick to follow the water.
+SceneFloat scene_float_defaults(FloatMesh mesh) {
+  SceneFloat f;
+  f.mesh = mesh;
+  f.radius = mesh == FloatMesh::kLog ? 0.6f : 0.15f;
+  f.drag = mesh == FloatMesh::kLog ? 1.5f : 6.0f;
+  return f;
+}
 
 std::vector<std::string> procedural_river_keys() {
   std::vector<std::string> keys;

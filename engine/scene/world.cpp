@@ -16,6 +16,7 @@
 #include "scene/scene_pass.h"
 #include "scene/default_scene.h"
 #include "scene/detail_texture.h"
+#include "scene/float_meshes.h"
 #include "scene/scene_objects.h"
 #include "siviflow/scene_river.h"
 #include "static_assets.h"
@@ -48,16 +49,38 @@ Status world_error(const std::string& message) {
   return Status::error(std::string(kWorldErrorPrefix) + message);
 }
 
-// The constants that draw a model placed at `offset` with the scene shaders, which work in the
-// model's coordinates: clip and fog see the same distances as for the translated model.
-gpu::SceneConstants translated(const gpu::SceneConstants& constants, glm::vec3 offset) {
+// The constants that draw a model turned by `heading` about +y and placed at `offset` with the
+// scene shaders, which work in the model's coordinates: light, clip and fog see the same
+// directions and distances as for the placed model.
+gpu::SceneConstants posed(const gpu::SceneConstants& constants, glm::vec3 offset,
+                          float heading = 0.0f) {
+  const float c = std::cos(heading);
+  const float s = std::sin(heading);
+  glm::mat4 model(1.0f);
+  model[0] = glm::vec4(c, 0.0f, s, 0.0f);  // +x turned towards +z
+  model[2] = glm::vec4(-s, 0.0f, c, 0.0f);
+  model[3] = glm::vec4(offset, 1.0f);
+  const glm::mat3 to_model = glm::transpose(glm::mat3(model));
   gpu::SceneConstants moved = constants;
-  moved.view_proj = constants.view_proj * glm::translate(glm::mat4(1.0f), offset);
-  moved.camera_position = constants.camera_position - glm::vec4(offset, 0.0f);
-  moved.clip_plane.w += glm::dot(glm::vec3(constants.clip_plane), offset);
+  moved.view_proj = constants.view_proj * model;
+  moved.camera_position =
+      glm::vec4(to_model * (glm::vec3(constants.camera_position) - offset), constants.camera_position.w);
+  moved.sun_direction = glm::vec4(to_model * glm::vec3(constants.sun_direction), constants.sun_direction.w);
+  moved.clip_plane = glm::vec4(to_model * glm::vec3(constants.clip_plane),
+                               constants.clip_plane.w + glm::dot(glm::vec3(constants.clip_plane), offset));
   moved.fog.z += offset.y;  // height fog needs the world height, not the model's
   return moved;
 }
+
+// A float the world draws where its host places it.
+struct WorldFloat {
+  FloatMesh mesh = FloatMesh::kLog;
+  float radius = 0.0f;
+  IndexRange triangles;
+  bool shown = false;
+  glm::vec3 centre{0.0f};
+  float heading = 0.0f;
+};
 
 }  // namespace
 
@@ -78,6 +101,7 @@ struct World::Impl {
   std::vector<bool> shown;
   std::vector<LodPiece> pieces;       // the static world, culled and levelled per view
   std::vector<IndexRange> boulders;   // per obstacle, drawn translated to it
+  std::vector<WorldFloat> floats;     // the scene's, then the spares
   SceneCamera camera_path;          // keys empty: the scene's default camera
   // The ground, beds and objects as World::occluders() gives them.
   std::vector<glm::vec3> occluder_positions;
@@ -101,6 +125,7 @@ struct World::Impl {
   gpu::SceneConstants main_constants{};
   gpu::SceneConstants reflection_constants{};
   std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main, then mirrored
+  std::vector<gpu::SceneConstants> float_constants;     // per float: main, then mirrored
   double time = 0.0;  // of the last record(), for the reflection
   glm::mat4 projection{1.0f};  // of the last record()'s view: the reflection's levels use it too
   WorldDrawStats stats;
@@ -160,6 +185,13 @@ Status World::Impl::load_scene() {
     shown.push_back(false);
   }
   placed.assign(obstacles.size(), std::nullopt);
+  if (info.scene != nullptr) {
+    for (const SceneFloat& f : info.scene->floats) floats.push_back({f.mesh, f.radius});
+  }
+  const float log_radius = scene_float_defaults(FloatMesh::kLog).radius;
+  const float leaf_radius = scene_float_defaults(FloatMesh::kLeaf).radius;
+  for (uint32_t i = 0; i < info.spare_logs; ++i) floats.push_back({FloatMesh::kLog, log_radius});
+  for (uint32_t i = 0; i < info.spare_leaves; ++i) floats.push_back({FloatMesh::kLeaf, leaf_radius});
   if (info.scene != nullptr) camera_path = info.scene->camera;
   return Status::success();
 }
@@ -178,6 +210,10 @@ Status World::Impl::create_resources() {
   if (info.scene != nullptr) SIVIFLOW_TRY(load_scene_objects(*info.scene, &objects));
   obstacle_constants.resize(2 * obstacles.size());  // sized once: the draws point into it
   boulders = geometry.obstacle_boulders;
+  float_constants.resize(2 * floats.size());
+  for (size_t i = 0; i < floats.size(); ++i) {
+    floats[i].triangles = add_float_mesh(floats[i].mesh, floats[i].radius, float(i), &geometry);
+  }
   // The other rivers' valleys or beds, static like the first's.
   for (SceneGeometry& other : other_rivers) append_geometry(std::move(other), &geometry);
   other_rivers.clear();
@@ -286,9 +322,15 @@ void World::Impl::select_draws(const CullView& view, const gpu::SceneConstants& 
   for (const auto& entry : seen) draws->push_back(entry.second);
   for (size_t i = 0; i < obstacles.size(); ++i) {
     if (!shown[i]) continue;
-    obstacle_constants[2 * i + which] = translated(constants, boulder_centre(i, time));
+    obstacle_constants[2 * i + which] = posed(constants, boulder_centre(i, time));
     draws->push_back({boulders[i].first_index, boulders[i].index_count,
                       &obstacle_constants[2 * i + which]});
+  }
+  for (size_t i = 0; i < floats.size(); ++i) {
+    const WorldFloat& f = floats[i];
+    if (!f.shown) continue;
+    float_constants[2 * i + which] = posed(constants, f.centre, f.heading);
+    draws->push_back({f.triangles.first_index, f.triangles.index_count, &float_constants[2 * i + which]});
   }
   *triangles = 0;
   for (const SceneDraw& draw : *draws) *triangles += draw.index_count / 3;
@@ -413,6 +455,43 @@ Status World::boulder_at(uint32_t index, double time_seconds, BoulderPose* out) 
   out->shown = impl_->shown[index];
   out->centre = impl_->boulder_centre(index, time_seconds);
   out->radii = boulder_radii(impl_->obstacles[index]);
+  return Status::success();
+}
+
+uint32_t World::float_count() const { return static_cast<uint32_t>(impl_->floats.size()); }
+
+Status World::place_float(uint32_t index, const glm::vec3& centre, float heading) {
+  if (index >= float_count()) {
+    return world_error("place_float: no float " + std::to_string(index) + " (there are " +
+                       std::to_string(float_count()) + ")");
+  }
+  if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z) ||
+      !std::isfinite(heading)) {
+    return world_error("place_float: centre or heading is not finite");
+  }
+  WorldFloat& f = impl_->floats[index];
+  f.centre = centre;
+  f.heading = heading;
+  f.shown = true;
+  return Status::success();
+}
+
+Status World::hide_float(uint32_t index) {
+  if (index >= float_count()) {
+    return world_error("hide_float: no float " + std::to_string(index) + " (there are " +
+                       std::to_string(float_count()) + ")");
+  }
+  impl_->floats[index].shown = false;
+  return Status::success();
+}
+
+Status World::float_reach(uint32_t index, glm::vec3* out) const {
+  if (index >= float_count()) {
+    return world_error("float_reach: no float " + std::to_string(index) + " (there are " +
+                       std::to_string(float_count()) + ")");
+  }
+  if (out == nullptr) return world_error("float_reach: out is null");
+  *out = siviflow::float_reach(impl_->floats[index].mesh, impl_->floats[index].radius);
   return Status::success();
 }
 

@@ -637,11 +637,22 @@ TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {
       EXPECT_TRUE(s.ok()) << section << "." << item.key() << ": " << s.message();
     }
   }
-  for (const char* key : {"version", "river", "rivers", "flow", "obstacles", "objects", "camera",
-                          "render", "look", "$schema"}) {
+  for (const char* key : {"version", "river", "rivers", "flow", "obstacles", "objects", "floats",
+                          "camera", "render", "look", "$schema"}) {
     EXPECT_TRUE(top.contains(key)) << key;
   }
-  EXPECT_EQ(top.size(), 10u) << "a top-level key the parser does not know";
+  EXPECT_EQ(top.size(), 11u) << "a top-level key the parser does not know";
+  // Floats: every listed key parses, and the listed mesh names are the parser's.
+  const Json& floating = top["floats"]["items"];
+  EXPECT_EQ(top["floats"]["maxItems"].get<size_t>(), kMaxSceneFloats);
+  EXPECT_EQ(floating["required"], Json({"release_point"}));
+  EXPECT_EQ(floating["properties"]["mesh"]["enum"], Json({"log", "leaf"}));
+  const Status with_every_key = parse(
+      with({{"floats", {{{"mesh", "leaf"}, {"release_point", {0, 0}}, {"release_time", 1},
+                         {"radius", 0.2}, {"drag", 3}}}}}),
+      &scene);
+  EXPECT_TRUE(with_every_key.ok()) << with_every_key.message();
+  EXPECT_EQ(floating["properties"].size(), 5u);
   // Obstacles: a circle or a polygon, exactly one (oneOf), and every listed key parses.
   const Json& obstacle = top["obstacles"]["items"];
   std::set<std::string> obstacle_keys;
@@ -650,6 +661,45 @@ TEST(SceneFileSchema, SectionDefaultsAndKeysMatchTheParser) {
   EXPECT_EQ(obstacle["required"], Json({"center"}));
   ASSERT_EQ(obstacle["oneOf"].size(), 2u);
   EXPECT_EQ(obstacle["properties"]["polygon"]["minItems"].get<int>(), 3);
+}
+
+TEST(SceneFile, FloatsTakeTheirMeshsDefaults) {
+  SceneFile scene;
+  const Status status =
+      parse(with({{"floats",
+                   {{{"release_point", {1.5, -20.0}}},
+                    {{"mesh", "leaf"}, {"release_point", {0, 3}}, {"release_time", 2.5}},
+                    {{"mesh", "log"}, {"release_point", {0, 3}}, {"radius", 1.1}, {"drag", 0}}}}}),
+            &scene);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(scene.floats.size(), 3u);
+  EXPECT_EQ(scene.floats[0].mesh, FloatMesh::kLog);
+  EXPECT_EQ(scene.floats[0].release_point, glm::vec2(1.5f, -20.0f));
+  EXPECT_EQ(scene.floats[0].release_time, 0.0);
+  EXPECT_EQ(scene.floats[0].radius, 0.6f);
+  EXPECT_EQ(scene.floats[0].drag, 1.5f);
+  EXPECT_EQ(scene.floats[1].mesh, FloatMesh::kLeaf);
+  EXPECT_EQ(scene.floats[1].release_time, 2.5);
+  EXPECT_EQ(scene.floats[1].radius, 0.15f);
+  EXPECT_EQ(scene.floats[1].drag, 6.0f);
+  EXPECT_EQ(scene.floats[2].radius, 1.1f);
+  EXPECT_EQ(scene.floats[2].drag, 0.0f);
+}
+
+TEST(SceneFile, BadFloatsAreNamed) {
+  expect_error(with({{"floats", {{{"mesh", "log"}}}}}),
+               {"floats[0]: missing required key 'release_point'"});
+  expect_error(with({{"floats", {{{"release_point", {0, 0}}, {"mesh", "boat"}}}}}),
+               {"floats[0].mesh: 'boat' is not a float mesh"});
+  expect_error(with({{"floats", {{{"release_point", {0, 0}}}, {{"release_point", {0, 0}}, {"radius", -1}}}}}),
+               {"floats[1].radius"});
+  expect_error(with({{"floats", {{{"release_point", {0, 0}}, {"release_time", -0.5}}}}}),
+               {"floats[0].release_time: -0.5 must not be negative"});
+  expect_error(with({{"floats", {{{"release_point", {0, 0}}, {"drag", -2}}}}}),
+               {"floats[0].drag: -2 must not be negative"});
+  expect_error(with({{"floats", {{{"release_point", {0, 0, 0}}}}}}), {"floats[0].release_point"});
+  expect_error(with({{"floats", {{{"release_point", {0, 0}}, {"speed", 2}}}}}),
+               {"floats[0]", "speed"});
 }
 
 }  // namespace

@@ -10,32 +10,14 @@
 #include <glm/vec2.hpp>
 #include <gtest/gtest.h>
 
-#include "river_simulation.h"
 #include "siviflow/drift.h"
-#include "unit/river_test_meshes.h"
+#include "unit/river_flow_fixture.h"
 
 namespace siviflow {
 namespace {
 
-// A RiverFlow on a test mesh, `depth` metres deep everywhere.
-std::unique_ptr<RiverFlow> river_flow(const test::TestMesh& m, const FlowParams& params,
-                                      std::vector<Obstacle> obstacles = {}, float depth = 1.0f) {
-  RiverInput input;
-  input.mesh.positions = m.positions;
-  input.mesh.indices = m.indices;
-  input.mesh.depth.assign(m.positions.size(), depth);
-  EXPECT_TRUE(RiverSurface::build(m.positions, m.indices, {}, &input.surface).ok());
-  auto flow = std::make_unique<RiverFlow>();
-  const Status created = flow->create(std::move(input), params, std::move(obstacles));
-  EXPECT_TRUE(created.ok()) << created.message();
-  return flow;
-}
-
-WaterSample query(const RiverFlow& flow, glm::vec3 point) {
-  WaterSample s;
-  flow.query(std::span<const glm::vec3>(&point, 1), std::span<WaterSample>(&s, 1));
-  return s;
-}
+using test::query;
+using test::river_flow;
 
 TEST(WaterQuery, StraightChannelIsUniformEverywhereOnIt) {
   const float width = 10.0f, q = 20.0f;
@@ -238,7 +220,9 @@ TEST(Drift, AroundACylinderFollowsTheFlowsStreamline) {
   EXPECT_LT(from_potential, 0.05f * length_of_path);  // 3.6 % measured: the flow model's own gap
   // Both pass the cylinder on the side of the release.
   for (const glm::vec3& x : path) {
-    if (std::abs(x.z - centre.z) < 0.5f) EXPECT_GT(x.x, a);
+    if (std::abs(x.z - centre.z) < 0.5f) {
+      EXPECT_GT(x.x, a);
+    }
   }
 }
 

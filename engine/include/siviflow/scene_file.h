@@ -15,6 +15,8 @@
 //                      "keys": [ { "t": 0.0, "center": [..] } ] } ],
 //     "objects":   [ { "gltf": "duck.glb", "translation": [..], "rotation": [x,y,z,w],
 //                      "scale": [..], "obstacle": true } ],
+//     "floats":    [ { "mesh": "log" | "leaf", "release_point": [x, z], "release_time": 2.0,
+//                      "radius": 0.6, "drag": 1.5 } ],
 //     "camera":    { "fov_y_deg": 50, "keys": [ { "t": 0.0, "position": [..], "target": [..] } ] },
 //     "render":    { "size": [1280, 720], "fps": 30, "seed": 1 },
 //     "look":      { "water_color": [r,g,b], "absorption_per_metre": 1.4, ... } }   WaterLook
@@ -38,6 +40,10 @@
 //   objects[].scale         [1, 1, 1];  obstacle false. An obstacle object is static (no keys):
 //                           its footprint is the XZ convex hull of its transformed mesh where it
 //                           dips below the water (see scene_river.h)
+//   floats                  none. mesh "log"; release_time 0 (>= 0); radius 0.6 for a log, 0.15
+//                           for a leaf (half its length, > 0); drag 1.5 for a log, 6 for a leaf
+//                           (1/s, >= 0; siviflow/drift.h). The release point must lie on a
+//                           river: captures refuse the scene otherwise (scene_floats.h)
 //   camera.fov_y_deg        kDefaultCameraFovYDeg (50)
 //   camera.keys             none: the built-in camera that glides down the river
 //   render.size             [1280, 720];  fps 30;  seed 1
@@ -75,6 +81,7 @@ inline constexpr uint32_t kMaxRenderDimension = 16384;  // maxImageDimension2D o
 inline constexpr double kMaxRenderFps = 1000.0;
 inline constexpr size_t kMaxSceneObjects = 4096;
 inline constexpr size_t kMaxSceneRivers = 64;
+inline constexpr size_t kMaxSceneFloats = 4096;
 inline constexpr size_t kMaxCameraKeys = size_t{1} << 20;
 inline constexpr float kDefaultSceneDischarge = 20.0f;  // m^2/s: ~1.7 m/s in the default 12 m river
 inline constexpr float kDefaultCameraFovYDeg = 50.0f;
@@ -98,6 +105,18 @@ struct SceneObject {
   glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // unit; the file writes it x, y, z, w as glTF does
   glm::vec3 scale{1.0f};                       // every component non-zero
   bool obstacle = false;                       // its footprint on the water plane cuts the river
+};
+
+// A floating body the scene releases onto the water: the hosts drift it with siviflow/drift.h
+// and the world draws it (a built-in mesh, modelled along +x, turned to where it drifts).
+enum class FloatMesh : uint8_t { kLog, kLeaf };
+
+struct SceneFloat {
+  FloatMesh mesh = FloatMesh::kLog;
+  glm::vec2 release_point{0.0f};  // [x, z], metres: it starts on the water surface there
+  double release_time = 0.0;      // seconds, >= 0: absent before
+  float radius = 0.6f;            // metres, > 0: half its length
+  float drag = 1.5f;              // 1/s, >= 0: how fast it takes the water's velocity
 };
 
 struct CameraKey {
@@ -125,6 +144,7 @@ struct SceneFile {
   std::vector<SceneRiver> rivers{1};  // at least one; each with its own flow
   std::vector<Obstacle> obstacles;  // in every river they touch  // circles (radius > 0) or polygons, keys optional
   std::vector<SceneObject> objects;
+  std::vector<SceneFloat> floats;
   SceneCamera camera;
   SceneRender render;
   WaterLook look;  // the water's starting look (Renderer::set_look() changes it at runtime)
@@ -138,6 +158,9 @@ Status load_scene_file(const std::string& path, SceneFile* out);
 // relative paths are resolved against (for tests and fuzzing).
 Status parse_scene_file(std::string_view text, const std::string& file, const std::string& folder,
                         SceneFile* out);
+
+// A float of `mesh` with its defaults: a log 0.6 m radius, drag 1.5; a leaf 0.15 m, drag 6.
+SceneFloat scene_float_defaults(FloatMesh mesh);
 
 // The keys `river.procedural` accepts: the fields of ProceduralRiverParams.
 std::vector<std::string> procedural_river_keys();

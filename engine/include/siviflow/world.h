@@ -1,5 +1,5 @@
-// The built-in world of SiViFlow's tools: sky, terrain, riverbed, a scene file's glTF objects
-// and a boulder at each obstacle. It is a host of the water renderer like any engine's world:
+// The built-in world of SiViFlow's tools: sky, terrain, riverbed, a scene file's glTF objects,
+// a boulder at each obstacle, and the floating logs and leaves the host drifts. It is a host of the water renderer like any engine's world:
 // it draws into the host's colour and depth (cleared first) before the water is recorded, and
 // draws itself mirrored into the renderer's reflection through the reflection callback.
 //
@@ -44,6 +44,11 @@ struct WorldCreateInfo {
   // with place_boulder(); each `spare_boulder_radius` metres round.
   uint32_t spare_boulders = 0;
   float spare_boulder_radius = 1.5f;
+  // Floats: one for each of the scene's `floats` (its mesh and radius), then these spares for a
+  // host to drop (logs, then leaves, of the scene file's default radii); all hidden until placed
+  // with place_float().
+  uint32_t spare_logs = 0;
+  uint32_t spare_leaves = 0;
   bool enable_timing = false;        // GPU timestamps around the world's pass (pass_times())
   uint32_t queue_family_index = 0;   // with enable_timing: the family of the queue that runs it
 };
@@ -88,6 +93,17 @@ class World {
   Status hide_boulder(uint32_t index);
   // Boulder `index` as record() would draw it at `time_seconds` (a capture's motion vectors).
   Status boulder_at(uint32_t index, double time_seconds, BoulderPose* out) const;
+
+  // The floats: the scene's `floats` in order, then the spare logs and leaves.
+  uint32_t float_count() const;
+  // Draws float `index` from the next record() on with its centre at `centre` (on the water
+  // surface: the host drifts it, e.g. with siviflow/drift.h), its length turned from +x by
+  // `heading` radians towards +z (along (cos, 0, sin)).
+  Status place_float(uint32_t index, const glm::vec3& centre, float heading);
+  Status hide_float(uint32_t index);
+  // How far float `index`'s mesh reaches from its centre (x, z along its length at any heading,
+  // y up): an ellipsoid that holds it, for motion vectors.
+  Status float_reach(uint32_t index, glm::vec3* out) const;
 
   // The host has waited until the GPU finished the commands last recorded for this slot.
   Status begin_frame(uint32_t slot);
