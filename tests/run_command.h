@@ -1,5 +1,5 @@
 // Runs the siviflow tool as a user would, capturing its exit status and output; a fresh folder
-// for what a test run writes.
+// for what a test run writes, and the bytes of what it wrote.
 #pragma once
 
 #include <sys/wait.h>
@@ -33,6 +33,18 @@ inline RunResult run_shell(const std::string& command) {
 // `env` is prepended as shell assignments, e.g. "VK_DRIVER_FILES=/x.json".
 inline RunResult run_siviflow(const std::string& args, const std::string& env = "") {
   return run_shell(env + " " + std::string(SIVIFLOW_BINARY_DIR) + "/tools/siviflow " + args);
+}
+
+// A file's bytes; empty when it cannot be read.
+inline std::string read_file(const std::filesystem::path& path) {
+  FILE* f = std::fopen(path.c_str(), "rb");
+  std::string text;
+  if (f == nullptr) return text;
+  char buffer[4096];
+  size_t n = 0;
+  while ((n = std::fread(buffer, 1, sizeof(buffer), f)) > 0) text.append(buffer, n);
+  std::fclose(f);
+  return text;
 }
 
 // An empty folder for the running test's files: <build>/tests/<group>/<test name>.

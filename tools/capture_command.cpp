@@ -166,9 +166,9 @@ struct SlotTargets {
   bool pending = false;  // a submitted frame whose readback has not been copied out yet
   uint32_t frame = 0;
   Camera camera;
-  Camera previous_camera;  // with the motion AOV, and the boulders that move about this frame
+  Camera previous_camera;  // with the motion AOV, and the bodies that move about this frame
   Camera next_camera;
-  std::vector<MovingBoulder> boulders;  // and the floats, as ellipsoids that hold them
+  std::vector<MovingBody> bodies;  // the boulders and floats that move about this frame
   std::vector<Particle> particles;  // as simulated for this frame
 };
 
@@ -352,7 +352,7 @@ Status Capture::record_motion(uint32_t frame, SlotTargets* slot) const {
   const double after = (static_cast<double>(frame) + 1.0) / options_.fps;
   slot->previous_camera = world_->scene_camera(before);
   slot->next_camera = world_->scene_camera(after);
-  slot->boulders.clear();
+  slot->bodies.clear();
   for (uint32_t i = 0; i < world_->boulder_count(); ++i) {
     BoulderPose then;
     BoulderPose now;
@@ -361,7 +361,7 @@ Status Capture::record_motion(uint32_t frame, SlotTargets* slot) const {
     SIVIFLOW_TRY(world_->boulder_at(i, time, &now));
     SIVIFLOW_TRY(world_->boulder_at(i, after, &later));
     if (!now.shown || (then.centre == now.centre && later.centre == now.centre)) continue;
-    slot->boulders.push_back({then.centre, now.centre, later.centre, now.radii});
+    slot->bodies.push_back({then.centre, now.centre, later.centre, now.radii});
   }
   return Status::success();
 }
@@ -381,8 +381,8 @@ Status Capture::step_floats(uint32_t frame, SlotTargets* slot) {
     const bool before_shown = !floats_before_.empty() && floats_before_[i].shown;
     glm::vec3 reach;
     SIVIFLOW_TRY(world_->float_reach(i, &reach));
-    slot->boulders.push_back(
-        {before_shown ? floats_before_[i].centre : now[i].centre, now[i].centre, next[i].centre, reach});
+    slot->bodies.push_back({before_shown ? floats_before_[i].centre : now[i].centre, now[i].centre,
+                            next[i].centre, reach, true});
   }
   floats_before_ = now;
   return Status::success();
@@ -394,7 +394,7 @@ void Capture::copy_out(const SlotTargets& slot, FinishedFrame* finished) const {
   finished->camera = slot.camera;
   finished->previous_camera = slot.previous_camera;
   finished->next_camera = slot.next_camera;
-  finished->boulders = slot.boulders;
+  finished->bodies = slot.bodies;
   // Each read-back image's bytes; the images not read back are left empty.
   const auto copy = [&slot](ReadbackImage kind, size_t count, auto* out) {
     using T = typename std::remove_reference_t<decltype(*out)>::value_type;

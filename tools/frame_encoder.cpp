@@ -146,7 +146,7 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
     motion.previous = camera_view(finished.previous_camera, extent);
     motion.current = camera_view(finished.camera, extent);
     motion.next = camera_view(finished.next_camera, extent);
-    motion.boulders = finished.boulders;
+    motion.bodies = finished.bodies;
     compute_motion(motion, &motion_);
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"motion", ExrCompression::kZip, {}});
     for (int c = 0; c < 4; ++c) layer.channels.push_back({kMotionChannels[c], motion_.data() + c, 4});

@@ -24,10 +24,11 @@ namespace siviflow {
 struct FinishedFrame {
   uint32_t frame = 0;
   Camera camera;
-  // With the motion AOV: the cameras of the frames before and after, and the keyed boulders.
+  // With the motion AOV: the cameras of the frames before and after, and the moving boulders
+  // and floats.
   Camera previous_camera;
   Camera next_camera;
-  std::vector<MovingBoulder> boulders;
+  std::vector<MovingBody> bodies;
   std::vector<uint16_t> color_halves;
   std::vector<float> window_depth;
   std::vector<float> water_mask;

@@ -11,8 +11,9 @@
 namespace siviflow {
 namespace {
 
-// Bumps stand out of a boulder's ellipsoid by less than this share of its radii.
-constexpr double kBoulderReach = 1.15;
+// Bumps stand out of a boulder's ellipsoid (a log's bark out of its cylinder) by less than this
+// share of its radii.
+constexpr double kBodyReach = 1.15;
 
 // Motion is rounded to 1/1024 px: finer than depth resolves it beyond a few metres, and with the
 // noise of the low mantissa bits gone deflate packs the layer 5x at a third of the time.
@@ -29,17 +30,23 @@ bool to_pixel(const glm::dmat4& view_proj, const glm::dvec4& point, glm::dvec2 s
   return true;
 }
 
-// The boulder (if any) whose surface the world point lies on: its displacement to the previous
-// and next frames, zero for the static world.
-void displacement(std::span<const MovingBoulder> boulders, const glm::dvec3& point,
+bool within_reach(const MovingBody& body, const glm::dvec3& point) {
+  const glm::dvec3 local = (point - glm::dvec3(body.centre)) / glm::dvec3(body.radii);
+  if (!body.upright_cylinder) return glm::dot(local, local) <= kBodyReach * kBodyReach;
+  return local.x * local.x + local.z * local.z <= kBodyReach * kBodyReach &&
+         std::abs(local.y) <= kBodyReach;
+}
+
+// The body (if any) whose surface the world point lies on: its displacement to the previous and
+// next frames, zero for the static world.
+void displacement(std::span<const MovingBody> bodies, const glm::dvec3& point,
                   glm::dvec3* to_previous, glm::dvec3* to_next) {
   *to_previous = glm::dvec3(0.0);
   *to_next = glm::dvec3(0.0);
-  for (const MovingBoulder& boulder : boulders) {
-    const glm::dvec3 local = (point - glm::dvec3(boulder.centre)) / glm::dvec3(boulder.radii);
-    if (glm::dot(local, local) > kBoulderReach * kBoulderReach) continue;
-    *to_previous = glm::dvec3(boulder.previous_centre - boulder.centre);
-    *to_next = glm::dvec3(boulder.next_centre - boulder.centre);
+  for (const MovingBody& body : bodies) {
+    if (!within_reach(body, point)) continue;
+    *to_previous = glm::dvec3(body.previous_centre - body.centre);
+    *to_next = glm::dvec3(body.next_centre - body.centre);
     return;
   }
 }
@@ -79,7 +86,7 @@ void compute_motion(const MotionFrame& frame, std::vector<float>* xyzw) {
         if (frame.water_mask[pixel] > 0.5f) {
           to_previous = to_next = glm::dvec3(0.0);
         } else {
-          displacement(frame.boulders, point, &to_previous, &to_next);
+          displacement(frame.bodies, point, &to_previous, &to_next);
         }
         point_now = glm::dvec4(point, 1.0);
         point_previous = glm::dvec4(point + to_previous, 1.0);

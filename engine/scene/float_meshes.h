@@ -10,7 +10,7 @@
 namespace siviflow {
 
 // How far a float's mesh reaches from its centre along its length (x and z, any heading) and up:
-// the ellipsoid a capture's motion vectors move with it.
+// the upright cylinder a capture's motion vectors move with it.
 glm::vec3 float_reach(FloatMesh mesh, float radius);
 
 // Appends the mesh of a float `radius` metres long each way from its centre to `geometry`;

@@ -196,16 +196,6 @@ TEST_F(CliTest, CaptureWritesExrFramesAndPreviews) {
   EXPECT_EQ(files, 6u);
 }
 
-std::string read_file(const fs::path& path) {
-  FILE* f = std::fopen(path.c_str(), "rb");
-  std::string text;
-  if (f == nullptr) return text;
-  char buffer[4096];
-  size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof(buffer), f)) > 0) text.append(buffer, n);
-  std::fclose(f);
-  return text;
-}
 
 TEST_F(CliTest, FlowAndParticleAovs) {
   const RunResult r = run_siviflow("capture --frames 2 --size 160x90 --aov flow,particles --validation --out " +

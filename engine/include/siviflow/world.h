@@ -101,8 +101,8 @@ class World {
   // `heading` radians towards +z (along (cos, 0, sin)).
   Status place_float(uint32_t index, const glm::vec3& centre, float heading);
   Status hide_float(uint32_t index);
-  // How far float `index`'s mesh reaches from its centre (x, z along its length at any heading,
-  // y up): an ellipsoid that holds it, for motion vectors.
+  // How far float `index`'s mesh reaches from its centre: x (and z) along its length, y up. The
+  // upright cylinder of radius x and half height y holds it at any heading (motion vectors).
   Status float_reach(uint32_t index, glm::vec3* out) const;
 
   // The host has waited until the GPU finished the commands last recorded for this slot.
