@@ -15,6 +15,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 #include <gtest/gtest.h>
 
 #include "default_river.h"
@@ -132,6 +133,7 @@ struct DefaultScene {
 
 struct Report {
   std::vector<glm::vec4> obstacles;  // centre, radius
+  std::vector<glm::vec3> floats;     // centres
   struct Sample {
     glm::vec3 position;
     glm::vec3 flow;
@@ -151,6 +153,7 @@ Report read_report(const std::filesystem::path& path) {
     float v[6];
     words >> kind >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5];
     if (kind == "obstacle") report.obstacles.push_back({v[0], v[1], v[2], v[3]});
+    if (kind == "float") report.floats.push_back({v[0], v[1], v[2]});
     if (kind == "vertex") report.vertices.push_back({{v[0], v[1], v[2]}, {v[3], v[4], v[5]}});
   }
   return report;
@@ -288,6 +291,42 @@ TEST(ViewWindow, DraggedBoulderReroutesTheNextFramesFlow) {
   // The flow now goes round the boulder where it was dropped, and straight on where it was.
   EXPECT_LT(new_after, new_before - 0.15);
   EXPECT_GT(old_after, old_before + 0.15);
+}
+
+// F drops a float under the cursor; it drifts downstream with the flow and stays on the water.
+TEST(ViewWindow, DroppedFloatDriftsDownstream) {
+  const auto dir = fresh_test_dir("window");
+  const DefaultScene scene;
+  const uint32_t middle = scene.river.mesh.vertices_across / 2;
+  const glm::vec3 camera(glm::inverse(scene.view.view)[3]);
+  std::optional<glm::vec3> drop;
+  std::optional<glm::vec2> px;
+  for (uint32_t s = 0; s < scene.river.mesh.section_count && !drop; ++s) {
+    const glm::vec3 p = scene.river.mesh.positions[s * scene.river.mesh.vertices_across + middle];
+    px = scene.pixel(p);
+    bool clear = true;  // of the boulders' footprints, by a margin
+    for (const auto& o : scene.river.obstacles) {
+      clear = clear && glm::length(glm::vec2(p.x - o.centre.x, p.z - o.centre.z)) > 3.0f * o.radius;
+    }
+    if (clear && px && scene.clickable(*px) && glm::length(p - camera) > 12.0f) {
+      drop = p;
+    }
+  }
+  ASSERT_TRUE(drop.has_value()) << "no open water in view to drop a float on";
+  write_text(dir / "drop.txt", "3 move " + std::to_string(px->x) + " " + std::to_string(px->y) +
+                                   "\n4 key f\n");
+  const auto run = run_siviflow("view --frames 64 --size 640x360 --validation --flow-report " +
+                                    (dir / "floats.csv").string() + " --input-script " +
+                                    (dir / "drop.txt").string(), display_env());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const Report report = read_report(dir / "floats.csv");
+  ASSERT_EQ(report.floats.size(), 1u) << "one log dropped";
+  const glm::vec3 at = report.floats[0];
+  std::printf("dropped at x %.2f, z %.2f; one second later at x %.2f, z %.2f\n", drop->x, drop->z,
+              at.x, at.z);
+  EXPECT_GT(at.z - drop->z, 0.3f) << "carried downstream (+z)";
+  EXPECT_LT(at.z - drop->z, 3.0f) << "no faster than the water";
+  EXPECT_LT(std::abs(at.x - drop->x), 1.5f) << "along the flow";
 }
 
 TEST(ViewWindow, WithoutADisplayExits1WithAMessage) {

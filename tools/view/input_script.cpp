@@ -33,8 +33,8 @@ Status load_input_script(const std::string& path, std::vector<InputEvent>* out) 
     } else if (kind == "key") {
       e.kind = InputEvent::Kind::kKey;
       ok = static_cast<bool>(words >> e.name) &&
-           (e.name == "b" || e.name == "x" || e.name == "c" || e.name == "space" ||
-            e.name == "escape");
+           (e.name == "b" || e.name == "x" || e.name == "f" || e.name == "c" || e.name == "v" ||
+            e.name == "space" || e.name == "escape");
     } else if (kind == "wheel") {
       e.kind = InputEvent::Kind::kWheel;
       ok = static_cast<bool>(words >> e.x) && std::isfinite(e.x);

@@ -2,8 +2,8 @@
 // through the same handlers as the window's own events (not a real mouse). One event a line:
 //   FRAME move X Y          cursor to window pixel (X, Y)
 //   FRAME press left|right  button down;  FRAME release left|right  button up
-//   FRAME key NAME          a key pressed and released: b (add boulder), x (remove), c (camera
-//                           path), space (pause), escape
+//   FRAME key NAME          a key pressed and released: b (add boulder), x (remove), f (drop a
+//                           float), c (camera path), v (debug view), space (pause), escape
 //   FRAME wheel N           N notches of the wheel
 //   FRAME resize W H        the window resized to W x H (through GLFW)
 // Blank lines and lines starting with '#' are skipped.

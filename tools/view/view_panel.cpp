@@ -50,7 +50,8 @@ PanelActions draw_panel(const PanelStats& stats, PanelState* state) {
     ImGui::SliderFloat("time scale", &state->time_scale, 0.0f, 4.0f);
     ImGui::Text("t = %.2f s   speed %.1f m/s (wheel)", state->time_seconds, state->camera_speed);
     ImGui::TextWrapped("WASD move, Q/E down/up, right drag look, shift fast; left drag a "
-                       "boulder, B adds one under the cursor, X removes it; Esc quits.");
+                       "boulder, B adds one under the cursor, X removes it; F drops a float; "
+                       "Esc quits.");
   }
   if (ImGui::CollapsingHeader("Water look", ImGuiTreeNodeFlags_DefaultOpen)) {
     WaterLook& look = state->look;

@@ -20,6 +20,7 @@
 #include "siviflow/scene_river.h"
 #include "siviflow/text_format.h"
 #include "siviflow/world.h"
+#include "view/float_control.h"
 #include "view/fly_camera.h"
 #include "view/frame_slots.h"
 #include "view/image_barrier.h"
@@ -110,6 +111,7 @@ class Viewer {
   std::vector<std::unique_ptr<Renderer>> renderers_;
   std::vector<Renderer*> renderer_list_;
   ObstacleControl obstacles_;
+  FloatControl floats_;
   VkDescriptorPool imgui_pool_ = VK_NULL_HANDLE;
   bool imgui_glfw_ = false;
   bool imgui_vulkan_ = false;
@@ -204,6 +206,8 @@ Status Viewer::create_water() {
   world_info.debug_utils = device_.validation;
   world_info.spare_boulders = kSpareBoulders;
   world_info.spare_boulder_radius = kSpareBoulderRadius;
+  world_info.spare_logs = kSpareLogs;
+  world_info.spare_leaves = kSpareLeaves;
   SIVIFLOW_TRY(World::create(world_info, &world_));
   const size_t scene_obstacles = world_->boulder_count() - kSpareBoulders;
 
@@ -231,7 +235,8 @@ Status Viewer::create_water() {
     renderer_list_.push_back(renderer.get());
     renderers_.push_back(std::move(renderer));
   }
-  return obstacles_.init(rivers_, scene_obstacles, renderer_list_, world_.get());
+  SIVIFLOW_TRY(obstacles_.init(rivers_, scene_obstacles, renderer_list_, world_.get()));
+  return floats_.init(scene_.get(), renderer_list_, world_.get());
 }
 
 Status Viewer::init_imgui() {
@@ -348,6 +353,11 @@ void Viewer::on_key(int key) {
       apply_debug_view();
       break;
     case GLFW_KEY_B: status = obstacles_.add_at(ray); break;
+    case GLFW_KEY_F: {
+      const std::optional<glm::vec3> hit = obstacles_.hit_water(ray);
+      status = hit ? floats_.drop_at(*hit) : Status::error("no water under the cursor to drop a float on");
+      break;
+    }
     case GLFW_KEY_X: {
       bool removed = false;
       status = obstacles_.remove_at(ray, sim_time_, &removed);
@@ -368,7 +378,7 @@ void Viewer::apply_script_events() {
   static const struct {
     const char* name;
     int key;
-  } kKeys[] = {{"b", GLFW_KEY_B}, {"x", GLFW_KEY_X}, {"c", GLFW_KEY_C}, {"v", GLFW_KEY_V},
+  } kKeys[] = {{"b", GLFW_KEY_B}, {"x", GLFW_KEY_X}, {"f", GLFW_KEY_F}, {"c", GLFW_KEY_C}, {"v", GLFW_KEY_V},
                {"space", GLFW_KEY_SPACE}, {"escape", GLFW_KEY_ESCAPE}};
   for (const InputEvent& e : script_) {
     if (e.frame != frame_index_) continue;
@@ -497,6 +507,7 @@ Status Viewer::frame(bool* presented) {
     SIVIFLOW_TRY(renderer->begin_frame(slot_index));
     SIVIFLOW_TRY(renderer->update(view, sim_time_));
   }
+  SIVIFLOW_TRY(floats_.step(sim_time_));
   const double update_ms = ms_since(update_start);
 
   const auto panel_start = std::chrono::steady_clock::now();
@@ -697,6 +708,12 @@ Status Viewer::write_flow_report() const {
   for (const ObstacleControl::Placed& p : obstacles_.placed(sim_time_)) {
     std::snprintf(row, sizeof(row), "obstacle,%.6g,%.6g,%.6g,%.6g,0,0\n", p.centre.x, p.centre.y,
                   p.centre.z, p.radius);
+    csv += row;
+  }
+  for (const FloatPose& f : floats_.poses()) {
+    if (!f.shown) continue;
+    std::snprintf(row, sizeof(row), "float,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", f.centre.x, f.centre.y,
+                  f.centre.z, f.velocity.x, f.velocity.y, f.velocity.z);
     csv += row;
   }
   const RiverFlowField& field = flow_field(*renderer_list_.front());
