@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "siviflow/sim/river_surface.h"
+#include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
@@ -67,8 +68,8 @@ Status river_input_from(const WaterRiver& river, RiverInput* out) {
   SIVIFLOW_TRY(per_vertex(river.slope.size(), "slope"));
   for (size_t v = 0; v < count; ++v) {
     const glm::vec3& p = river.positions[v];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return Status::error(text_format("CreateInfo::river->positions[%zu] is not finite", v));
+    if (!within_world(p)) {
+      return Status::error(text_format("CreateInfo::river->positions[%zu] ", v) + world_limit_problem(p));
     }
     if (!(river.depth[v] >= 0.0f) || !std::isfinite(river.depth[v])) {
       return Status::error(text_format("CreateInfo::river->depth[%zu] %g is not a finite depth >= 0",

@@ -8,14 +8,11 @@
 #include <glm/geometric.hpp>
 
 #include "siviflow/sim/river_tuning.h"
+#include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {
-
-bool finite3(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
 
 double cross2(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
 
@@ -44,8 +41,8 @@ bool inside_triangle(std::span<const glm::dvec2, 3> t, glm::dvec2 p) {
 }  // namespace
 
 Status validate_obstacle(const Obstacle& o, size_t index) {
-  if (!finite3(o.centre)) {
-    return Status::error(text_format("obstacle %zu has a non-finite centre", index));
+  if (!within_world(o.centre)) {
+    return Status::error(text_format("obstacle %zu: its centre ", index) + world_limit_problem(o.centre));
   }
   if (!std::isfinite(o.height) || !(o.height >= 0.0f)) {
     return Status::error(text_format("obstacle %zu has height %g: it must be finite and >= 0",
@@ -67,9 +64,9 @@ Status validate_obstacle(const Obstacle& o, size_t index) {
     double area2 = 0.0, scale = 0.0;
     for (size_t i = 0; i < n; ++i) {
       const glm::vec2 p = o.polygon[i];
-      if (!std::isfinite(p.x) || !std::isfinite(p.y)) {
-        return Status::error(text_format(
-            "obstacle %zu: footprint point %zu is not finite", index, i));
+      if (!within_world(p)) {
+        return Status::error(text_format("obstacle %zu: footprint point %zu ", index, i) +
+                             world_limit_problem(glm::vec3(p.x, 0.0f, p.y)));
       }
       area2 += cross2(glm::dvec2(p), glm::dvec2(o.polygon[(i + 1) % n]));
       scale = std::max({scale, std::abs(double{p.x}), std::abs(double{p.y})});
@@ -94,8 +91,12 @@ Status validate_obstacle(const Obstacle& o, size_t index) {
                                      index, o.keys.size(), kMaxObstacleKeys));
   }
   for (size_t k = 0; k < o.keys.size(); ++k) {
-    if (!std::isfinite(o.keys[k].t) || !finite3(o.keys[k].centre)) {
-      return Status::error(text_format("obstacle %zu: key %zu is not finite", index, k));
+    if (!std::isfinite(o.keys[k].t)) {
+      return Status::error(text_format("obstacle %zu: key %zu's time is not finite", index, k));
+    }
+    if (!within_world(o.keys[k].centre)) {
+      return Status::error(text_format("obstacle %zu: key %zu's centre ", index, k) +
+                           world_limit_problem(o.keys[k].centre));
     }
     if (k > 0 && !(o.keys[k].t > o.keys[k - 1].t)) {
       return Status::error(text_format(

@@ -7,6 +7,8 @@
 
 #include <glm/geometric.hpp>
 
+#include "siviflow/sim/world_limits.h"
+
 namespace siviflow {
 namespace {
 
@@ -76,8 +78,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
   }
   for (size_t i = 0; i < positions.size(); ++i) {
     const glm::vec3& p = positions[i];
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-      return Status::error(name + "::positions[" + std::to_string(i) + "] is not finite");
+    if (!within_world(p)) {
+      return Status::error(name + "::positions[" + std::to_string(i) + "] " + world_limit_problem(p));
     }
   }
   for (size_t i = 0; i < indices.size(); ++i) {

@@ -25,8 +25,9 @@ class TriangleBvh {
  public:
   // `indices` holds 3 vertex indices per triangle; when empty, every 3 positions are a triangle.
   // The spans are referenced, not copied: they must outlive the BVH and keep their contents.
-  // Fails on no triangles, a count that is not a multiple of 3, an index out of range, a non-
-  // finite position, or more triangles than 32-bit indices address.
+  // Fails on no triangles, a count that is not a multiple of 3, an index out of range, a
+  // position outside the world (siviflow/sim/world_limits.h), or more triangles than 32-bit
+  // indices address.
   // Messages name the fields after `mesh_name` ("RiverFlowField::positions[3] is not finite").
   static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                       TriangleBvh* out, std::string_view mesh_name = "RiverFlowField");

@@ -26,6 +26,7 @@
 #include <tiny_gltf.h>
 
 #include "siviflow/sha256.h"
+#include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
@@ -898,10 +899,6 @@ glm::vec3 apply(const glm::dmat4& m, const glm::vec3& p) {
   return glm::vec3(m * glm::dvec4(glm::dvec3(p), 1.0));
 }
 
-bool finite3(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
 // --- Images --------------------------------------------------------------------------------------
 
 bool is_png(std::span<const uint8_t> b) {
@@ -1070,11 +1067,10 @@ Status load_river_mesh(const std::string& path, const std::string& mesh_name, Tr
                               false, &raw));
   for (size_t i = 0; i < raw.positions.size(); ++i) {
     raw.positions[i] = apply(world, raw.positions[i]);
-    if (!finite3(raw.positions[i])) {
-      return fail(path,
-                  text_format("%s primitive 0: vertex %zu is not finite after the transform of "
-                              "node %d",
-                              mesh_label(model, mesh).c_str(), i, node));
+    if (!within_world(raw.positions[i])) {
+      return fail(path, text_format("%s primitive 0: vertex %zu after the transform of node %d ",
+                                    mesh_label(model, mesh).c_str(), i, node) +
+                            world_limit_problem(raw.positions[i]));
     }
   }
   TriangleMesh result;
@@ -1179,9 +1175,10 @@ Status load_gltf_object(const std::string& path, GltfObject* out) {
       // Transform, then drop degenerate triangles (they have no normal).
       for (size_t i = 0; i < raw.positions.size(); ++i) {
         raw.positions[i] = apply(instance.world, raw.positions[i]);
-        if (!finite3(raw.positions[i])) {
-          return fail(path, text_format("%s: vertex %zu is not finite after the node transforms",
-                                        out_prim.label.c_str(), i));
+        if (!within_world(raw.positions[i])) {
+          return fail(path, text_format("%s: vertex %zu after the node transforms ",
+                                        out_prim.label.c_str(), i) +
+                                world_limit_problem(raw.positions[i]));
         }
       }
       const bool mirrored = det < 0.0;  // a mirroring transform flips the winding

@@ -7,6 +7,7 @@
 #include <glm/geometric.hpp>
 
 #include "scene/gltf_import.h"
+#include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
@@ -66,6 +67,12 @@ Status load_scene_objects(const SceneFile& scene, SceneObjects* out) {
         gpu::SceneVertex vertex{};
         // glTF order: scale, then rotate, then translate; normals by the inverse transpose.
         vertex.position = so.translation + so.rotation * (so.scale * primitive.positions[v]);
+        if (!within_world(vertex.position)) {
+          return Status::error(where + text_format("%s: vertex %zu placed by the object's "
+                                                   "translation, rotation and scale ",
+                                                   so.gltf.c_str(), v) +
+                               world_limit_problem(vertex.position));
+        }
         vertex.normal = glm::normalize(so.rotation * (primitive.normals[v] / so.scale));
         vertex.color = glm::vec4(glm::vec3(primitive.base_color_factor), 1.0f);
         if (!primitive.texcoords.empty()) vertex.texcoord = primitive.texcoords[v];

@@ -17,6 +17,7 @@
 #include "siviflow/sim/river_surface.h"
 #include "siviflow/sim/river_tuning.h"
 #include "siviflow/sim/spatial_grid.h"
+#include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
@@ -171,8 +172,15 @@ Status scene_object_obstacles(const SceneFile& scene, std::span<const glm::vec3>
     glm::vec3 lo(0.0f), hi(0.0f);
     bool first = true;
     for (GltfPrimitive& primitive : object.primitives) {
-      for (glm::vec3& p : primitive.positions) {
+      for (size_t v = 0; v < primitive.positions.size(); ++v) {
+        glm::vec3& p = primitive.positions[v];
         p = so.translation + so.rotation * (so.scale * p);  // glTF order: scale, rotate, translate
+        if (!within_world(p)) {
+          return Status::error(scene.path + ": " + what +
+                               text_format("vertex %zu placed by the object's translation, "
+                                           "rotation and scale ", v) +
+                               world_limit_problem(p));
+        }
         lo = first ? p : glm::min(lo, p);
         hi = first ? p : glm::max(hi, p);
         first = false;

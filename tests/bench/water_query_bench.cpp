@@ -22,9 +22,9 @@ RiverFlow& default_river() {
     auto f = std::make_unique<RiverFlow>();
     const ProceduralRiver procedural(default_river_params());
     RiverInput input;
-    const RiverFlowParams flow;
+    const RiverFlowParams params;
     if (!procedural_river_input(procedural, &input).ok() ||
-        !f->create(std::move(input), {flow.discharge, flow.shepard_power, flow.search_radius},
+        !f->create(std::move(input), {params.discharge, params.shepard_power, params.search_radius},
                    default_scene_obstacles(procedural)).ok()) {
       std::abort();
     }

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gltf_test_files.h"
 #include "run_command.h"
 #include "siviflow/frame_folder.h"
 #include "siviflow/image_files.h"
@@ -274,6 +275,43 @@ TEST_F(CliTest, CaptureOfAProceduralSceneFile) {
   ASSERT_EQ(run_siviflow(smaller + " --force").exit_code, 0);
   ASSERT_TRUE(read_exr((dir_ / "frame_00000.exr").string(), &image).ok());
   EXPECT_EQ(image.width, 32);
+}
+
+// Finite values whose products are not (issue 28): refused by name before anything is built,
+// never a crash. The first is the crash seeded mutants found: one element of a glTF node's matrix
+// at 3.4e38 faulted the occluders' hierarchy.
+TEST_F(CliTest, GeometryBeyondTheWorldLimitIsRefusedByName) {
+  const fs::path box = dir_.parent_path() / "huge_node_box.gltf";
+  write_box_gltf(box, {1.0f, 1.0f, 1.0f});
+  std::string text = read_file(box);
+  const std::string node = R"("nodes":[{"mesh":0}])";
+  ASSERT_NE(text.find(node), std::string::npos);
+  text.replace(text.find(node), node.size(),
+               R"("nodes":[{"mesh":0,"matrix":[1,0,0,0,0,1,0,0,0,0,1,0,3.4e38,0,0,1]}])");
+  write_text(box, text);
+  const fs::path plain_box = dir_.parent_path() / "plain_box.gltf";
+  write_box_gltf(plain_box, {1.0f, 1.0f, 1.0f});
+  const auto scene = [&](const std::string& name, const std::string& objects) {
+    const fs::path path = dir_.parent_path() / (name + ".json");
+    write_text(path, R"({"version":1,"river":{"procedural":{}},)" + objects + "}");
+    return "capture " + path.string() + " --size 64x36 --out " + dir_.string();
+  };
+  const std::string huge_node = R"("objects":[{"gltf":"huge_node_box.gltf","translation":[20,0,0]}])";
+  expect_error(run_siviflow(scene("huge_node", huge_node)),
+               "huge_node.json: objects[0]: " + box.string() + ": mesh 'Box' primitive 0 (node 0): "
+               "vertex 0 after the node transforms (3.4e+38, -1, -1) lies beyond the world limit "
+               "of ±1e+06 m");
+  expect_error(run_siviflow(scene("huge_scale",
+                                  R"("objects":[{"gltf":"plain_box.gltf","scale":[1e30,1,1]}])")),
+               "huge_scale.json: objects[0]: " + plain_box.string() +
+                   ": vertex 0 placed by the object's translation, rotation and scale (-1e+30, -1, "
+                   "-1) lies beyond the world limit");
+  expect_error(run_siviflow(scene("huge_obstacle_object",
+                                  R"("objects":[{"gltf":"plain_box.gltf","scale":[1e30,1,1],"obstacle":true}])")),
+               "vertex 0 placed by the object's translation, rotation and scale (-1e+30, -1, -1) "
+               "lies beyond the world limit");
+  expect_error(run_siviflow(scene("far_obstacle", R"("obstacles":[{"center":[3e6,0,0],"radius":1}])")),
+               "obstacles[0]: obstacle 0: its centre (3e+06, 0, 0) lies beyond the world limit");
 }
 
 TEST_F(CliTest, CaptureRefusesBadSceneFiles) {

@@ -148,6 +148,13 @@ TEST_F(HiddenWaterTest, ABadOccluderMeshIsRefusedByName) {
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("OccluderMesh::positions[1] is not finite"), std::string::npos)
       << s.message();
+  // Finite, but past the world limit: a bounding box of it would overflow (issue 28's crash).
+  const std::vector<glm::vec3> huge = {{0, 0, 0}, {3.4e38f, 0, 0}, {0, 1, 0}};
+  s = renderer_->set_occluders({huge, {}});
+  EXPECT_NE(s.message().find("OccluderMesh::positions[1] (3.4e+38, 0, 0) lies beyond the world "
+                             "limit of ±1e+06 m"),
+            std::string::npos)
+      << s.message();
   const std::vector<glm::vec3> two = {{0, 0, 0}, {1, 0, 0}};
   s = renderer_->set_occluders({two, {}});
   EXPECT_NE(s.message().find("OccluderMesh::positions has 2 values, not 3 per triangle"),

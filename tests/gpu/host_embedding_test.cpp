@@ -360,6 +360,9 @@ TEST_F(HostEmbeddingTest, HostsOwnRiverFlowsAndBadArraysAreRefusedByName) {
   broken.positions[7].y = NAN;
   refused(broken.river(), "CreateInfo::river->positions[7] is not finite");
   broken = channel;
+  broken.positions[8].x = 2.0e6f;
+  refused(broken.river(), "CreateInfo::river->positions[8] (2e+06, ");
+  broken = channel;
   broken.slope[3] = -1.0f;
   refused(broken.river(), "CreateInfo::river->slope[3] -1");
   WaterObstacle flat;
