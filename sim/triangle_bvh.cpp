@@ -54,6 +54,16 @@ struct BuildTask {
   int depth;
 };
 
+// Whether the centroids spread along an axis by `extent` can be binned: a denormal extent makes
+// kBins / extent infinite, and a centroid at the low end would then fall in bin NaN.
+bool binnable(float extent) { return extent > 0.0f && std::isfinite(kBins / extent); }
+
+// The bin of a centroid at `c` among centroids from `lo` spread over a binnable `extent`.
+int bin_of(float c, float lo, float extent) {
+  const float at = (c - lo) * (kBins / extent);
+  return std::clamp(static_cast<int>(std::min(at, float(kBins - 1))), 0, kBins - 1);
+}
+
 // Squared distance from p to the box (0 inside).
 float box_distance2(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& p) {
   const glm::vec3 d = glm::max(glm::max(lo - p, p - hi), glm::vec3(0.0f));
@@ -140,16 +150,14 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
       for (uint32_t i = task.begin; i < task.end; ++i) {
         const Aabb box = bounds(refs[i].triangle);
         for (int axis = 0; axis < 3; ++axis) {
-          if (!(extent[axis] > 0.0f)) continue;
-          const float scale = kBins / extent[axis];
-          const int b = std::min(
-              kBins - 1, static_cast<int>((refs[i].centroid(axis) - centroids.lo[axis]) * scale));
+          if (!binnable(extent[axis])) continue;
+          const int b = bin_of(refs[i].centroid(axis), centroids.lo[axis], extent[axis]);
           axis_bins[axis][b].count++;
           axis_bins[axis][b].box.grow(box);
         }
       }
       for (int axis = 0; axis < 3; ++axis) {
-        if (!(extent[axis] > 0.0f)) continue;
+        if (!binnable(extent[axis])) continue;
         const Bin* bins = axis_bins[axis];
         float right_area[kBins];
         uint32_t right_count[kBins];
@@ -188,11 +196,11 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     Aabb left_box, right_box;
     if (best_axis >= 0) {
       const float lo = centroids.lo[best_axis];
-      const float scale = kBins / extent[best_axis];
+      const float axis_extent = extent[best_axis];
       const int axis = best_axis;
       const int split = best_split;
       Ref* m = std::partition(refs.data() + task.begin, refs.data() + task.end, [&](const Ref& r) {
-        return std::min(kBins - 1, static_cast<int>((r.centroid(axis) - lo) * scale)) < split;
+        return bin_of(r.centroid(axis), lo, axis_extent) < split;
       });
       mid = static_cast<uint32_t>(m - refs.data());
       for (int b = 0; b < kBins; ++b) {
