@@ -1,8 +1,8 @@
 // The scene file, and then the whole scene it describes up to, not including, the GPU: each
 // river's surface and flow as the renderer solves it (obstacles checked as it checks them), the
 // glTF objects placed, the ground and beds the world builds, the occluders' ray-cast hierarchy,
-// and the floats released and drifted through the flow. Relative paths resolve against a folder
-// holding the glTF seeds (channel.gltf, box_nodes.gltf, ...), so scenes that name them load real
+// and the floats released and drifted through the flow. Relative paths resolve as they do for the
+// seeds in tests/fuzz/seeds/scene/: "../gltf/channel.gltf" and the other glTF seeds are real
 // files; procedural rivers past a size are skipped, to keep each input quick.
 #include <cstddef>
 #include <cstdint>
@@ -22,16 +22,18 @@ namespace {
 
 constexpr double kMaxRiverVertices = 20000.0;
 
-// A folder with copies of the glTF seeds, made once.
-const std::string& seed_folder() {
+// The scenes' folder: a temporary scene/ beside gltf/, which holds copies of the glTF seeds.
+const std::string& scene_folder() {
   static const std::string folder = [] {
     namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / "siviflow_fuzz_scene";
-    fs::create_directories(dir);
+    const fs::path root = fs::temp_directory_path() / "siviflow_fuzz_scene";
+    fs::create_directories(root / "scene");
+    fs::create_directories(root / "gltf");
     for (const auto& entry : fs::directory_iterator(SIVIFLOW_GLTF_SEEDS)) {
-      fs::copy_file(entry.path(), dir / entry.path().filename(), fs::copy_options::overwrite_existing);
+      fs::copy_file(entry.path(), root / "gltf" / entry.path().filename(),
+                    fs::copy_options::overwrite_existing);
     }
-    return dir.string();
+    return (root / "scene").string();
   }();
   return folder;
 }
@@ -100,7 +102,7 @@ void build_scene(const siviflow::SceneFile& scene) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   siviflow::SceneFile scene;
-  if (!siviflow::parse_scene_file(text, "fuzz.json", seed_folder(), &scene).ok()) return 0;
+  if (!siviflow::parse_scene_file(text, "fuzz.json", scene_folder(), &scene).ok()) return 0;
   for (const siviflow::SceneRiver& river : scene.rivers) {
     if (too_big(river)) return 0;
   }
