@@ -7,6 +7,7 @@
 #include <string>
 
 #include "renderer_impl.h"
+#include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
 #include "vk/vk_text.h"
 
@@ -43,6 +44,9 @@ bool finite_affine(const glm::mat4& m, float* det) {
   *det = glm::determinant(glm::mat3(m));
   return m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f && m[3][3] == 1.0f;
 }
+
+// The most a placement may scale by: the river's centimetres stay centimetres to a factor of 1000.
+constexpr float kMaxPlacementScale = 1000.0f;
 
 }  // namespace
 
@@ -92,6 +96,21 @@ Status check_create_info(const CreateInfo& info) {
     }
     return argument_error("CreateInfo::world_from_river " + rows +
                           " is not a finite, invertible affine transform (last row 0 0 0 1)");
+  }
+  // Finite is not enough: a river in the world limit, placed, must land where floats still hold.
+  const glm::mat4& m = info.world_from_river;
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r) {
+      if (!(std::abs(m[c][r]) <= kMaxPlacementScale)) {
+        return argument_error(text_format("CreateInfo::world_from_river[%d][%d] %g is past ±%g: it "
+                                          "places the river (a rotation, at most a moderate scale)",
+                                          c, r, double(m[c][r]), double(kMaxPlacementScale)));
+      }
+    }
+  }
+  if (!within_world(glm::vec3(m[3]))) {
+    return argument_error("CreateInfo::world_from_river's translation " +
+                          world_limit_problem(glm::vec3(m[3])));
   }
   return Status::success();
 }

@@ -461,6 +461,14 @@ TEST_F(BareHostTest, BadPlacementJitterAndScissorAreRefusedByName) {
   EXPECT_EQ(Renderer::create(info, &renderer).message(),
             "siviflow::Renderer: CreateInfo::world_from_river [0 0 0 0] [0 0 0 0] [0 0 0 0] "
             "[0 0 0 1] is not a finite, invertible affine transform (last row 0 0 0 1)");
+  info.world_from_river = glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 3.4e38f, 0.0f));
+  EXPECT_EQ(Renderer::create(info, &renderer).message(),
+            "siviflow::Renderer: CreateInfo::world_from_river's translation (0, 3.4e+38, 0) lies "
+            "beyond the world limit of ±1e+06 m");
+  info.world_from_river = glm::scale(glm::mat4(1.0f), glm::vec3(1e30f, 1.0f, 1.0f));
+  EXPECT_EQ(Renderer::create(info, &renderer).message(),
+            "siviflow::Renderer: CreateInfo::world_from_river[0][0] 1e+30 is past ±1000: it places "
+            "the river (a rotation, at most a moderate scale)");
   info.world_from_river = glm::mat4(1.0f);
   info.motion_format = VK_FORMAT_R8_UNORM;
   EXPECT_EQ(Renderer::create(info, &renderer).message(),
