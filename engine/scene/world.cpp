@@ -1,30 +1,19 @@
 #include "siviflow/world.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <utility>
 #include <vector>
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include "entry_guard.h"
-#include "gpu_timer.h"
-#include "scene/scene_pass.h"
-#include "scene/default_scene.h"
 #include "scene/detail_texture.h"
 #include "scene/float_meshes.h"
 #include "scene/scene_objects.h"
+#include "scene/world_impl.h"
 #include "siviflow/scene_river.h"
-#include "static_assets.h"
 #include "view_math.h"
-#include "vk/device_table.h"
-#include "vk/frame_graph.h"
-#include "vk/frame_ring.h"
-#include "vk/gpu_resources.h"
 #include "vk/pipeline.h"
 #include "vk/vk_text.h"
 
@@ -43,118 +32,7 @@ constexpr VkFormat kBaseColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
 constexpr float kMainErrorPixels = 1.0f;
 constexpr float kReflectionErrorPixels = 2.0f;
 
-constexpr std::string_view kWorldErrorPrefix = "siviflow::World: ";
-
-Status world_error(const std::string& message) {
-  return Status::error(std::string(kWorldErrorPrefix) + message);
-}
-
-// The constants that draw a model turned by `heading` about +y and placed at `offset` with the
-// scene shaders, which work in the model's coordinates: light, clip and fog see the same
-// directions and distances as for the placed model.
-gpu::SceneConstants posed(const gpu::SceneConstants& constants, glm::vec3 offset,
-                          float heading = 0.0f) {
-  const float c = std::cos(heading);
-  const float s = std::sin(heading);
-  glm::mat4 model(1.0f);
-  model[0] = glm::vec4(c, 0.0f, s, 0.0f);  // +x turned towards +z
-  model[2] = glm::vec4(-s, 0.0f, c, 0.0f);
-  model[3] = glm::vec4(offset, 1.0f);
-  const glm::mat3 to_model = glm::transpose(glm::mat3(model));
-  gpu::SceneConstants moved = constants;
-  moved.view_proj = constants.view_proj * model;
-  moved.camera_position =
-      glm::vec4(to_model * (glm::vec3(constants.camera_position) - offset), constants.camera_position.w);
-  moved.sun_direction = glm::vec4(to_model * glm::vec3(constants.sun_direction), constants.sun_direction.w);
-  moved.clip_plane = glm::vec4(to_model * glm::vec3(constants.clip_plane),
-                               constants.clip_plane.w + glm::dot(glm::vec3(constants.clip_plane), offset));
-  moved.fog.z += offset.y;  // height fog needs the world height, not the model's
-  return moved;
-}
-
-// A float the world draws where its host places it.
-struct WorldFloat {
-  FloatMesh mesh = FloatMesh::kLog;
-  float radius = 0.0f;
-  IndexRange triangles;
-  bool shown = false;
-  glm::vec3 centre{0.0f};
-  float heading = 0.0f;
-};
-
 }  // namespace
-
-struct World::Impl {
-  WorldCreateInfo info;
-  DeviceTable table;
-  GpuContext gpu;
-  FrameRing ring;  // deletions only: the static upload's staging buffer
-  ProceduralRiver river{default_river_params()};  // the default scene's, or the scene file's
-  bool river_from_file = false;  // a glTF river: no valley, its bed drawn from its own depth
-  RiverMesh river_mesh;          // for a glTF river's bed and overview camera
-  std::vector<SceneGeometry> other_rivers;  // the scene's rivers after the first, until uploaded
-  std::vector<RiverMesh> other_meshes;      // those from files, for the ground, until built
-  std::vector<Obstacle> obstacles;  // each drawn as a boulder where it is at the frame's time
-  // Per boulder: where the host stood it (overriding its obstacle's keys), and whether it is
-  // drawn (spares start hidden).
-  std::vector<std::optional<glm::vec3>> placed;
-  std::vector<bool> shown;
-  std::vector<LodPiece> pieces;       // the static world, culled and levelled per view
-  std::vector<IndexRange> boulders;   // per obstacle, drawn translated to it
-  std::vector<WorldFloat> floats;     // the scene's, then the spares
-  SceneCamera camera_path;          // keys empty: the scene's default camera
-  // The ground, beds and objects as World::occluders() gives them.
-  std::vector<glm::vec3> occluder_positions;
-  std::vector<uint32_t> occluder_indices;
-  SceneLook look = default_scene_look();
-
-  enum StaticBufferId : uint32_t { kVertices, kIndices };
-  enum StaticImageId : uint32_t { kDetail, kFirstBaseColor };
-  StaticAssets assets;
-  StaticAssets::GraphHandles asset_handles;  // in `graph`
-  ScenePass main_pass;        // host colour and depth formats
-  ScenePass reflection_pass;  // the renderer's reflection target, when its formats differ
-  bool own_reflection_pass = false;
-
-  // What the passes draw, chosen per view: the static pieces it sees (nearest first, so the
-  // depth test spares the far ones' shading), then each obstacle's boulder with its own
-  // constants (translated to where the obstacle is). Per view: main, then mirrored.
-  std::vector<SceneDraw> main_draws;
-  std::vector<SceneDraw> reflection_draws;
-  std::vector<std::pair<float, SceneDraw>> sorted_pieces;  // kept: a steady frame allocates nothing
-  gpu::SceneConstants main_constants{};
-  gpu::SceneConstants reflection_constants{};
-  std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main, then mirrored
-  std::vector<gpu::SceneConstants> float_constants;     // per float: main, then mirrored
-  double time = 0.0;  // of the last record(), for the reflection
-  glm::mat4 projection{1.0f};  // of the last record()'s view: the reflection's levels use it too
-  WorldDrawStats stats;
-  GpuTimer timer;  // with WorldCreateInfo::enable_timing
-  uint32_t slot = 0;  // of the last begin_frame()
-  ScenePass::Frame frame;  // the main view's depth convention and viewport
-  ScenePass::FrameData frame_data;  // where `graph` reads the draws and `frame`
-
-  FrameGraph graph;
-  ImageHandle color;
-  ImageHandle depth;
-  FrameBindings bindings;
-
-  Status load_scene();
-  Status create_resources();
-  Status declare_graph();
-  gpu::SceneConstants view_constants(const glm::mat4& view_proj, const glm::vec3& camera,
-                                     const glm::vec4& clip_plane, bool reverse) const;
-  // Where boulder `i` stands at time `at`: where the host placed it, or where its keys put it.
-  glm::vec3 boulder_centre(size_t i, double at) const {
-    return placed[i] ? *placed[i] : obstacle_centre_at(obstacles[i], at);
-  }
-  void select_draws(const CullView& view, const gpu::SceneConstants& constants, size_t which,
-                    std::vector<SceneDraw>* draws, uint32_t* triangles);
-  void destroy();
-  static Status create(const WorldCreateInfo& info, std::unique_ptr<World>* out);
-  Status record(VkCommandBuffer cmd, const View& view, double time_seconds,
-                const ExternalImage& host_color, const ExternalImage& host_depth);
-};
 
 Status World::Impl::load_scene() {
   SceneRiverData first;
@@ -302,39 +180,6 @@ gpu::SceneConstants World::Impl::view_constants(const glm::mat4& view_proj,
   return c;
 }
 
-// The pieces `view` sees, nearest first, then the boulders where their obstacles are at the
-// frame's time; `which` 0 main view, 1 mirrored.
-void World::Impl::select_draws(const CullView& view, const gpu::SceneConstants& constants,
-                               size_t which, std::vector<SceneDraw>* draws, uint32_t* triangles) {
-  std::vector<std::pair<float, SceneDraw>>& seen = sorted_pieces;
-  seen.clear();
-  for (const LodPiece& piece : pieces) {
-    const uint32_t level = choose_level(piece, view);
-    if (level == kCulled) continue;
-    const IndexRange& range = piece.levels[level];
-    const glm::vec3 nearest = glm::clamp(view.camera, piece.lo, piece.hi);
-    seen.push_back({glm::length(nearest - view.camera),
-                    {range.first_index, range.index_count, &constants, piece.material}});
-  }
-  std::stable_sort(seen.begin(), seen.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
-  draws->clear();
-  for (const auto& entry : seen) draws->push_back(entry.second);
-  for (size_t i = 0; i < obstacles.size(); ++i) {
-    if (!shown[i]) continue;
-    obstacle_constants[2 * i + which] = posed(constants, boulder_centre(i, time));
-    draws->push_back({boulders[i].first_index, boulders[i].index_count,
-                      &obstacle_constants[2 * i + which]});
-  }
-  for (size_t i = 0; i < floats.size(); ++i) {
-    const WorldFloat& f = floats[i];
-    if (!f.shown) continue;
-    float_constants[2 * i + which] = posed(constants, f.centre, f.heading);
-    draws->push_back({f.triangles.first_index, f.triangles.index_count, &float_constants[2 * i + which]});
-  }
-  *triangles = 0;
-  for (const SceneDraw& draw : *draws) *triangles += draw.index_count / 3;
-}
 
 void World::Impl::destroy() {
   if (gpu.table == nullptr) return;
@@ -422,78 +267,6 @@ OccluderMesh World::occluders() const {
   return {impl_->occluder_positions, impl_->occluder_indices};
 }
 
-uint32_t World::boulder_count() const { return static_cast<uint32_t>(impl_->obstacles.size()); }
-
-Status World::place_boulder(uint32_t index, const glm::vec3& centre) {
-  if (index >= boulder_count()) {
-    return world_error("place_boulder: no boulder " + std::to_string(index) + " (there are " +
-                       std::to_string(boulder_count()) + ")");
-  }
-  if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) {
-    return world_error("place_boulder: centre is not finite");
-  }
-  impl_->placed[index] = centre;
-  impl_->shown[index] = true;
-  return Status::success();
-}
-
-Status World::hide_boulder(uint32_t index) {
-  if (index >= boulder_count()) {
-    return world_error("hide_boulder: no boulder " + std::to_string(index) + " (there are " +
-                       std::to_string(boulder_count()) + ")");
-  }
-  impl_->shown[index] = false;
-  return Status::success();
-}
-
-Status World::boulder_at(uint32_t index, double time_seconds, BoulderPose* out) const {
-  if (index >= boulder_count()) {
-    return world_error("boulder_at: no boulder " + std::to_string(index) + " (there are " +
-                       std::to_string(boulder_count()) + ")");
-  }
-  if (out == nullptr) return world_error("boulder_at: out is null");
-  out->shown = impl_->shown[index];
-  out->centre = impl_->boulder_centre(index, time_seconds);
-  out->radii = boulder_radii(impl_->obstacles[index]);
-  return Status::success();
-}
-
-uint32_t World::float_count() const { return static_cast<uint32_t>(impl_->floats.size()); }
-
-Status World::place_float(uint32_t index, const glm::vec3& centre, float heading) {
-  if (index >= float_count()) {
-    return world_error("place_float: no float " + std::to_string(index) + " (there are " +
-                       std::to_string(float_count()) + ")");
-  }
-  if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z) ||
-      !std::isfinite(heading)) {
-    return world_error("place_float: centre or heading is not finite");
-  }
-  WorldFloat& f = impl_->floats[index];
-  f.centre = centre;
-  f.heading = heading;
-  f.shown = true;
-  return Status::success();
-}
-
-Status World::hide_float(uint32_t index) {
-  if (index >= float_count()) {
-    return world_error("hide_float: no float " + std::to_string(index) + " (there are " +
-                       std::to_string(float_count()) + ")");
-  }
-  impl_->floats[index].shown = false;
-  return Status::success();
-}
-
-Status World::float_reach(uint32_t index, glm::vec3* out) const {
-  if (index >= float_count()) {
-    return world_error("float_reach: no float " + std::to_string(index) + " (there are " +
-                       std::to_string(float_count()) + ")");
-  }
-  if (out == nullptr) return world_error("float_reach: out is null");
-  *out = siviflow::float_reach(impl_->floats[index].mesh, impl_->floats[index].radius);
-  return Status::success();
-}
 
 Status World::begin_frame(uint32_t slot) {
   return guarded(kWorldErrorPrefix, nullptr, nullptr, [&] {
