@@ -2,6 +2,7 @@
 // formats and placement), in one place so that the two refuse exactly the same, in the same
 // words.
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
 #include <string>
@@ -45,7 +46,7 @@ bool finite_affine(const glm::mat4& m, float* det) {
   return m[0][3] == 0.0f && m[1][3] == 0.0f && m[2][3] == 0.0f && m[3][3] == 1.0f;
 }
 
-// The most a placement may scale by: the river's centimetres stay centimetres to a factor of 1000.
+// The most a placement may scale an axis by, either way.
 constexpr float kMaxPlacementScale = 1000.0f;
 
 }  // namespace
@@ -97,15 +98,18 @@ Status check_create_info(const CreateInfo& info) {
     return argument_error("CreateInfo::world_from_river " + rows +
                           " is not a finite, invertible affine transform (last row 0 0 0 1)");
   }
-  // Finite is not enough: a river in the world limit, placed, must land where floats still hold.
+  // Finite is not enough: a placement that stretches or shrinks an axis past a thousand, or
+  // moves the river past the world limit, leaves the river's centimetres (or the host's, brought
+  // back by its inverse) to float rounding.
   const glm::mat4& m = info.world_from_river;
   for (int c = 0; c < 3; ++c) {
-    for (int r = 0; r < 3; ++r) {
-      if (!(std::abs(m[c][r]) <= kMaxPlacementScale)) {
-        return argument_error(text_format("CreateInfo::world_from_river[%d][%d] %g is past ±%g: it "
-                                          "places the river (a rotation, at most a moderate scale)",
-                                          c, r, double(m[c][r]), double(kMaxPlacementScale)));
-      }
+    const double scale = glm::length(glm::dvec3(glm::vec3(m[c])));  // doubles: 1e30 squared overflows a float
+    if (!(scale >= 1.0f / kMaxPlacementScale && scale <= kMaxPlacementScale)) {
+      return argument_error(text_format("CreateInfo::world_from_river scales axis %d by %g: a "
+                                        "placement (a rotation, at most a moderate scale) keeps "
+                                        "each axis's scale within [1/%g, %g]",
+                                        c, scale, double(kMaxPlacementScale),
+                                        double(kMaxPlacementScale)));
     }
   }
   if (!within_world(glm::vec3(m[3]))) {

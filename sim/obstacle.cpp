@@ -49,10 +49,10 @@ Status validate_obstacle(const Obstacle& o, size_t index) {
                                      index, double(o.height)));
   }
   if (o.polygon.empty()) {
-    if (!std::isfinite(o.radius) || !(o.radius > 0.0f)) {
+    if (!(o.radius > 0.0f && o.radius <= kMaxWorldCoordinate)) {
       return Status::error(text_format(
-          "obstacle %zu has radius %g: a circular obstacle needs a positive, finite radius", index,
-          o.radius));
+          "obstacle %zu has radius %g: a circular obstacle needs a positive radius within the "
+          "world limit (%g m)", index, o.radius, double(kMaxWorldCoordinate)));
     }
   } else {
     const size_t n = o.polygon.size();
@@ -66,7 +66,7 @@ Status validate_obstacle(const Obstacle& o, size_t index) {
       const glm::vec2 p = o.polygon[i];
       if (!within_world(p)) {
         return Status::error(text_format("obstacle %zu: footprint point %zu ", index, i) +
-                             world_limit_problem(glm::vec3(p.x, 0.0f, p.y)));
+                             world_limit_problem(p));
       }
       area2 += cross2(glm::dvec2(p), glm::dvec2(o.polygon[(i + 1) % n]));
       scale = std::max({scale, std::abs(double{p.x}), std::abs(double{p.y})});

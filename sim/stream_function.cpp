@@ -8,6 +8,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
@@ -381,8 +382,8 @@ Status StreamFunction::move_obstacle(size_t index, const glm::vec3& centre) {
     return Status::error(text_format("no obstacle %zu to move (there are %zu)", index,
                                      obstacles_.size()));
   }
-  if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z)) {
-    return Status::error(text_format("obstacle %zu: the new centre is not finite", index));
+  if (!within_world(centre)) {
+    return Status::error(text_format("obstacle %zu: the new centre ", index) + world_limit_problem(centre));
   }
   stats_ = {};
   move_incremental(index, place(index, centre));

@@ -518,7 +518,13 @@ Status parse_floats(const Reader& r, const Json& v, std::vector<SceneFloat>* out
                       text_format("%g must not be negative", parsed.release_time));
       }
     }
-    if (const Json* x = find(o, "radius")) SIVIFLOW_TRY(r.positive(*x, join(path, "radius"), &parsed.radius));
+    if (const Json* x = find(o, "radius")) {
+      SIVIFLOW_TRY(r.positive(*x, join(path, "radius"), &parsed.radius));
+      if (parsed.radius > kMaxFloatRadius) {
+        return r.fail(join(path, "radius"), text_format("%g is past the largest float, %g metres",
+                                                        double(parsed.radius), double(kMaxFloatRadius)));
+      }
+    }
     if (const Json* x = find(o, "drag")) {
       SIVIFLOW_TRY(r.real(*x, join(path, "drag"), &parsed.drag));
       if (parsed.drag < 0.0f) {

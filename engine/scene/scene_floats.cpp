@@ -11,6 +11,20 @@ namespace {
 
 constexpr float kHeadingSpeed = 0.02f;  // m/s: slower, a float keeps the heading it had
 
+// What is wrong with a float's own numbers ("radius -1 must be ..."), or "".
+std::string float_problem(const SceneFloat& f) {
+  if (!(std::isfinite(f.radius) && f.radius > 0.0f && f.radius <= kMaxFloatRadius)) {
+    return text_format("radius %g must be in (0, %g] metres", double(f.radius), double(kMaxFloatRadius));
+  }
+  if (!(std::isfinite(f.drag) && f.drag >= 0.0f)) {
+    return text_format("drag %g must be finite and not negative", double(f.drag));
+  }
+  if (!(std::isfinite(f.release_time) && f.release_time >= 0.0)) {
+    return text_format("release_time %g must be finite and not negative", f.release_time);
+  }
+  return "";
+}
+
 }  // namespace
 
 Status SceneFloats::create(const SceneFile& scene, std::vector<WaterQueryFunction> rivers,
@@ -18,11 +32,22 @@ Status SceneFloats::create(const SceneFile& scene, std::vector<WaterQueryFunctio
   if (out == nullptr) return Status::error("SceneFloats::create: out is null");
   SceneFloats made;
   made.rivers_ = std::move(rivers);
+  // The rivers' own obstacles as the scene file names them: its obstacles, then its objects
+  // marked obstacle (scene_river.h).
+  for (size_t i = 0; i < scene.obstacles.size(); ++i) {
+    made.obstacle_names_.push_back(text_format("obstacles[%zu]", i));
+  }
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    if (scene.objects[i].obstacle) made.obstacle_names_.push_back(text_format("objects[%zu]", i));
+  }
   for (size_t i = 0; i < scene.floats.size(); ++i) {
     Float f;
     f.spec = scene.floats[i];
-    WaterSample sample;
-    const Status found = made.river_of(f.spec.release_point, &f.river, &sample);
+    const std::string problem = float_problem(f.spec);
+    if (!problem.empty()) {
+      return Status::error(text_format("%s: floats[%zu]: ", scene.path.c_str(), i) + problem);
+    }
+    const Status found = made.river_of(f.spec.release_point, &f.river);
     if (!found.ok()) {
       return Status::error(text_format("%s: floats[%zu].release_point: ", scene.path.c_str(), i) +
                            found.message());
@@ -35,19 +60,20 @@ Status SceneFloats::create(const SceneFile& scene, std::vector<WaterQueryFunctio
   return Status::success();
 }
 
-Status SceneFloats::river_of(glm::vec2 point, uint32_t* river, WaterSample* sample) const {
+Status SceneFloats::river_of(glm::vec2 point, uint32_t* river) const {
   const glm::vec3 at(point.x, 0.0f, point.y);
   for (uint32_t r = 0; r < rivers_.size(); ++r) {
-    SIVIFLOW_TRY(rivers_[r](std::span(&at, 1), std::span(sample, 1)));
-    if (!sample->on_surface) continue;
-    if (!sample->wet) {
-      const uint32_t id = sample->obstacle;
-      const std::string which =
-          id >= WaterSample::kRiverObstacle
-              ? text_format("obstacles[%u]'s", id - WaterSample::kRiverObstacle)
-              : text_format("obstacle %u's", id);
+    WaterSample sample;
+    SIVIFLOW_TRY(rivers_[r](std::span(&at, 1), std::span(&sample, 1)));
+    if (!sample.on_surface) continue;
+    if (!sample.wet) {
+      const uint32_t id = sample.obstacle;
+      const size_t index = id - WaterSample::kRiverObstacle;
+      const std::string which = id < WaterSample::kRiverObstacle ? text_format("obstacle %u", id)
+                                : index < obstacle_names_.size() ? obstacle_names_[index]
+                                                                 : text_format("obstacle %zu", index);
       return Status::error(text_format("(%g, %g) is inside ", double(point.x), double(point.y)) +
-                           which + " footprint, not on the water");
+                           which + "'s footprint, not on the water");
     }
     *river = r;
     return Status::success();
@@ -55,8 +81,8 @@ Status SceneFloats::river_of(glm::vec2 point, uint32_t* river, WaterSample* samp
   return Status::error(text_format("(%g, %g) is not on any river", double(point.x), double(point.y)));
 }
 
-// At rest on the surface at its release point, along the flow there.
-Status SceneFloats::release(Float* f) {
+// At rest on the surface at its release point, turned along the flow there.
+Status SceneFloats::release(Float* f, float* heading) const {
   WaterSample sample;
   const glm::vec3 at(f->spec.release_point.x, 0.0f, f->spec.release_point.y);
   SIVIFLOW_TRY(rivers_[f->river](std::span(&at, 1), std::span(&sample, 1)));
@@ -65,8 +91,7 @@ Status SceneFloats::release(Float* f) {
   f->body.radius = f->spec.radius;
   f->body.drag = f->spec.drag;
   f->released = true;
-  const size_t i = static_cast<size_t>(f - floats_.data());
-  poses_[i].heading = std::atan2(sample.velocity.z, sample.velocity.x);
+  *heading = std::atan2(sample.velocity.z, sample.velocity.x);
   return Status::success();
 }
 
@@ -81,35 +106,30 @@ void SceneFloats::update_pose(size_t i) {
   }
 }
 
+Status SceneFloats::drift(size_t i, double seconds) {
+  const Status drifted =
+      drift_bodies(std::span(&floats_[i].body, 1), static_cast<float>(seconds), rivers_[floats_[i].river]);
+  if (!drifted.ok()) return Status::error(text_format("floats[%zu]: ", i) + drifted.message());
+  return Status::success();
+}
+
 Status SceneFloats::advance(double time_seconds) {
   if (!(time_seconds >= time_)) {
     return Status::error(text_format("SceneFloats::advance: time %g is before the current %g",
                                      time_seconds, time_));
   }
+  // Those afloat already drift the whole step; each one released within it, the part after its
+  // release. One at a time: drift_bodies is per body anyway, and an error names the float.
   const double step = time_seconds - time_;
-  // Those afloat already, one drift per river; then each one released within the step, for the
-  // part of it after its release.
-  for (uint32_t r = 0; r < rivers_.size(); ++r) {
-    std::vector<FloatingBody> bodies;
-    std::vector<size_t> which;
-    for (size_t i = 0; i < floats_.size(); ++i) {
-      if (floats_[i].released && floats_[i].river == r) {
-        bodies.push_back(floats_[i].body);
-        which.push_back(i);
-      }
-    }
-    if (bodies.empty() || step <= 0.0) continue;
-    SIVIFLOW_TRY(drift_bodies(bodies, static_cast<float>(step), rivers_[r]));
-    for (size_t k = 0; k < which.size(); ++k) floats_[which[k]].body = bodies[k];
+  for (size_t i = 0; i < floats_.size(); ++i) {
+    if (floats_[i].released && step > 0.0) SIVIFLOW_TRY(drift(i, step));
   }
   for (size_t i = 0; i < floats_.size(); ++i) {
     Float& f = floats_[i];
     if (f.released || f.spec.release_time > time_seconds) continue;
-    SIVIFLOW_TRY(release(&f));
+    SIVIFLOW_TRY(release(&f, &poses_[i].heading));
     const double afloat = time_seconds - std::max(f.spec.release_time, time_);
-    if (afloat > 0.0) {
-      SIVIFLOW_TRY(drift_bodies(std::span(&f.body, 1), static_cast<float>(afloat), rivers_[f.river]));
-    }
+    if (afloat > 0.0) SIVIFLOW_TRY(drift(i, afloat));
   }
   for (size_t i = 0; i < floats_.size(); ++i) update_pose(i);
   time_ = time_seconds;
@@ -117,19 +137,16 @@ Status SceneFloats::advance(double time_seconds) {
 }
 
 Status SceneFloats::drop(const SceneFloat& spec) {
-  if (!(std::isfinite(spec.radius) && spec.radius > 0.0f) || !(std::isfinite(spec.drag) && spec.drag >= 0.0f)) {
-    return Status::error(text_format("SceneFloats::drop: radius %g must be positive and drag %g "
-                                     "not negative, both finite",
-                                     double(spec.radius), double(spec.drag)));
-  }
   Float f;
   f.spec = spec;
   f.spec.release_time = time_;
-  WaterSample sample;
-  SIVIFLOW_TRY(river_of(spec.release_point, &f.river, &sample));
+  const std::string problem = float_problem(f.spec);
+  if (!problem.empty()) return Status::error("SceneFloats::drop: " + problem);
+  SIVIFLOW_TRY(river_of(spec.release_point, &f.river));
+  FloatPose pose;
+  SIVIFLOW_TRY(release(&f, &pose.heading));  // nothing added until it is afloat
   floats_.push_back(f);
-  poses_.emplace_back();
-  SIVIFLOW_TRY(release(&floats_.back()));
+  poses_.push_back(pose);
   update_pose(floats_.size() - 1);
   return Status::success();
 }

@@ -1,12 +1,12 @@
 // The scene file, and then the whole scene it describes up to, not including, the GPU: each
 // river's surface and flow as the renderer solves it (obstacles checked as it checks them), the
 // glTF objects placed, the ground and beds the world builds, the occluders' ray-cast hierarchy,
-// and the floats released and drifted through the flow. Relative paths resolve as they do for the
-// seeds in tests/fuzz/seeds/scene/: "../gltf/channel.gltf" and the other glTF seeds are real
-// files; procedural rivers past a size are skipped, to keep each input quick.
+// and the floats released and drifted through the flow. Relative paths resolve against the seeds'
+// own folder, tests/fuzz/seeds/scene/, so "../gltf/channel.gltf" and the other glTF seeds are
+// real files (read, never written); procedural rivers past a size are skipped, to keep each
+// input quick.
 #include <cstddef>
 #include <cstdint>
-#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,22 +21,6 @@
 namespace {
 
 constexpr double kMaxRiverVertices = 20000.0;
-
-// The scenes' folder: a temporary scene/ beside gltf/, which holds copies of the glTF seeds.
-const std::string& scene_folder() {
-  static const std::string folder = [] {
-    namespace fs = std::filesystem;
-    const fs::path root = fs::temp_directory_path() / "siviflow_fuzz_scene";
-    fs::create_directories(root / "scene");
-    fs::create_directories(root / "gltf");
-    for (const auto& entry : fs::directory_iterator(SIVIFLOW_GLTF_SEEDS)) {
-      fs::copy_file(entry.path(), root / "gltf" / entry.path().filename(),
-                    fs::copy_options::overwrite_existing);
-    }
-    return (root / "scene").string();
-  }();
-  return folder;
-}
 
 bool too_big(const siviflow::SceneRiver& river) {
   if (river.source != siviflow::SceneRiver::Source::kProcedural) return false;
@@ -80,13 +64,13 @@ void build_scene(const siviflow::SceneFile& scene) {
   std::vector<glm::vec3> positions;
   for (const siviflow::SceneVertex& v : geometry.vertices) positions.push_back(v.position);
   for (const siviflow::SceneVertex& v : objects.vertices) positions.push_back(v.position);
-  siviflow::RiverFlow occluders;
-  (void)occluders.set_occluders(positions, {});  // every 3 positions a triangle, as far as they go
+  // Every 3 positions a triangle, as far as they go: the hierarchy over all of them.
   (void)flows.front()->set_occluders(std::span(positions).first(positions.size() / 3 * 3), {});
   std::vector<siviflow::WaterQueryFunction> queries;
   for (const auto& flow : flows) {
-    queries.push_back([&flow](std::span<const glm::vec3> p, std::span<siviflow::WaterSample> s) {
-      flow->query(p, s);
+    queries.push_back([river = flow.get()](std::span<const glm::vec3> p,
+                                           std::span<siviflow::WaterSample> s) {
+      river->query(p, s);
       return siviflow::Status::success();
     });
   }
@@ -102,7 +86,7 @@ void build_scene(const siviflow::SceneFile& scene) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   siviflow::SceneFile scene;
-  if (!siviflow::parse_scene_file(text, "fuzz.json", scene_folder(), &scene).ok()) return 0;
+  if (!siviflow::parse_scene_file(text, "fuzz.json", SIVIFLOW_SCENE_SEEDS, &scene).ok()) return 0;
   for (const siviflow::SceneRiver& river : scene.rivers) {
     if (too_big(river)) return 0;
   }

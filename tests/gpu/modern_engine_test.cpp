@@ -467,8 +467,8 @@ TEST_F(BareHostTest, BadPlacementJitterAndScissorAreRefusedByName) {
             "beyond the world limit of ±1e+06 m");
   info.world_from_river = glm::scale(glm::mat4(1.0f), glm::vec3(1e30f, 1.0f, 1.0f));
   EXPECT_EQ(Renderer::create(info, &renderer).message(),
-            "siviflow::Renderer: CreateInfo::world_from_river[0][0] 1e+30 is past ±1000: it places "
-            "the river (a rotation, at most a moderate scale)");
+            "siviflow::Renderer: CreateInfo::world_from_river scales axis 0 by 1e+30: a placement "
+            "(a rotation, at most a moderate scale) keeps each axis's scale within [1/1000, 1000]");
   info.world_from_river = glm::mat4(1.0f);
   info.motion_format = VK_FORMAT_R8_UNORM;
   EXPECT_EQ(Renderer::create(info, &renderer).message(),

@@ -162,6 +162,7 @@ class RippleMotionTest : public StraightChannelTest {
   // kApart frames from each of kApart + 1 frames on, and the ripples' under them (the median of
   // those shifts: one window can lock onto the wrong peak).
   std::vector<FloatMotion> float_motions() const {
+    if (frames_.size() != kFirst + 2 * kApart + 1) return {};  // measure() failed, and said why
     const WaterQueryFunction ask = [this](std::span<const glm::vec3> p, std::span<WaterSample> s) {
       return renderer_->query_water(p, s);
     };

@@ -172,6 +172,7 @@ SANITIZER_REPORTS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime
 
 
 def run_case(siviflow, case, env):
+    """(exit status, what went wrong or None)."""
     if case.command == "flow":
         args = [siviflow, "flow", str(case.scene), "--out", str(case.folder / "flow.csv")]
     else:
@@ -179,7 +180,6 @@ def run_case(siviflow, case, env):
         out.mkdir()
         args = [siviflow, "capture", str(case.scene), "--frames", "1", "--size", "32x18",
                 "--validation", "--out", str(out)]
-    """(exit status, what went wrong or None)."""
     try:
         done = subprocess.run(args, capture_output=True, text=True, timeout=TIMEOUT_S,
                               errors="replace", env=env)

@@ -693,6 +693,8 @@ TEST(SceneFile, BadFloatsAreNamed) {
                {"floats[0].mesh: 'boat' is not a float mesh"});
   expect_error(with({{"floats", {{{"release_point", {0, 0}}}, {{"release_point", {0, 0}}, {"radius", -1}}}}}),
                {"floats[1].radius"});
+  expect_error(with({{"floats", {{{"release_point", {0, 0}}, {"radius", 60}}}}}),
+               {"floats[0].radius: 60 is past the largest float, 50 metres"});
   expect_error(with({{"floats", {{{"release_point", {0, 0}}, {"release_time", -0.5}}}}}),
                {"floats[0].release_time: -0.5 must not be negative"});
   expect_error(with({{"floats", {{{"release_point", {0, 0}}, {"drag", -2}}}}}),

@@ -26,6 +26,7 @@ class SceneFloatsTest : public ::testing::Test {
     flow_ = test::river_flow(test::straight_channel(kWidth, 60.0f, 61, 21),
                              {kDischarge, 1.0f, 100.0f * kWidth}, {boulder});
     scene_.path = "floats.json";
+    scene_.obstacles = {boulder};  // the scene the flow was made from
   }
   std::vector<WaterQueryFunction> queries() const {
     // Obstacles named as Renderer::query_water names the river's own.
@@ -110,6 +111,26 @@ TEST_F(SceneFloatsTest, ReleasePointsOffTheWaterAreNamedAndNothingIsMade) {
   s = SceneFloats::create(scene_, queries(), &floats);
   EXPECT_EQ(s.message(), "floats.json: floats[0].release_point: (0.5, 30) is inside "
                          "obstacles[0]'s footprint, not on the water");
+  // A footprint of an object marked obstacle is named as the scene names it.
+  scene_.objects.resize(3);
+  scene_.objects[2].obstacle = true;  // its footprint is the flow's second obstacle
+  scene_.floats = {log_at(0.5f, 30.0f)};
+  const auto named_as_object = [this](std::span<const glm::vec3> p, std::span<WaterSample> out) {
+    SIVIFLOW_TRY(queries()[0](p, out));
+    for (WaterSample& sample : out) {
+      if (sample.obstacle != 0) ++sample.obstacle;  // as if obstacles[0] were elsewhere
+    }
+    return Status::success();
+  };
+  s = SceneFloats::create(scene_, {named_as_object}, &floats);
+  EXPECT_EQ(s.message(), "floats.json: floats[0].release_point: (0.5, 30) is inside "
+                         "objects[2]'s footprint, not on the water");
+  scene_.objects.clear();
+  // A float's own numbers are checked before its place.
+  scene_.floats = {log_at(0.0f, 5.0f), log_at(0.0f, 6.0f)};
+  scene_.floats[1].radius = 0.0f;
+  s = SceneFloats::create(scene_, queries(), &floats);
+  EXPECT_EQ(s.message(), "floats.json: floats[1]: radius 0 must be in (0, 50] metres");
   // A host's drop: refused off the water, nothing added; taken on it, at the current time.
   scene_.floats.clear();
   ASSERT_TRUE(SceneFloats::create(scene_, queries(), &floats).ok());

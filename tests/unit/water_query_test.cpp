@@ -248,6 +248,28 @@ TEST(Drift, SlidesAlongABankAndSettlesOnTheSurface) {
   EXPECT_NEAR(body[0].velocity.x, 0.0f, 1e-3f);  // what pointed into the bank is gone
 }
 
+TEST(Drift, ABodyDriftsTheSameAloneOrBesideOthers) {
+  const auto flow = river_flow(test::straight_channel(10.0f, 40.0f, 41, 11), {20.0f, 1.0f, 1000.0f});
+  const WaterQueryFunction ask = [&](std::span<const glm::vec3> p, std::span<WaterSample> s) {
+    flow->query(p, s);
+    return Status::success();
+  };
+  std::vector<FloatingBody> alone(1);
+  alone[0].position = {-1.0f, 0.0f, 5.0f};
+  alone[0].drag = 1.5f;
+  std::vector<FloatingBody> together = alone;
+  together.push_back(alone[0]);
+  together[1].position = {2.0f, 0.0f, 6.0f};
+  together[1].radius = 0.05f;  // a leaf: far more sub-steps than the log
+  together[1].drag = 8.0f;
+  for (int frame = 0; frame < 30; ++frame) {
+    ASSERT_TRUE(drift_bodies(alone, 1.0f / 30.0f, ask).ok());
+    ASSERT_TRUE(drift_bodies(together, 1.0f / 30.0f, ask).ok());
+    ASSERT_EQ(alone[0].position, together[0].position) << "frame " << frame;
+    ASSERT_EQ(alone[0].velocity, together[0].velocity) << "frame " << frame;
+  }
+}
+
 TEST(Drift, BadBodiesAreNamedAndNothingMoves) {
   const auto flow = river_flow(test::straight_channel(10.0f, 40.0f, 41, 11), {20.0f, 1.0f, 1000.0f});
   const WaterQueryFunction ask = [&](std::span<const glm::vec3> p, std::span<WaterSample> s) {

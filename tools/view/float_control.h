@@ -1,4 +1,4 @@
-// The floats of the viewer: the scene file's, replayed as a capture replays them, and the ones the
+// The floats of the viewer: the scene file's, replayed by a capture's code, and the ones the
 // user drops under the cursor (F key: a log, then a leaf, in turn, from the world's spares).
 // Each frame, once the water is updated for its time, they drift on to it and the world draws
 // them where they are.

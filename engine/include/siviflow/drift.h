@@ -11,8 +11,8 @@
 //
 // Each body's velocity is pulled towards the water's at its centre at the rate `drag` (1/s), and
 // its centre moves with that velocity, integrated with Heun's method (second order) in
-// sub-steps short enough that no body crosses more than half its radius, nor more than 1/drag
-// seconds, in one. A body stays on wet water: a step that would take its centre onto a bank or
+// sub-steps of its own, short enough that it crosses no more than half its radius, nor more than
+// 1/drag seconds, in one: a body drifts the same alone or beside others. A body stays on wet water: a step that would take its centre onto a bank or
 // into an obstacle's footprint keeps only its part along the flow (banks and footprints are
 // streamlines, so it slides along them), and the body's velocity loses what pointed out of the
 // water. Each step ends with the centre on the water surface. Deterministic: the same bodies,

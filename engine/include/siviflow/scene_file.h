@@ -41,7 +41,7 @@
 //                           its footprint is the XZ convex hull of its transformed mesh where it
 //                           dips below the water (see scene_river.h)
 //   floats                  none. mesh "log"; release_time 0 (>= 0); radius 0.6 for a log, 0.15
-//                           for a leaf (half its length, > 0); drag 1.5 for a log, 6 for a leaf
+//                           for a leaf (half its length, in (0, kMaxFloatRadius]); drag 1.5 for a log, 6 for a leaf
 //                           (1/s, >= 0; siviflow/drift.h). The release point must lie on a
 //                           river: captures refuse the scene otherwise (scene_floats.h)
 //   camera.fov_y_deg        kDefaultCameraFovYDeg (50)
@@ -82,6 +82,7 @@ inline constexpr double kMaxRenderFps = 1000.0;
 inline constexpr size_t kMaxSceneObjects = 4096;
 inline constexpr size_t kMaxSceneRivers = 64;
 inline constexpr size_t kMaxSceneFloats = 4096;
+inline constexpr float kMaxFloatRadius = 50.0f;  // metres: a raft, a fallen tree; not an island
 inline constexpr size_t kMaxCameraKeys = size_t{1} << 20;
 inline constexpr float kDefaultSceneDischarge = 20.0f;  // m^2/s: ~1.7 m/s in the default 12 m river
 inline constexpr float kDefaultCameraFovYDeg = 50.0f;
@@ -115,7 +116,7 @@ struct SceneFloat {
   FloatMesh mesh = FloatMesh::kLog;
   glm::vec2 release_point{0.0f};  // [x, z], metres: it starts on the water surface there
   double release_time = 0.0;      // seconds, >= 0: absent before
-  float radius = 0.6f;            // metres, > 0: half its length
+  float radius = 0.6f;            // metres, (0, kMaxFloatRadius]: half its length
   float drag = 1.5f;              // 1/s, >= 0: how fast it takes the water's velocity
 };
 

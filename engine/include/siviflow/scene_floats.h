@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -34,9 +35,10 @@ struct FloatPose {
 
 class SceneFloats {
  public:
-  // Checks every release point against the rivers (an error names the scene file, the float and
-  // the point: "scene.json: floats[2].release_point: (40, 3) is not on any river") and releases
-  // the floats due at time 0.
+  // Checks every float (radius, drag, release time) and its release point against the rivers (an
+  // error names the scene file, the float and the point: "scene.json: floats[2].release_point:
+  // (40, 3) is not on any river", or the footprint that holds it) and releases the floats due at
+  // time 0.
   static Status create(const SceneFile& scene, std::vector<WaterQueryFunction> rivers,
                        SceneFloats* out);
 
@@ -45,7 +47,8 @@ class SceneFloats {
   Status advance(double time_seconds);
 
   // Releases one more float now, at `release_point` (a host dropping it; its release time is
-  // ignored): an error, and nothing added, where the point is not on any river.
+  // ignored): an error, and nothing added, where the point is not on the water or the float's
+  // numbers are out of range.
   Status drop(const SceneFloat& f);
 
   double time() const { return time_; }
@@ -59,12 +62,14 @@ class SceneFloats {
     bool released = false;
     FloatingBody body;
   };
-  // The river whose surface holds `point`, or false.
-  Status river_of(glm::vec2 point, uint32_t* river, WaterSample* sample) const;
-  Status release(Float* f);
+  // The river whose water (outside every footprint) holds `point`; an error naming why not.
+  Status river_of(glm::vec2 point, uint32_t* river) const;
+  Status release(Float* f, float* heading) const;
+  Status drift(size_t i, double seconds);
   void update_pose(size_t i);
 
   std::vector<WaterQueryFunction> rivers_;
+  std::vector<std::string> obstacle_names_;  // the rivers' own obstacles, as the scene names them
   std::vector<Float> floats_;
   std::vector<FloatPose> poses_;
   double time_ = 0.0;

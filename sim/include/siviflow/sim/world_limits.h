@@ -33,4 +33,11 @@ inline std::string world_limit_problem(const glm::vec3& p) {
                      double(p.z), double(kMaxWorldCoordinate));
 }
 
+// The same for an [x, z] point: "(3.4e+38, 0) lies beyond ...".
+inline std::string world_limit_problem(const glm::vec2& p) {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y)) return "is not finite";
+  return text_format("(%g, %g) lies beyond the world limit of ±%g m", double(p.x), double(p.y),
+                     double(kMaxWorldCoordinate));
+}
+
 }  // namespace siviflow
