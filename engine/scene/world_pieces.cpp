@@ -17,7 +17,6 @@
 namespace siviflow {
 namespace {
 
-
 // The constants that draw a model turned by `heading` about +y and placed at `offset` with the
 // scene shaders, which work in the model's coordinates: light, clip and fog see the same
 // directions and distances as for the placed model.
@@ -44,7 +43,7 @@ gpu::SceneConstants posed(const gpu::SceneConstants& constants, glm::vec3 offset
 }  // namespace
 
 // The pieces `view` sees, nearest first, then the boulders where their obstacles are at the
-// frame's time; `which` 0 main view, 1 mirrored.
+// frame's time, then the floats where their host placed them; `which` 0 main view, 1 mirrored.
 void World::Impl::select_draws(const CullView& view, const gpu::SceneConstants& constants,
                                size_t which, std::vector<SceneDraw>* draws, uint32_t* triangles) {
   std::vector<std::pair<float, SceneDraw>>& seen = sorted_pieces;
