@@ -42,42 +42,6 @@ constexpr uint32_t kMaxFlowTextureSide = 16384;
 
 }  // namespace
 
-uint16_t to_half(float value) {
-  uint32_t x;
-  std::memcpy(&x, &value, sizeof x);
-  const uint32_t sign = (x >> 16) & 0x8000u;
-  x &= 0x7fffffffu;
-  if (x >= 0x7f800000u) return static_cast<uint16_t>(sign | (x > 0x7f800000u ? 0x7e00u : 0x7c00u));
-  if (x >= 0x477ff000u) return static_cast<uint16_t>(sign | 0x7c00u);  // rounds past 65504
-  if (x < 0x38800000u) {  // below 2^-14: a subnormal half, or zero
-    if (x < 0x33000000u) return static_cast<uint16_t>(sign);
-    const uint32_t e = x >> 23;
-    const uint32_t m = (x & 0x7fffffu) | 0x800000u;
-    const uint32_t shift = 126u - e;
-    uint32_t h = m >> shift;
-    const uint32_t rem = m & ((1u << shift) - 1u), halfway = 1u << (shift - 1u);
-    if (rem > halfway || (rem == halfway && (h & 1u))) ++h;
-    return static_cast<uint16_t>(sign | h);
-  }
-  uint32_t h = (x >> 13) - (112u << 10);
-  const uint32_t rem = x & 0x1fffu;
-  if (rem > 0x1000u || (rem == 0x1000u && (h & 1u))) ++h;  // a carry into the exponent is right
-  return static_cast<uint16_t>(sign | h);
-}
-
-float from_half(uint16_t bits) {
-  const uint32_t sign = (bits & 0x8000u) << 16;
-  const uint32_t e = (bits >> 10) & 0x1fu, m = bits & 0x3ffu;
-  if (e == 0) {
-    const float v = std::ldexp(static_cast<float>(m), -24);
-    return sign ? -v : v;
-  }
-  const uint32_t x = e == 31 ? sign | 0x7f800000u | (m << 13) : sign | ((e + 112u) << 23) | (m << 13);
-  float f;
-  std::memcpy(&f, &x, sizeof f);
-  return f;
-}
-
 glm::vec3 decode_flow(const gpu::FlowTexel& t) {
   return {from_half(t.flow_x), from_half(t.flow_y), from_half(t.flow_z)};
 }

@@ -15,6 +15,7 @@
 #include <glm/vec3.hpp>
 
 #include "shaders/shared.h"
+#include "sim/half_float.h"
 #include "sim/particle_tuning.h"
 #include "sim/particles.h"
 #include "siviflow/status.h"
@@ -79,8 +80,5 @@ Status read_flow_texel(std::span<const std::byte> staging, const FlowTextureLayo
 Status read_particle_aux(std::span<const std::byte> staging, const FlowTextureLayout& layout,
                          uint32_t id, gpu::ParticleAux* out);
 glm::vec3 decode_flow(const gpu::FlowTexel& texel);
-// The binary16 bits a float becomes in the flow texture (round to nearest).
-uint16_t to_half(float value);
-float from_half(uint16_t bits);
 
 }  // namespace siviflow

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <iterator>
+#include <span>
 #include <string>
 
 #include "scene/scene_objects.h"
@@ -81,24 +81,21 @@ FrameExpectation frame_expectation(const CaptureOptions& options) {
   expected.width = static_cast<int>(options.size.width);
   expected.height = static_cast<int>(options.size.height);
   expected.aovs = aov_names(options);
+  // Each channel with its pixel type: every water layer and the motion are HALF, depth FLOAT.
   std::vector<std::string>& names = expected.channels;
-  names = {"R", "G", "B", "A"};
-  if (options.depth_aov) names.push_back(kDepthChannel);
-  if (water_layers(options)) names.push_back(kWaterMaskChannel);
-  if (options.flow_aov) {
-    names.insert(names.end(), std::begin(kFlowChannels), std::end(kFlowChannels));
-  }
-  if (options.particles_aov) names.push_back(kParticleIdChannel);
-  if (options.normal_aov) {
-    names.insert(names.end(), std::begin(kNormalChannels), std::end(kNormalChannels));
-  }
-  if (options.reflection_aov) {
-    names.insert(names.end(), std::begin(kReflectionChannels), std::end(kReflectionChannels));
-  }
-  if (options.foam_aov) names.push_back(kFoamChannel);
-  if (options.motion_aov) {
-    names.insert(names.end(), std::begin(kMotionChannels), std::end(kMotionChannels));
-  }
+  const auto add = [&names](std::span<const char* const> channels, const char* type) {
+    for (const char* channel : channels) names.push_back(text_format("%s:%s", channel, type));
+  };
+  const char* const beauty[] = {"R", "G", "B", "A"};
+  add(beauty, "half");
+  if (options.depth_aov) add({&kDepthChannel, 1}, "float");
+  if (water_layers(options)) add({&kWaterMaskChannel, 1}, "half");
+  if (options.flow_aov) add(kFlowChannels, "half");
+  if (options.particles_aov) add({&kParticleIdChannel, 1}, "uint");
+  if (options.normal_aov) add(kNormalChannels, "half");
+  if (options.reflection_aov) add(kReflectionChannels, "half");
+  if (options.foam_aov) add({&kFoamChannel, 1}, "half");
+  if (options.motion_aov) add(kMotionChannels, "half");
   std::sort(names.begin(), names.end());
   expected.software_version = version_string();
   return expected;

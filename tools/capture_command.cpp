@@ -19,6 +19,7 @@
 #include "commands.h"
 #include "frame_writer.h"
 #include "renderer_inspect.h"
+#include "sim/half_float.h"
 #include "siviflow/headless_context.h"
 #include "siviflow/host_frame.h"
 #include "siviflow/renderer.h"
@@ -407,9 +408,17 @@ void Capture::copy_out(const SlotTargets& slot, FinishedFrame* finished) const {
   copy(ReadbackImage::kWaterMask, pixels, &finished->water_mask);
   copy(ReadbackImage::kFlowTexture, renderer_->readback_bytes(ReadbackImage::kFlowTexture),
        &finished->flow_texture);
-  copy(ReadbackImage::kNormal, pixels * 4, &finished->normal);
-  copy(ReadbackImage::kReflection, pixels * 4, &finished->reflection);
-  copy(ReadbackImage::kFoam, pixels, &finished->foam);
+  // The layers written as HALF are converted as they are copied: a pass over them saved.
+  const auto copy_as_halves = [&slot](ReadbackImage kind, size_t count,
+                                      std::vector<uint16_t>* out) {
+    const auto* data = static_cast<const float*>(slot.readback[index_of(kind)].data);
+    if (data == nullptr) return;
+    out->resize(count);
+    to_halves({data, count}, *out);
+  };
+  copy_as_halves(ReadbackImage::kNormal, pixels * 4, &finished->normal);
+  copy_as_halves(ReadbackImage::kReflection, pixels * 4, &finished->reflection);
+  copy_as_halves(ReadbackImage::kFoam, pixels, &finished->foam);
   finished->particles = slot.particles;
 }
 

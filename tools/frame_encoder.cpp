@@ -11,6 +11,7 @@
 
 #include "renderer_inspect.h"
 #include "shaders/shared.h"
+#include "sim/half_float.h"
 #include "siviflow/image_files.h"
 
 namespace siviflow {
@@ -42,6 +43,12 @@ ExrCamera exr_camera(const Camera& camera, VkExtent2D extent) {
   out.near_plane = camera.near_plane;
   out.far_plane = camera.far_plane;
   return out;
+}
+
+// `values` as half bits in `halves` (resized), rounded to nearest even as GPUs round.
+void convert_to_halves(const std::vector<float>& values, std::vector<uint16_t>* halves) {
+  halves->resize(values.size());
+  to_halves(values, *halves);
 }
 
 std::vector<uint32_t> texel_columns(uint32_t width, uint32_t texel_px) {
@@ -99,18 +106,23 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
       }
     }
   };
+  // Every water layer and the motion are HALF, which keeps what they hold (docs/output.md); depth
+  // stays FLOAT, as half would lose metres at a kilometre.
   if (water_layers(options_)) {
+    convert_to_halves(finished.water_mask, &water_);
     frame.layers.push_back(
-        {"water", ExrCompression::kZip, {{kWaterMaskChannel, finished.water_mask.data()}}});
+        {"water", ExrCompression::kZip, {{kWaterMaskChannel, nullptr, 1, nullptr, water_.data()}}});
   }
   // Flow, mask and ids are constant over texels and regions: deflate finds the repeated rows.
   if (options_.flow_aov) {
-    for (std::vector<float>& plane : flow_) plane.assign(pixels, 0.0f);
+    for (std::vector<uint16_t>& plane : flow_) plane.assign(pixels, 0);
     for_each_water_pixel([&](size_t pixel, size_t texel) {
       for (int c = 0; c < 3; ++c) flow_[c][pixel] = texel_flow_[texel][c];
     });
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"flow", ExrCompression::kZip, {}});
-    for (int c = 0; c < 3; ++c) layer.channels.push_back({kFlowChannels[c], flow_[c].data()});
+    for (int c = 0; c < 3; ++c) {
+      layer.channels.push_back({kFlowChannels[c], nullptr, 1, nullptr, flow_[c].data()});
+    }
   }
   if (options_.particles_aov) {
     // The flow texture holds GPU slots; the layer and the CSV use the ids unique over the run.
@@ -126,15 +138,19 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
   }
   // The water's own layers are zero off the water, which RLE packs as well as deflate does, and
   // their noisy low mantissa bytes on it defeat deflate: RLE at a third of its time.
-  const auto add_rgb = [&](const char* name, const std::vector<float>& rgba,
+  const auto add_rgb = [&](const char* name, const std::vector<uint16_t>& rgba,
                            const char* const channels[3]) {
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{name, ExrCompression::kRle, {}});
-    for (int c = 0; c < 3; ++c) layer.channels.push_back({channels[c], rgba.data() + c, 4});
+    for (int c = 0; c < 3; ++c) {
+      layer.channels.push_back({channels[c], nullptr, 4, nullptr, rgba.data() + c});
+    }
   };
   if (options_.normal_aov) add_rgb("normal", finished.normal, kNormalChannels);
   if (options_.reflection_aov) add_rgb("reflection", finished.reflection, kReflectionChannels);
   if (options_.foam_aov) {
-    frame.layers.push_back({"foam", ExrCompression::kZip, {{kFoamChannel, finished.foam.data()}}});
+    frame.layers.push_back(
+        {"foam", ExrCompression::kZip,
+         {{kFoamChannel, nullptr, 1, nullptr, finished.foam.data()}}});
   }
   if (options_.motion_aov) {
     const VkExtent2D extent{width, height};
@@ -148,8 +164,12 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
     motion.next = camera_view(finished.next_camera, extent);
     motion.bodies = finished.bodies;
     compute_motion(motion, &motion_);
+    convert_to_halves(motion_, &motion_halves_);
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"motion", ExrCompression::kZip, {}});
-    for (int c = 0; c < 4; ++c) layer.channels.push_back({kMotionChannels[c], motion_.data() + c, 4});
+    for (int c = 0; c < 4; ++c) {
+      layer.channels.push_back(
+          {kMotionChannels[c], nullptr, 4, nullptr, motion_halves_.data() + c});
+    }
   }
   frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;
   frame.metadata.frame = static_cast<int>(finished.frame);
@@ -186,7 +206,8 @@ void FrameEncoder::decode_flow_texture(const std::vector<std::byte>& flow_textur
     gpu::FlowTexel texel{};
     std::memcpy(&texel, flow_texture.data() + t * sizeof(texel), sizeof(texel));
     texel_slot_[t] = texel.id;
-    texel_flow_[t] = texel.id == SIVIFLOW_PARTICLE_NONE ? glm::vec3(0.0f) : decode_flow(texel);
+    texel_flow_[t] = {texel.flow_x, texel.flow_y, texel.flow_z};
+    if (texel.id == SIVIFLOW_PARTICLE_NONE) texel_flow_[t] = {0, 0, 0};
   }
 }
 

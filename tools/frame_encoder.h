@@ -3,12 +3,11 @@
 // It keeps its scratch planes from frame to frame; each encoding thread has its own.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <glm/vec3.hpp>
 
 #include "capture_options.h"
 #include "motion_vectors.h"
@@ -33,9 +32,9 @@ struct FinishedFrame {
   std::vector<float> window_depth;
   std::vector<float> water_mask;
   std::vector<std::byte> flow_texture;  // as uploaded: shaders/shared.h FlowTexel per texel
-  std::vector<float> normal;            // RGBA per pixel
-  std::vector<float> reflection;        // RGBA per pixel
-  std::vector<float> foam;
+  std::vector<uint16_t> normal;         // RGBA halves per pixel
+  std::vector<uint16_t> reflection;     // RGBA halves per pixel
+  std::vector<uint16_t> foam;           // halves
   std::vector<Particle> particles;
 };
 
@@ -65,10 +64,12 @@ class FrameEncoder {
   // Scratch planes, reused from frame to frame.
   std::vector<float> rgba_;  // the preview's
   std::vector<float> depth_;
-  std::vector<float> flow_[3];
+  std::vector<uint16_t> water_;  // halves, as every water layer and motion are written
+  std::vector<uint16_t> flow_[3];
   std::vector<uint32_t> particle_id_;
   std::vector<float> motion_;
-  std::vector<glm::vec3> texel_flow_;
+  std::vector<uint16_t> motion_halves_;
+  std::vector<std::array<uint16_t, 3>> texel_flow_;  // the texture's own halves
   std::vector<uint32_t> texel_slot_;
 };
 

@@ -40,9 +40,10 @@ struct MotionFrame {
 
 // Writes 4 floats per pixel into `xyzw` (resized), in Blender's Vector pass layout: X, Y = where
 // the surface seen in the pixel was in the previous frame minus where it is now; Z, W = where it
-// is now minus where it will be in the next frame; in pixels (rounded to 1/1024), x right, y up.
-// Sky pixels move with the camera's rotation alone; a point behind a neighbour's camera has no
-// motion (0). A point that is not water and lies within a moving body's reach moves with it.
+// is now minus where it will be in the next frame; in pixels (rounded to 1/1024, within ±65504),
+// x right, y up. Sky pixels move with the camera's rotation alone; a point behind a neighbour's
+// camera has no motion (0). A point that is not water and lies within a moving body's reach moves
+// with it.
 void compute_motion(const MotionFrame& frame, std::vector<float>* xyzw);
 
 }  // namespace siviflow

@@ -89,9 +89,11 @@ Status validate(const ExrFrame& frame, const std::string& what) {
     }
     for (const ExrChannel& channel : layer.channels) {
       if (channel.name.empty()) return Status::error(what + ": a data channel has no name");
-      if ((channel.pixels == nullptr) == (channel.ids == nullptr)) {
+      const int given = (channel.pixels != nullptr) + (channel.ids != nullptr) +
+                        (channel.halves != nullptr);
+      if (given != 1) {
         return Status::error(what + ": data channel '" + channel.name +
-                             "' needs its pixels as floats or as ids, one of the two");
+                             "' needs its pixels as floats, halves or ids, one of the three");
       }
       if (channel.stride < 1) {
         return Status::error(what + ": data channel '" + channel.name + "' has stride " +
@@ -112,6 +114,19 @@ Imf::Compression openexr_compression(ExrCompression compression) {
     case ExrCompression::kZip: break;
   }
   return Imf::ZIP_COMPRESSION;
+}
+
+// A data channel's pixel type in the file (as in memory), its first sample and its size.
+struct ChannelSamples {
+  Imf::PixelType type;
+  const void* first;
+  size_t bytes;
+};
+
+ChannelSamples channel_samples(const ExrChannel& channel) {
+  if (channel.ids != nullptr) return {Imf::UINT, channel.ids, sizeof(uint32_t)};
+  if (channel.halves != nullptr) return {Imf::HALF, channel.halves, sizeof(half)};
+  return {Imf::FLOAT, channel.pixels, sizeof(float)};
 }
 
 // A part's header: the frame's size and metadata, the part's name and compression.
@@ -180,27 +195,25 @@ Status encode_exr_named(const ExrFrame& frame, const std::string& name,
     frame_buffers[0].insert(rgba_names[c], Imf::Slice(Imf::HALF, rgba + c * sizeof(half),
                                                       rgba_pixel, rgba_pixel * width));
   }
+  size_t bytes_per_pixel = 4 * sizeof(half);
   for (size_t i = 0; i < frame.layers.size(); ++i) {
     const ExrLayer& layer = frame.layers[i];
     headers.push_back(part_header(frame, layer.compression, layer.name));
     for (const ExrChannel& channel : layer.channels) {
-      const Imf::PixelType type = channel.ids != nullptr ? Imf::UINT : Imf::FLOAT;
-      headers.back().channels().insert(channel.name, Imf::Channel(type));
-      const void* samples = channel.ids != nullptr ? static_cast<const void*>(channel.ids)
-                                                   : static_cast<const void*>(channel.pixels);
-      char* base = const_cast<char*>(static_cast<const char*>(samples));
-      const size_t pixel = 4 * static_cast<size_t>(channel.stride);  // float and uint alike
-      frame_buffers[i + 1].insert(channel.name, Imf::Slice(type, base, pixel, pixel * width));
+      const ChannelSamples samples = channel_samples(channel);
+      headers.back().channels().insert(channel.name, Imf::Channel(samples.type));
+      char* base = const_cast<char*>(static_cast<const char*>(samples.first));
+      const size_t pixel = samples.bytes * static_cast<size_t>(channel.stride);
+      frame_buffers[i + 1].insert(channel.name,
+                                  Imf::Slice(samples.type, base, pixel, pixel * width));
+      bytes_per_pixel += samples.bytes;
     }
   }
 
   // OpenEXR stores a line block raw where compressing would grow it, so the raw planes (and room
   // for headers and offset tables) bound the file: one allocation holds it, and a buffer reused
   // from frame to frame is never copied into a larger one.
-  size_t samples_per_pixel = 0;
-  for (const ExrLayer& layer : frame.layers) samples_per_pixel += layer.channels.size();
-  const size_t raw_bytes = width * static_cast<size_t>(frame.height) *
-                           (4 * sizeof(half) + samples_per_pixel * sizeof(float));
+  const size_t raw_bytes = width * static_cast<size_t>(frame.height) * bytes_per_pixel;
   bytes->clear();
   bytes->reserve(raw_bytes + raw_bytes / 16 + (size_t{1} << 20));
   MemoryOStream stream(bytes, name.c_str());

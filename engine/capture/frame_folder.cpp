@@ -43,6 +43,15 @@ std::string joined(const std::vector<std::string>& names) {
   return list;
 }
 
+const char* pixel_type_name(ExrPixelType type) {
+  switch (type) {
+    case ExrPixelType::kUint: return "uint";
+    case ExrPixelType::kHalf: return "half";
+    case ExrPixelType::kFloat: break;
+  }
+  return "float";
+}
+
 FrameExpectation expectation_of(const ExrImage& image) {
   FrameExpectation expected;
   expected.scene_digest = image.metadata.scene_digest;
@@ -51,7 +60,10 @@ FrameExpectation expectation_of(const ExrImage& image) {
   expected.width = image.width;
   expected.height = image.height;
   expected.aovs = image.metadata.aovs;
-  for (const auto& [name, plane] : image.channels) expected.channels.push_back(name);
+  for (const auto& [name, plane] : image.channels) {
+    expected.channels.push_back(name + ":" + pixel_type_name(plane.type));
+  }
+  std::sort(expected.channels.begin(), expected.channels.end());
   expected.software_version = image.metadata.software_version;
   return expected;
 }

@@ -36,15 +36,15 @@ FRAME_NAME = "frame_00003.exr"
 PARTS = {
     "rgba": [("R", "half"), ("G", "half"), ("B", "half"), ("A", "half")],
     "depth": [("depth.Z", "float")],
-    "flow": [("flow.X", "float"), ("flow.Y", "float"), ("flow.Z", "float")],
-    "water": [("water.A", "float")],
+    "flow": [("flow.X", "half"), ("flow.Y", "half"), ("flow.Z", "half")],
+    "water": [("water.A", "half")],
     "particle": [("particle.I", "uint")],
-    "normal": [("normal.X", "float"), ("normal.Y", "float"), ("normal.Z", "float")],
-    "reflection": [("reflection.R", "float"), ("reflection.G", "float"),
-                   ("reflection.B", "float")],
-    "foam": [("foam.Y", "float")],
-    "motion": [("motion.X", "float"), ("motion.Y", "float"), ("motion.Z", "float"),
-               ("motion.W", "float")],
+    "normal": [("normal.X", "half"), ("normal.Y", "half"), ("normal.Z", "half")],
+    "reflection": [("reflection.R", "half"), ("reflection.G", "half"),
+                   ("reflection.B", "half")],
+    "foam": [("foam.Y", "half")],
+    "motion": [("motion.X", "half"), ("motion.Y", "half"), ("motion.Z", "half"),
+               ("motion.W", "half")],
 }
 # The layers that are zero (or id 0) off the water.
 WATER_LAYERS = ["flow", "particle", "normal", "reflection", "foam"]

@@ -108,9 +108,10 @@ TEST_F(CaptureLayersTest, EveryLayerNamedForEveryReaderAndZeroOffTheWater) {
     // LAYER.C with a one-letter C, or a bare beauty channel: what Blender's reader takes.
     const size_t dot = name.rfind('.');
     EXPECT_EQ(dot == std::string::npos ? name.size() : name.size() - dot - 1, 1u) << name;
-    const ExrPixelType expected = name.size() == 1         ? ExrPixelType::kHalf
+    // Depth alone is FLOAT (half loses metres at a kilometre); the ids are UINT.
+    const ExrPixelType expected = name == "depth.Z"      ? ExrPixelType::kFloat
                                   : name == "particle.I" ? ExrPixelType::kUint
-                                                           : ExrPixelType::kFloat;
+                                                         : ExrPixelType::kHalf;
     EXPECT_EQ(plane.type, expected) << name;
   }
   const std::vector<float>& mask = *image.find("water.A");

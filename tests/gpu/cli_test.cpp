@@ -206,7 +206,7 @@ TEST_F(CliTest, FlowAndParticleAovs) {
   ASSERT_TRUE(read_exr((dir_ / "frame_00001.exr").string(), &image).ok());
   for (const char* channel : {"flow.X", "flow.Y", "flow.Z", "water.A"}) {
     ASSERT_NE(image.find(channel), nullptr) << channel;
-    EXPECT_EQ(image.channels.at(channel).type, ExrPixelType::kFloat) << channel;
+    EXPECT_EQ(image.channels.at(channel).type, ExrPixelType::kHalf) << channel;
   }
   ASSERT_NE(image.find("particle.I"), nullptr);
   EXPECT_EQ(image.channels.at("particle.I").type, ExrPixelType::kUint);

@@ -30,6 +30,7 @@ struct FrameSpec {
   std::string scene = "default";
   std::string version = "0.1.0";
   bool depth = false;
+  bool half_depth = false;  // depth.Z written as HALF: the layout of another build
   int frame_attribute = -1;  // -1: the file's own frame
   std::string digest = kDigest;  // "": a frame of the layout before digests
   float fps = 30.0f;
@@ -40,18 +41,23 @@ void write_frame(const fs::path& dir, uint32_t frame, const FrameSpec& spec = {}
   const size_t pixels = size_t(spec.width) * spec.height;
   std::vector<float> rgba(pixels * 4, 0.25f);
   std::vector<float> depth(pixels, 3.0f);
+  std::vector<uint16_t> depth_halves(pixels, 0x4200);  // 3.0
   ExrFrame exr;
   exr.width = spec.width;
   exr.height = spec.height;
   exr.rgba = rgba.data();
   if (spec.depth) exr.layers.push_back({"depth", ExrCompression::kZip, {{"depth.Z", depth.data()}}});
+  if (spec.half_depth) {
+    exr.layers.push_back(
+        {"depth", ExrCompression::kZip, {{"depth.Z", nullptr, 1, nullptr, depth_halves.data()}}});
+  }
   exr.metadata.scene = spec.scene;
   exr.metadata.frame = spec.frame_attribute >= 0 ? spec.frame_attribute : static_cast<int>(frame);
   exr.metadata.seed = spec.seed;
   exr.metadata.software_version = spec.version;
   exr.metadata.scene_digest = spec.digest;
   exr.metadata.fps = spec.digest.empty() ? 0.0f : spec.fps;  // the earlier layout had neither
-  exr.metadata.aovs = spec.aovs ? *spec.aovs : spec.depth ? "depth" : "";
+  exr.metadata.aovs = spec.aovs ? *spec.aovs : spec.depth || spec.half_depth ? "depth" : "";
   const Status status = write_exr((dir / frame_file_name(frame)).string(), exr);
   ASSERT_TRUE(status.ok()) << status.message();
 }
@@ -98,11 +104,12 @@ TEST(FrameFolder, NamesEveryBadFrameAndItsProblem) {
   write_frame(dir, 11, {.depth = true, .digest = "sha256:fedcba98765432100123"});
   write_frame(dir, 12, {.aovs = "depth"});  // the AOVs' channels under other names
   write_frame(dir, 13, {.seed = 2, .depth = true, .digest = ""});
+  write_frame(dir, 14, {.half_depth = true});  // the same names, another pixel type
 
   FrameFolderReport report;
-  ASSERT_TRUE(check_frame_folder(dir.string(), 0, 14, &report).ok());
+  ASSERT_TRUE(check_frame_folder(dir.string(), 0, 15, &report).ok());
   EXPECT_EQ(report.complete, 2u);
-  ASSERT_EQ(report.problems.size(), 12u);
+  ASSERT_EQ(report.problems.size(), 13u);
   EXPECT_EQ(report.problems[0].file, "frame_00002.exr");
   EXPECT_EQ(problem_of(report, 2), "missing");
   EXPECT_NE(problem_of(report, 3).find("cannot be read whole"), std::string::npos)
@@ -121,11 +128,15 @@ TEST(FrameFolder, NamesEveryBadFrameAndItsProblem) {
             "differs from frame_00000.exr (in brackets): scene content differs, digest "
             "sha256:fedcba987654... (sha256:0123456789ab...)");
   EXPECT_EQ(problem_of(report, 12),
-            "differs from frame_00000.exr (in brackets): channels A,B,G,R (A,B,G,R,depth.Z)");
+            "differs from frame_00000.exr (in brackets): channels A:half,B:half,G:half,R:half "
+            "(A:half,B:half,G:half,R:half,depth.Z:float)");
   // A frame of the layout before digests is another capture, whatever else it shares.
   EXPECT_EQ(problem_of(report, 13),
             "differs from frame_00000.exr (in brackets): an earlier layout without "
             "siviflow/scene_digest (one with it)");
+  EXPECT_EQ(problem_of(report, 14),
+            "differs from frame_00000.exr (in brackets): channels A:half,B:half,G:half,R:half,"
+            "depth.Z:half (A:half,B:half,G:half,R:half,depth.Z:float)");
 }
 
 TEST(FrameFolder, WhatACaptureIsMadeOfNamesTheFrameOfAnotherOne) {
@@ -144,7 +155,7 @@ TEST(FrameFolder, WhatACaptureIsMadeOfNamesTheFrameOfAnotherOne) {
   capture.seed = 1;
   capture.width = 8;
   capture.height = 4;
-  capture.channels = {"A", "B", "G", "R"};
+  capture.channels = {"A:half", "B:half", "G:half", "R:half"};
   capture.software_version = "0.1.0";
   FrameCheck check = check_frame(dir.string(), 1, capture, "this capture");
   EXPECT_EQ(check.state, FrameState::kComplete) << check.problem;

@@ -281,7 +281,10 @@ TEST_F(ImageFilesExr, HalfBeautyIsWrittenBitForBitAndStridedChannelsAreGathered)
   frame.rgba = nullptr;
   frame.rgba_half = halves.data();
   frame.layers = {{"normal", ExrCompression::kRle,
-                   {{"normal.X", normal.data(), 4}, {"normal.Z", normal.data() + 2, 4}}}};
+                   {{"normal.X", normal.data(), 4}, {"normal.Z", normal.data() + 2, 4}}},
+                  {"motion", ExrCompression::kZip,
+                   {{"motion.X", nullptr, 4, nullptr, halves.data()},
+                    {"motion.W", nullptr, 4, nullptr, halves.data() + 3}}}};
   const std::string file = path("frame.exr");
   ASSERT_TRUE(write_exr(file, frame).ok());
 
@@ -297,6 +300,13 @@ TEST_F(ImageFilesExr, HalfBeautyIsWrittenBitForBitAndStridedChannelsAreGathered)
   for (size_t i = 0; i < pixels; ++i) {
     EXPECT_EQ(image.channels.at("normal.X").pixels[i], normal[i * 4]);
     EXPECT_EQ(image.channels.at("normal.Z").pixels[i], normal[i * 4 + 2]);
+  }
+  // Data channels given as halves are HALF, gathered from their stride bit for bit.
+  EXPECT_EQ(image.channels.at("motion.X").type, ExrPixelType::kHalf);
+  EXPECT_EQ(image.channels.at("normal.X").type, ExrPixelType::kFloat);
+  for (size_t i = 0; i < pixels; ++i) {
+    EXPECT_EQ(half(image.channels.at("motion.X").pixels[i]).bits(), halves[i * 4]);
+    EXPECT_EQ(half(image.channels.at("motion.W").pixels[i]).bits(), halves[i * 4 + 3]);
   }
 }
 
@@ -355,7 +365,7 @@ TEST_F(ImageFilesExr, IdentifiersAsUintAndTheCameraInStandardAttributes) {
                          {{"particle.I", data.depth.data(), 1, ids.data()}}});
   const Status s = write_exr(path("both.exr"), both);
   EXPECT_FALSE(s.ok());
-  EXPECT_NE(s.message().find("'particle.I' needs its pixels as floats or as ids, one of the two"),
+  EXPECT_NE(s.message().find("'particle.I' needs its pixels as floats, halves or ids, one of the"),
             std::string::npos)
       << s.message();
 }
@@ -432,6 +442,15 @@ TEST_F(ImageFilesExr, InvalidFramesAreRejectedWithoutFiles) {
   s = write_exr(file, null_channel);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find(file), std::string::npos) << s.message();
+
+  ExrFrame floats_and_halves = data.frame();
+  floats_and_halves.layers[0].channels.push_back(
+      {"water.A", data.depth.data(), 1, nullptr, halves.data()});
+  s = write_exr(file, floats_and_halves);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("'water.A' needs its pixels as floats, halves or ids"),
+            std::string::npos)
+      << s.message();
 
   EXPECT_FALSE(encode_exr(data.frame(), nullptr).ok());
   EXPECT_TRUE(list_dir(dir_).empty());

@@ -23,7 +23,9 @@ struct FrameExpectation {
   int width = 0;
   int height = 0;
   std::string aovs;                   // "depth,flow", as the capture names them
-  std::vector<std::string> channels;  // sorted, as OpenEXR lists them
+  // "NAME:TYPE" ("depth.Z:float"; types half, float, uint), sorted: frames whose channels are
+  // named or typed otherwise are of another layout.
+  std::vector<std::string> channels;
   std::string software_version;
 };
 

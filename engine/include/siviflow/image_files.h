@@ -1,5 +1,6 @@
-// Capture files: EXR frames (HALF beauty + FLOAT data channels + metadata) and PNG previews,
-// written atomically (temporary in the same folder, fsync, rename); EXR read-back for tests.
+// Capture files: EXR frames (a HALF beauty; data channels as HALF, FLOAT or UINT; metadata) and
+// PNG previews, written atomically (temporary in the same folder, fsync, rename); EXR read-back
+// for tests.
 #pragma once
 
 #include <cstdint>
@@ -29,13 +30,15 @@ inline constexpr const char* kExrAttrFps = "siviflow/fps";                  // f
 inline constexpr const char* kExrAttrAovs = "siviflow/aovs";                // string
 
 // One data channel: width * height samples, row-major, top-left origin; floats written as
-// FLOAT, or identifiers written as UINT (exactly one of the two). Names follow the layer
-// convention, LAYER.C with a one-letter channel, e.g. "depth.Z", "flow.X", "water.A".
+// FLOAT, IEEE half bits written as HALF, or identifiers written as UINT (exactly one of the
+// three). Names follow the layer convention, LAYER.C with a one-letter channel, e.g. "depth.Z",
+// "flow.X", "water.A".
 struct ExrChannel {
   std::string name;
   const float* pixels = nullptr;
   int stride = 1;  // samples from one pixel's to the next (4: a channel of interleaved RGBA)
   const uint32_t* ids = nullptr;
+  const uint16_t* halves = nullptr;
 };
 
 // The lossless compressions a part may use (OpenEXR's RLE, ZIP at deflate level 1, PIZ).

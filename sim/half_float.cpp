@@ -1,0 +1,84 @@
+#include "sim/half_float.h"
+
+#include <cmath>
+#include <cstring>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
+namespace siviflow {
+namespace {
+
+#if defined(__x86_64__) || defined(__i386__)
+// F16C converts 8 floats at once with the same rounding; the tail goes one by one.
+__attribute__((target("avx,f16c"))) void to_halves_f16c(std::span<const float> values,
+                                                         std::span<uint16_t> halves) {
+  size_t i = 0;
+  for (; i + 8 <= values.size(); i += 8) {
+    const __m256 eight = _mm256_loadu_ps(values.data() + i);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(halves.data() + i),
+                     _mm256_cvtps_ph(eight, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC));
+  }
+  for (; i < values.size(); ++i) halves[i] = to_half(values[i]);
+}
+
+bool cpu_has_f16c() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx") && __builtin_cpu_supports("f16c");
+}
+#endif
+
+}  // namespace
+
+uint16_t to_half(float value) {
+  uint32_t x;
+  std::memcpy(&x, &value, sizeof x);
+  const uint32_t sign = (x >> 16) & 0x8000u;
+  x &= 0x7fffffffu;
+  if (x > 0x7f800000u) {  // NaN: quiet, with its payload's top bits (as F16C keeps them)
+    return static_cast<uint16_t>(sign | 0x7e00u | ((x >> 13) & 0x3ffu));
+  }
+  if (x >= 0x477ff000u) return static_cast<uint16_t>(sign | 0x7c00u);  // infinite or past 65504
+  if (x < 0x38800000u) {  // below 2^-14: a subnormal half, or zero
+    if (x < 0x33000000u) return static_cast<uint16_t>(sign);
+    const uint32_t e = x >> 23;
+    const uint32_t m = (x & 0x7fffffu) | 0x800000u;
+    const uint32_t shift = 126u - e;
+    uint32_t h = m >> shift;
+    const uint32_t rem = m & ((1u << shift) - 1u), halfway = 1u << (shift - 1u);
+    if (rem > halfway || (rem == halfway && (h & 1u))) ++h;
+    return static_cast<uint16_t>(sign | h);
+  }
+  uint32_t h = (x >> 13) - (112u << 10);
+  const uint32_t rem = x & 0x1fffu;
+  if (rem > 0x1000u || (rem == 0x1000u && (h & 1u))) ++h;  // a carry into the exponent is right
+  return static_cast<uint16_t>(sign | h);
+}
+
+float from_half(uint16_t bits) {
+  const uint32_t sign = (bits & 0x8000u) << 16;
+  const uint32_t e = (bits >> 10) & 0x1fu, m = bits & 0x3ffu;
+  if (e == 0) {
+    const float v = std::ldexp(static_cast<float>(m), -24);
+    return sign ? -v : v;
+  }
+  const uint32_t x =
+      e == 31 ? sign | 0x7f800000u | (m << 13) : sign | ((e + 112u) << 23) | (m << 13);
+  float f;
+  std::memcpy(&f, &x, sizeof f);
+  return f;
+}
+
+void to_halves(std::span<const float> values, std::span<uint16_t> halves) {
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool f16c = cpu_has_f16c();
+  if (f16c) {
+    to_halves_f16c(values, halves);
+    return;
+  }
+#endif
+  for (size_t i = 0; i < values.size(); ++i) halves[i] = to_half(values[i]);
+}
+
+}  // namespace siviflow
