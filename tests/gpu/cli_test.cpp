@@ -176,7 +176,7 @@ TEST_F(CliTest, CaptureWritesExrFramesAndPreviews) {
     // The beauty's part, then one per layer, each compressed as suits it.
     EXPECT_EQ(image.parts, (std::vector<std::string>{"rgba", "depth"}));
     EXPECT_EQ(image.channels.at("R").compression, "piz");
-    EXPECT_EQ(image.channels.at("depth.Z").compression, "zip");
+    EXPECT_EQ(image.channels.at("depth.Z").compression, "rle");
     EXPECT_EQ(image.metadata.frame, frame);
     EXPECT_EQ(image.metadata.seed, 9);
     EXPECT_EQ(image.metadata.scene, "default");
