@@ -23,6 +23,7 @@ constexpr double kBodyReach = 1.15;
 constexpr double kSteps = 1024.0;
 constexpr double kLargestHalf = 65504.0;
 float rounded(double pixels) {
+  if (std::isnan(pixels)) return 0.0f;  // two infinite positions: no motion to tell
   const double steps = std::clamp(pixels, -kLargestHalf, kLargestHalf) * kSteps;
   // Half away from zero as std::round, inline: its library call took a fifth of a pixel's time.
   const double whole = static_cast<double>(static_cast<int64_t>(steps + std::copysign(0.5, steps)));
