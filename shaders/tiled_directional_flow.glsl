@@ -54,14 +54,14 @@ struct TdfResult {
 // tile's foam (z) and the ripple height there (w).
 //   u: the fragment in tile units; lattice: the tile centre's lattice point.
 //   wrap: the tile table's size - 1 (a power of two less one: lattice points wrap by masking)
-vec4 tdf_tile_sample(vec2 u, ivec2 lattice, vec2 du_dx, vec2 du_dy, float repeat_tiles,
+vec4 tdf_tile_sample(vec2 u, ivec2 lattice, float lod_base, float repeat_tiles,
                      ivec2 wrap, usampler2D tile_table, sampler2D normal_map) {
   uvec4 tile = texelFetch(tile_table, lattice & wrap, 0);
   vec2 ab = uintBitsToFloat(tile.rg);
   vec2 back = tdf_back_rotation(ab, repeat_tiles);
   mat2 m = mat2(ab.x, -ab.y, ab.y, ab.x);
   vec2 s = m * (u - 0.5 * vec2(lattice)) + unpackUnorm2x16(tile.b);
-  vec4 texel = textureGrad(normal_map, s, m * du_dx, m * du_dy);
+  vec4 texel = textureLod(normal_map, s, lod_base + 0.5 * log2(dot(ab, ab)));
   vec2 n = texel.rg * 2.0 - 1.0;
   return vec4(mat2(back.x, back.y, -back.y, back.x) * n, uintBitsToFloat(tile.a), texel.a);
 }
@@ -82,10 +82,12 @@ TdfResult tdf_normal(vec3 world, vec3 surface_normal, float strength, float tile
   const vec2 kOffsets[4] = vec2[4](vec2(0.0), vec2(0.5, 0.0), vec2(0.0, 0.5), vec2(0.5));
   const ivec2 kCentres[4] = ivec2[4](ivec2(1), ivec2(0, 1), ivec2(1, 0), ivec2(0));
   ivec2 wrap = textureSize(tile_table, 0) - 1;
+  float map_size = float(textureSize(normal_map, 0).x);
+  float lod_base = 0.5 * log2(max(dot(du_dx, du_dx), dot(du_dy, du_dy)) * map_size * map_size);
   vec4 n[4];
   for (int k = 0; k < 4; ++k) {
     ivec2 lattice = 2 * ivec2(floor(u + kOffsets[k])) + kCentres[k];
-    n[k] = tdf_tile_sample(u, lattice, du_dx, du_dy, repeat_tiles, wrap, tile_table, normal_map);
+    n[k] = tdf_tile_sample(u, lattice, lod_base, repeat_tiles, wrap, tile_table, normal_map);
   }
   // van Hoesel's weights: ff = 1 at the centre of grid A's tile, 0 at its edges (per axis).
   vec2 g = abs(2.0 * fract(u) - 1.0) - 0.5;
