@@ -70,10 +70,18 @@ float from_half(uint16_t bits) {
   return f;
 }
 
-void to_halves(std::span<const float> values, std::span<uint16_t> halves) {
+bool to_halves_uses_f16c() {
 #if defined(__x86_64__) || defined(__i386__)
   static const bool f16c = cpu_has_f16c();
-  if (f16c) {
+  return f16c;
+#else
+  return false;
+#endif
+}
+
+void to_halves(std::span<const float> values, std::span<uint16_t> halves) {
+#if defined(__x86_64__) || defined(__i386__)
+  if (to_halves_uses_f16c()) {
     to_halves_f16c(values, halves);
     return;
   }

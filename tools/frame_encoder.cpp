@@ -45,7 +45,7 @@ ExrCamera exr_camera(const Camera& camera, VkExtent2D extent) {
   return out;
 }
 
-// `values` as half bits in `halves` (resized), rounded to nearest even as GPUs round.
+// `values` as half bits in `halves` (resized), rounded to nearest even.
 void convert_to_halves(const std::vector<float>& values, std::vector<uint16_t>* halves) {
   halves->resize(values.size());
   to_halves(values, *halves);
@@ -109,11 +109,11 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
     }
   };
   // Every water layer and the motion are HALF, which keeps what they hold (docs/output.md); depth
-  // stays FLOAT, as half would lose metres at a kilometre.
+  // stays FLOAT, as half would place a point a kilometre away to half a metre.
   if (water_layers(options_)) {
     convert_to_halves(finished.water_mask, &water_);
     frame.layers.push_back(
-        {"water", ExrCompression::kZip, {{kWaterMaskChannel, nullptr, 1, nullptr, water_.data()}}});
+        {"water", ExrCompression::kZip, {{.name = kWaterMaskChannel, .halves = water_.data()}}});
   }
   // Flow, mask and ids are constant over texels and regions: deflate finds the repeated rows.
   if (options_.flow_aov) {
@@ -123,7 +123,7 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
     });
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"flow", ExrCompression::kZip, {}});
     for (int c = 0; c < 3; ++c) {
-      layer.channels.push_back({kFlowChannels[c], nullptr, 1, nullptr, flow_[c].data()});
+      layer.channels.push_back({.name = kFlowChannels[c], .halves = flow_[c].data()});
     }
   }
   if (options_.particles_aov) {
@@ -136,7 +136,7 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
       if (slot <= layout_.slot_count) particle_id_[pixel] = id_of_slot[slot];
     });
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"particle", ExrCompression::kZip, {}});
-    layer.channels.push_back({kParticleIdChannel, nullptr, 1, particle_id_.data()});
+    layer.channels.push_back({.name = kParticleIdChannel, .ids = particle_id_.data()});
   }
   // The water's own layers are zero off the water, which RLE packs as well as deflate does, and
   // their noisy low mantissa bytes on it defeat deflate: RLE at a third of its time.
@@ -144,15 +144,14 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
                            const char* const channels[3]) {
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{name, ExrCompression::kRle, {}});
     for (int c = 0; c < 3; ++c) {
-      layer.channels.push_back({channels[c], nullptr, 4, nullptr, rgba.data() + c});
+      layer.channels.push_back({.name = channels[c], .stride = 4, .halves = rgba.data() + c});
     }
   };
   if (options_.normal_aov) add_rgb("normal", finished.normal, kNormalChannels);
   if (options_.reflection_aov) add_rgb("reflection", finished.reflection, kReflectionChannels);
   if (options_.foam_aov) {
     frame.layers.push_back(
-        {"foam", ExrCompression::kZip,
-         {{kFoamChannel, nullptr, 1, nullptr, finished.foam.data()}}});
+        {"foam", ExrCompression::kZip, {{.name = kFoamChannel, .halves = finished.foam.data()}}});
   }
   if (options_.motion_aov) {
     const VkExtent2D extent{width, height};
@@ -170,7 +169,7 @@ Status FrameEncoder::encode(const FinishedFrame& finished, EncodedFrame* out) {
     ExrLayer& layer = frame.layers.emplace_back(ExrLayer{"motion", ExrCompression::kZip, {}});
     for (int c = 0; c < 4; ++c) {
       layer.channels.push_back(
-          {kMotionChannels[c], nullptr, 4, nullptr, motion_halves_.data() + c});
+          {.name = kMotionChannels[c], .stride = 4, .halves = motion_halves_.data() + c});
     }
   }
   frame.metadata.scene = options_.scene_path.empty() ? "default" : options_.scene_path;

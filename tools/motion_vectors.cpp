@@ -18,16 +18,19 @@ namespace {
 constexpr double kBodyReach = 1.15;
 
 // Motion is rounded to 1/1024 px: finer than depth resolves it beyond a few metres, and with the
-// noise of the low mantissa bits gone deflate packs the layer 5x at a third of the time. It is
-// held within the half's range, which the layer is written in.
+// noise of the low mantissa bits gone deflate packs the layer several times smaller (5x when it
+// was FLOAT). It is held within the half's range, which the layer is written in; no motion is +0.
 constexpr double kSteps = 1024.0;
 constexpr double kLargestHalf = 65504.0;
 float rounded(double pixels) {
   if (std::isnan(pixels)) return 0.0f;  // two infinite positions: no motion to tell
   const double steps = std::clamp(pixels, -kLargestHalf, kLargestHalf) * kSteps;
   // Half away from zero as std::round, inline: its library call took a fifth of a pixel's time.
-  const double whole = static_cast<double>(static_cast<int64_t>(steps + std::copysign(0.5, steps)));
-  return static_cast<float>(whole * (1.0 / kSteps));  // exact: a power of two
+  // The fraction left after truncating is exact, so ties round as std::round rounds them.
+  const int64_t whole = static_cast<int64_t>(steps);
+  const double fraction = steps - static_cast<double>(whole);
+  const int64_t nearest = whole + (fraction >= 0.5) - (fraction <= -0.5);
+  return static_cast<float>(static_cast<double>(nearest) * (1.0 / kSteps));  // exact: 2^-10
 }
 
 // Pixel position (x right, y down, pixel centres at +0.5) of a point in clip space, or false where

@@ -108,7 +108,8 @@ TEST_F(CaptureLayersTest, EveryLayerNamedForEveryReaderAndZeroOffTheWater) {
     // LAYER.C with a one-letter C, or a bare beauty channel: what Blender's reader takes.
     const size_t dot = name.rfind('.');
     EXPECT_EQ(dot == std::string::npos ? name.size() : name.size() - dot - 1, 1u) << name;
-    // Depth alone is FLOAT (half loses metres at a kilometre); the ids are UINT.
+    // Depth alone is FLOAT (half would place a point a kilometre away to half a metre); the ids
+    // are UINT.
     const ExrPixelType expected = name == "depth.Z"      ? ExrPixelType::kFloat
                                   : name == "particle.I" ? ExrPixelType::kUint
                                                          : ExrPixelType::kHalf;

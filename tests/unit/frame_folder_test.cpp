@@ -49,7 +49,7 @@ void write_frame(const fs::path& dir, uint32_t frame, const FrameSpec& spec = {}
   if (spec.depth) exr.layers.push_back({"depth", ExrCompression::kZip, {{"depth.Z", depth.data()}}});
   if (spec.half_depth) {
     exr.layers.push_back(
-        {"depth", ExrCompression::kZip, {{"depth.Z", nullptr, 1, nullptr, depth_halves.data()}}});
+        {"depth", ExrCompression::kZip, {{.name = "depth.Z", .halves = depth_halves.data()}}});
   }
   exr.metadata.scene = spec.scene;
   exr.metadata.frame = spec.frame_attribute >= 0 ? spec.frame_attribute : static_cast<int>(frame);

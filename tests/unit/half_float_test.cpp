@@ -55,6 +55,7 @@ TEST(HalfFloat, BulkConversionGivesTheScalarBits) {
   values.push_back(std::ldexp(1.0f, -25));
   ASSERT_NE(values.size() % 8, 0u);
   std::vector<uint16_t> halves(values.size());
+  SCOPED_TRACE(to_halves_uses_f16c() ? "with F16C" : "one value at a time (no F16C here)");
   to_halves(values, halves);
   for (size_t i = 0; i < values.size(); ++i) {
     ASSERT_EQ(halves[i], to_half(values[i]))

@@ -283,8 +283,8 @@ TEST_F(ImageFilesExr, HalfBeautyIsWrittenBitForBitAndStridedChannelsAreGathered)
   frame.layers = {{"normal", ExrCompression::kRle,
                    {{"normal.X", normal.data(), 4}, {"normal.Z", normal.data() + 2, 4}}},
                   {"motion", ExrCompression::kZip,
-                   {{"motion.X", nullptr, 4, nullptr, halves.data()},
-                    {"motion.W", nullptr, 4, nullptr, halves.data() + 3}}}};
+                   {{.name = "motion.X", .stride = 4, .halves = halves.data()},
+                    {.name = "motion.W", .stride = 4, .halves = halves.data() + 3}}}};
   const std::string file = path("frame.exr");
   ASSERT_TRUE(write_exr(file, frame).ok());
 
@@ -445,7 +445,7 @@ TEST_F(ImageFilesExr, InvalidFramesAreRejectedWithoutFiles) {
 
   ExrFrame floats_and_halves = data.frame();
   floats_and_halves.layers[0].channels.push_back(
-      {"water.A", data.depth.data(), 1, nullptr, halves.data()});
+      {.name = "water.A", .pixels = data.depth.data(), .halves = halves.data()});
   s = write_exr(file, floats_and_halves);
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message().find("'water.A' needs its pixels as floats, halves or ids"),
