@@ -4,6 +4,7 @@
 #include <cstring>
 
 #if defined(__x86_64__) || defined(__i386__)
+#include <cpuid.h>
 #include <immintrin.h>
 #endif
 
@@ -23,9 +24,16 @@ __attribute__((target("avx,f16c"))) void to_halves_f16c(std::span<const float> v
   for (; i < values.size(); ++i) halves[i] = to_half(values[i]);
 }
 
+// By CPUID rather than __builtin_cpu_supports, which clang does not ask about F16C: the CPU
+// converts (F16C) and runs AVX, and the system saves the AVX registers (XCR0's SSE and AVX bits).
 bool cpu_has_f16c() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx") && __builtin_cpu_supports("f16c");
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  if (__get_cpuid(1, &eax, &ebx, &ecx, &edx) == 0) return false;
+  const unsigned needed = bit_OSXSAVE | bit_AVX | bit_F16C;
+  if ((ecx & needed) != needed) return false;
+  unsigned xcr0 = 0, xcr0_high = 0;
+  __asm__("xgetbv" : "=a"(xcr0), "=d"(xcr0_high) : "c"(0));
+  return (xcr0 & 6u) == 6u;
 }
 #endif
 
