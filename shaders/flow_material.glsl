@@ -98,8 +98,8 @@ void main() {
     ripples = flow_map_normal(in_world, strength, flow.water.z * look.surface.y / kTdfScaleFast,
                               look.clock.x, here, normal_map);
   } else {
-    ripples = tdf_normal(in_world, vec3(0.0, 1.0, 0.0), strength, flow.water.z, look.surface.y,
-                         tile_table, normal_map);
+    ripples = tdf_normal(in_world, vec3(0.0, 1.0, 0.0), strength, flow.water.z, tile_table,
+                         normal_map);
   }
   vec3 n = ripples.normal;
 

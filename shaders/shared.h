@@ -146,11 +146,13 @@ struct FlowConstants {
 // SIVIFLOW_TILE_TABLE_MAX texels a side at most and a power of two; lattice point (i, j) lives
 // in texel (i, j) mod size:
 //   .r  .g  float bits of (a, b): the tile's map transform M = mat2(a, -b, b, a), its rotation
-//           by the flow direction times the map repeats per tile (its length also gives the
-//           roughness, tdf_back_rotation)
-//   .b      the map offset at the tile centre (hashed offset minus the scroll, mod 1) as two
-//           16-bit unorms (packUnorm2x16)
-//   .a      float bits of the foam at the tile centre (0..1, the particle's, sim/foam.h)
+//           by the flow direction times the map repeats per tile
+//   .b      bits 0-11 and 12-23: the map offset at the tile centre (hashed offset minus the
+//           scroll, mod 1) in 1/4096; bits 24-31: the foam at the tile centre (0..1, the
+//           particle's, sim/foam.h) in 1/255
+//   .a      two halves (packHalf2x16): the factor of (a, b) that turns a sampled tilt back into
+//           world x/z, with the roughness of the tile's speed; log2 |M|, the normal map's level
+//           of detail over the fragment's (tdf_encode_tile)
 #define SIVIFLOW_TILE_TABLE_MAX 512u
 // Water heights (R32_SFLOAT, world-aligned samples, see FlowTileConstants.heights) are this or
 // more where no water is near: the lattice points there are no tile of any water fragment.

@@ -50,17 +50,24 @@ uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float foam, float periods, float
   float cycles = round(speed * scale * cycles_per_mps * kTdfGridSpeed[grid]);
   float phase = fract(cycles * periods + kTdfGridPhase[grid]);
   // Subtracting the phase after M moves the pattern along +dir, i.e. downstream.
-  // The map tiles, so the offset keeps only its fraction: 16 bits each resolve 1/65536 of it.
+  // The map tiles, so the offset keeps only its fraction: 12 bits each resolve 1/4096 of it.
   vec2 offset = fract(tdf_tile_offset(cell, grid) - vec2(phase, 0.0));
-  return uvec4(floatBitsToUint(ab), packUnorm2x16(offset), floatBitsToUint(foam));
+  uvec2 offset_bits = uvec2(round(offset * 4096.0)) & 0xfffu;
+  uint foam_bits = uint(round(clamp(foam, 0.0, 1.0) * 255.0));
+  // What every fragment would otherwise derive from (a, b) for each of its four tiles: the
+  // factor of R(+angle) by which a sampled tilt turns back into world x/z, scaled by the
+  // roughness (repeat / scale, times the roughness of this speed), and the normal map's level of
+  // detail over the fragment's own, log2 |M|.
+  float back = mix(kTdfStillRoughness, 1.0, fast) * repeat_tiles / scale;
+  float lod_offset = log2(scale / repeat_tiles);
+  return uvec4(floatBitsToUint(ab), offset_bits.x | (offset_bits.y << 12) | (foam_bits << 24),
+               packHalf2x16(vec2(back, lod_offset)));
 }
 
-// R(+angle) scaled by the roughness, which turns a tile's sampled tilt back into world x/z: both
-// follow from (a, b) = scale / repeat * dir, as scale and roughness grow together with speed.
-vec2 tdf_back_rotation(vec2 ab, float repeat_tiles) {
-  float inv_k = inversesqrt(dot(ab, ab));  // repeat / scale
-  float fast = (repeat_tiles / inv_k - kTdfScaleStill) / (kTdfScaleFast - kTdfScaleStill);
-  return (mix(kTdfStillRoughness, 1.0, fast) * inv_k) * ab;
+// A tile table texel's map offset (xy) and foam (z), unpacked.
+vec3 tdf_tile_offset_and_foam(uint bits) {
+  return vec3(float(bits & 0xfffu), float((bits >> 12) & 0xfffu), 0.0) * (1.0 / 4096.0) +
+         vec3(0.0, 0.0, float(bits >> 24) * (1.0 / 255.0));
 }
 
 #endif  // SIVIFLOW_TDF_TILE_TABLE_GLSL

@@ -53,17 +53,20 @@ struct TdfResult {
 // One tile of one grid: its normal-map sample, as a tangent tilt along world x/z (xy), the
 // tile's foam (z) and the ripple height there (w).
 //   u: the fragment in tile units; lattice: the tile centre's lattice point.
+//   lod_base: the normal map's level of detail for the fragment's footprint in tile units
 //   wrap: the tile table's size - 1 (a power of two less one: lattice points wrap by masking)
-vec4 tdf_tile_sample(vec2 u, ivec2 lattice, float lod_base, float repeat_tiles,
-                     ivec2 wrap, usampler2D tile_table, sampler2D normal_map) {
+vec4 tdf_tile_sample(vec2 u, ivec2 lattice, float lod_base, ivec2 wrap, usampler2D tile_table,
+                     sampler2D normal_map) {
   uvec4 tile = texelFetch(tile_table, lattice & wrap, 0);
   vec2 ab = uintBitsToFloat(tile.rg);
-  vec2 back = tdf_back_rotation(ab, repeat_tiles);
+  vec3 offset_and_foam = tdf_tile_offset_and_foam(tile.b);
+  vec2 back_and_lod = unpackHalf2x16(tile.a);
+  vec2 back = back_and_lod.x * ab;
   mat2 m = mat2(ab.x, -ab.y, ab.y, ab.x);
-  vec2 s = m * (u - 0.5 * vec2(lattice)) + unpackUnorm2x16(tile.b);
-  vec4 texel = textureLod(normal_map, s, lod_base + 0.5 * log2(dot(ab, ab)));
+  vec2 s = m * (u - 0.5 * vec2(lattice)) + offset_and_foam.xy;
+  vec4 texel = textureLod(normal_map, s, lod_base + back_and_lod.y);
   vec2 n = texel.rg * 2.0 - 1.0;
-  return vec4(mat2(back.x, back.y, -back.y, back.x) * n, uintBitsToFloat(tile.a), texel.a);
+  return vec4(mat2(back.x, back.y, -back.y, back.x) * n, offset_and_foam.z, texel.a);
 }
 
 // The Tiled Directional Flow normal of a water fragment.
@@ -71,9 +74,8 @@ vec4 tdf_tile_sample(vec2 u, ivec2 lattice, float lod_base, float repeat_tiles,
 //   surface_normal geometric normal of the river surface (unit; (0,1,0) for flat water)
 //   strength       van Hoesel's 0.3 * transp^2: fold fade, shore and depth in (0 = flat mirror)
 //   tile_size_m    tile side in metres
-//   repeat_tiles   tiles per normal-map repeat at scale 1, as the tile table was encoded with
 TdfResult tdf_normal(vec3 world, vec3 surface_normal, float strength, float tile_size_m,
-                     float repeat_tiles, usampler2D tile_table, sampler2D normal_map) {
+                     usampler2D tile_table, sampler2D normal_map) {
   vec2 u = world.xz / tile_size_m;
   vec2 du_dx = dFdx(u);
   vec2 du_dy = dFdy(u);
@@ -87,7 +89,7 @@ TdfResult tdf_normal(vec3 world, vec3 surface_normal, float strength, float tile
   vec4 n[4];
   for (int k = 0; k < 4; ++k) {
     ivec2 lattice = 2 * ivec2(floor(u + kOffsets[k])) + kCentres[k];
-    n[k] = tdf_tile_sample(u, lattice, lod_base, repeat_tiles, wrap, tile_table, normal_map);
+    n[k] = tdf_tile_sample(u, lattice, lod_base, wrap, tile_table, normal_map);
   }
   // van Hoesel's weights: ff = 1 at the centre of grid A's tile, 0 at its edges (per axis).
   vec2 g = abs(2.0 * fract(u) - 1.0) - 0.5;

@@ -252,8 +252,9 @@ TEST_F(RenderTest, UploadedFlowTexturesEqualThePackedBytes) {
 
 // Each tile of the water's Tiled Directional Flow takes the flow and foam of the particle under
 // its centre: the tile table turns the map along that flow and scales it with its speed, and
-// carries the foam as it is. Checked where that
-// particle lies within a tile of the centre: tiles farther from water are no water pixel's.
+// carries the foam to 1/255, the roughness's turn-back factor and the map's level of detail for
+// that speed. Checked where that particle lies within a tile of the centre: tiles farther from
+// water are no water pixel's.
 TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
   const std::vector<Frame> frames = render(0, 2);
   ASSERT_EQ(frames.size(), 2u);
@@ -304,16 +305,23 @@ TEST_F(RenderTest, TileTableCarriesTheFlowUnderEachTileCentre) {
       const float cos_angle = glm::dot(ab, glm::vec2(flow.x, flow.z)) / (glm::length(ab) * speed);
       gpu::ParticleAux aux{};
       ASSERT_TRUE(read_particle_aux(staging, layout, texel.id, &aux).ok());
-      float foam = 0.0f;
-      std::memcpy(&foam, tile + 3, sizeof(foam));
+      const float foam = static_cast<float>(tile[2] >> 24) / 255.0f;
       if (foam > 0.0f) ++foamy;
+      // Roughness 0.4 in still water to 1 from 1.5 m/s, over the map repeats per tile.
+      const float roughness = glm::mix(0.4f, 1.0f, std::clamp(speed / 1.5f, 0.0f, 1.0f));
+      const float back = from_half(static_cast<uint16_t>(tile[3] & 0xffffu));
+      const float lod_offset = from_half(static_cast<uint16_t>(tile[3] >> 16));
       if (cos_angle > std::cos(glm::radians(0.5f)) && std::abs(glm::length(ab) - scale) < 1e-4f &&
-          foam == aux.foam) {
+          std::abs(foam - aux.foam) <= 0.5f / 255.0f + 1e-6f &&
+          std::abs(back - roughness / scale) <= 2e-3f * back &&
+          std::abs(lod_offset - std::log2(scale)) <= 2e-3f) {
         ++agreeing;
       } else {
         ADD_FAILURE() << "lattice point (" << lattice.x << ", " << lattice.y << "): flow ("
                       << flow.x << ", " << flow.z << "), table (" << ab.x << ", " << ab.y
-                      << "), foam " << foam << " against the particle's " << aux.foam;
+                      << "), foam " << foam << " against the particle's " << aux.foam
+                      << ", turn-back " << back << " against " << roughness / scale
+                      << ", level of detail " << lod_offset << " against " << std::log2(scale);
       }
     }
   }
