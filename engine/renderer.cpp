@@ -655,6 +655,12 @@ uint32_t RendererInspector::drawn_water_triangles(const Renderer& renderer) {
   for (const IndexRange& run : renderer.impl_->water_draws) indices += run.index_count;
   return indices / 3;
 }
+bool RendererInspector::flow_reads_gpu_mesh(const Renderer& renderer) {
+  const SharedRiver& river = *renderer.impl_->river;
+  return river.flow.positions().data() ==
+             river.assets.buffer(SharedRiver::kRiverVertices).mapped &&
+         river.flow.indices().data() == river.assets.buffer(SharedRiver::kRiverIndices).mapped;
+}
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 uint64_t Renderer::flow_solves() const { return impl_->river->flow.full_solves(); }
 

@@ -19,6 +19,9 @@ class RendererInspector {
   static const RiverFlowField& flow_field(const Renderer& renderer);
   // The triangles of the water surface the last updated view draws (its chunks in view).
   static uint32_t drawn_water_triangles(const Renderer& renderer);
+  // Whether the flow reads the river's positions and indices from the GPU's vertex and index
+  // buffers (a unified-memory device's) rather than from a copy of its own.
+  static bool flow_reads_gpu_mesh(const Renderer& renderer);
 };
 
 inline const ParticleField& particle_field(const Renderer& renderer) {

@@ -117,7 +117,8 @@ Status check_obstacle(const WaterObstacle& placed, size_t index) {
   return validate_obstacle(flow_obstacle(placed), index);
 }
 
-Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles) {
+Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
+                         const MeshHome& home) {
   mesh_ = std::move(river.mesh);
   slope_ = std::move(river.slope);
   SIVIFLOW_TRY(StreamFunction::create(std::move(river.surface), flow, &flow_));
@@ -127,6 +128,17 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   const RiverSurface& surface = flow_.surface();
   const size_t count = surface.vertex_count();
   per_node_ = mesh_.positions.empty();
+  if (home) {
+    PlacedMesh placed;
+    if (per_node_) {
+      SIVIFLOW_TRY(home(surface.node_positions(), surface.triangles(), &placed));
+      if (placed.positions.data() != nullptr) {
+        SIVIFLOW_TRY(flow_.share_mesh(placed.positions, placed.indices));
+      }
+    } else {
+      SIVIFLOW_TRY(home(mesh_.positions, mesh_.indices, &placed));
+    }
+  }
   std::span<const uint32_t> section = surface.node_section();
   if (per_node_) {
     field_.positions = surface.node_positions();

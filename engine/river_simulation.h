@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -57,9 +58,22 @@ Status check_obstacle(const WaterObstacle& placed, size_t index);
 // per-vertex arrays change in place, so the views' particles see every new flow.
 class RiverFlow {
  public:
-  // Solves the flow of `river` with the obstacles. Must not be moved after create(): the views
-  // keep spans into its per-vertex arrays.
-  Status create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles);
+  // Where the mesh the GPU draws lives once the GPU has it. Given the positions and indices to
+  // draw, a home makes its buffers of them and, where the host reads those as fast as its own
+  // memory (a unified-memory device's), returns them; else leaves `placed` empty.
+  struct PlacedMesh {
+    std::span<const glm::vec3> positions;
+    std::span<const uint32_t> indices;
+  };
+  using MeshHome = std::function<Status(std::span<const glm::vec3> positions,
+                                        std::span<const uint32_t> indices, PlacedMesh* placed)>;
+
+  // Solves the flow of `river` with the obstacles, and hands the mesh to `home` (if any) before
+  // anything reads it: a mesh placed there, outliving this flow, is then read from there and the
+  // flow's own copy freed (only a mesh read from the surface, see per_node_). Must not be moved
+  // after create(): the views keep spans into its per-vertex arrays.
+  Status create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
+                const MeshHome& home = {});
 
   // Places the keyframed obstacles at `time_seconds` and re-solves the flow near those that
   // moved (nothing when they are already there).

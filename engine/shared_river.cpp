@@ -44,18 +44,32 @@ Status SharedRiver::create(const DeviceTable& table, const VkAllocationCallbacks
   auto river = std::make_shared<SharedRiver>();
   river->table = table;
   river->gpu = make_gpu_context(river->table, callbacks);
-  SIVIFLOW_TRY(river->flow.create(std::move(input), flow, std::move(obstacles)));
+  StaticAssets& assets = river->assets;
+  // The mesh's buffers are made before the flow's ray-cast structure and foam: on a
+  // unified-memory device the flow then reads them and frees its own copy first.
+  const auto home = [&river, &assets](std::span<const glm::vec3> positions,
+                                      std::span<const uint32_t> indices,
+                                      RiverFlow::PlacedMesh* placed) {
+    StaticAssets::BufferSpec vertices{"river vertices", Access::VertexBufferRead,
+                                      VK_BUFFER_USAGE_VERTEX_BUFFER_BIT};
+    vertices.borrowed = byte_view(positions);
+    assets.add_buffer(std::move(vertices));
+    StaticAssets::BufferSpec triangles{"river indices", Access::IndexBufferRead,
+                                       VK_BUFFER_USAGE_INDEX_BUFFER_BIT};
+    triangles.borrowed = byte_view(indices);
+    assets.add_buffer(std::move(triangles));
+    SIVIFLOW_TRY(assets.create_buffers(river->gpu));
+    const Buffer& vertex_buffer = assets.buffer(kRiverVertices);
+    const Buffer& index_buffer = assets.buffer(kRiverIndices);
+    if (vertex_buffer.host_cached && index_buffer.host_cached) {
+      placed->positions = {static_cast<const glm::vec3*>(vertex_buffer.mapped), positions.size()};
+      placed->indices = {static_cast<const uint32_t*>(index_buffer.mapped), indices.size()};
+    }
+    return Status::success();
+  };
+  SIVIFLOW_TRY(river->flow.create(std::move(input), flow, std::move(obstacles), home));
   river->scene_obstacle_count = river->flow.obstacle_count();
   river->cut_into_chunks();
-  StaticAssets& assets = river->assets;
-  StaticAssets::BufferSpec vertices{"river vertices", Access::VertexBufferRead,
-                                    VK_BUFFER_USAGE_VERTEX_BUFFER_BIT};
-  vertices.borrowed = byte_view(river->flow.positions());
-  assets.add_buffer(std::move(vertices));
-  StaticAssets::BufferSpec indices{"river indices", Access::IndexBufferRead,
-                                   VK_BUFFER_USAGE_INDEX_BUFFER_BIT};
-  indices.borrowed = byte_view(river->flow.indices());
-  assets.add_buffer(std::move(indices));
   WaterNormalMap normal_map = make_water_normal_map();
   assets.add_image({"water normal map", kNormalMapFormat, {normal_map.size, normal_map.size},
                     std::move(normal_map.texels), std::move(normal_map.mip_offsets)});

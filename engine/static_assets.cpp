@@ -15,9 +15,13 @@ uint32_t StaticAssets::add_image(ImageSpec spec) {
   return static_cast<uint32_t>(images_.size() - 1);
 }
 
-Status StaticAssets::create(const GpuContext& gpu) {
-  staging_handle_ = upload_graph_.import_buffer({"static staging", 0}, ResourceState{});
-  for (uint32_t n = 0; n < buffers_.size(); ++n) {
+Status StaticAssets::create_buffers(const GpuContext& gpu) {
+  if (!staging_declared_) {
+    staging_handle_ = upload_graph_.import_buffer({"static staging", 0}, ResourceState{});
+    staging_declared_ = true;
+  }
+  for (; created_buffers_ < buffers_.size(); ++created_buffers_) {
+    const auto n = static_cast<uint32_t>(created_buffers_);
     StaticBuffer& b = buffers_[n];
     const std::span<const uint8_t> source = b.spec.source();
     SIVIFLOW_TRY(create_device_buffer(gpu, source.size(),
@@ -36,6 +40,11 @@ Status StaticAssets::create(const GpuContext& gpu) {
     uploads_.buffers.push_back({0, handle, b.buffer.size});
     staged_buffers_.push_back(n);
   }
+  return Status::success();
+}
+
+Status StaticAssets::create(const GpuContext& gpu) {
+  SIVIFLOW_TRY(create_buffers(gpu));
   std::vector<ImageHandle> handles;
   for (const StaticImage& i : images_) {
     const ImageHandle handle = upload_graph_.import_image(

@@ -56,6 +56,9 @@ class StaticAssets {
   // Creates every buffer and image and declares their upload; a buffer in memory the host maps
   // (a unified-memory device's) is filled here instead, and its bytes freed.
   Status create(const GpuContext& gpu);
+  // The buffers alone, those added and not yet created, as create() makes them: a buffer's
+  // memory can then be read (buffer(i).mapped) before the images are added. create() does the rest.
+  Status create_buffers(const GpuContext& gpu);
   void destroy(const GpuContext& gpu);
 
   // Copies every byte into one host-visible staging buffer, once, before the first upload.
@@ -92,6 +95,8 @@ class StaticAssets {
     Image image;
   };
   std::vector<StaticBuffer> buffers_;
+  size_t created_buffers_ = 0;  // buffers_[0 .. created_buffers_) exist
+  bool staging_declared_ = false;
   std::vector<uint32_t> staged_buffers_;  // those copied from staging, in uploads_.buffers' order
   std::vector<StaticImage> images_;
   FrameGraph upload_graph_;

@@ -254,6 +254,26 @@ size_t RiverSurface::memory_bytes() const {
          bytes(section_nodes_);
 }
 
+Status RiverSurface::share_mesh(std::span<const glm::vec3> positions,
+                               std::span<const uint32_t> triangles) {
+  const std::span<const glm::vec3> own_positions = node_positions();
+  const std::span<const uint32_t> own_triangles = this->triangles();
+  if (positions.size() != own_positions.size() || triangles.size() != own_triangles.size()) {
+    return Status::error(text_format(
+        "share_mesh: %zu positions and %zu indices given for a surface of %zu and %zu",
+        positions.size(), triangles.size(), own_positions.size(), own_triangles.size()));
+  }
+  if (!std::equal(positions.begin(), positions.end(), own_positions.begin()) ||
+      !std::equal(triangles.begin(), triangles.end(), own_triangles.begin())) {
+    return Status::error("share_mesh: the shared positions or triangles differ from the surface's");
+  }
+  shared_positions_ = positions;
+  shared_triangles_ = triangles;
+  node_positions_ = std::vector<glm::vec3>();
+  triangles_ = std::vector<uint32_t>();
+  return Status::success();
+}
+
 Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                            const RiverSurfaceOptions& options, RiverSurface* out) {
   // --- Sizes, before anything is allocated or read.

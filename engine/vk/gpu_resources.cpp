@@ -31,12 +31,14 @@ void set_name(const GpuContext& gpu, VkObjectType type, uint64_t handle, const c
 }
 
 Status allocate(const GpuContext& gpu, const VkMemoryRequirements& requirements,
-                VkMemoryPropertyFlags wanted, const char* name, VkDeviceMemory* memory) {
+                VkMemoryPropertyFlags wanted, const char* name, VkDeviceMemory* memory,
+                VkMemoryPropertyFlags* type_flags = nullptr) {
   uint32_t type_index = 0;
   if (!find_memory_type(gpu.memory_properties, requirements.memoryTypeBits, wanted, &type_index)) {
     return Status::error(std::string("no suitable memory type for '") + name + "'",
                          VK_ERROR_OUT_OF_DEVICE_MEMORY);
   }
+  if (type_flags != nullptr) *type_flags = gpu.memory_properties.memoryTypes[type_index].propertyFlags;
   VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   info.allocationSize = requirements.size;
   info.memoryTypeIndex = type_index;
@@ -92,7 +94,8 @@ Status make_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags 
                        &shared_type)) {
     wanted |= kHost;
   }
-  Status status = allocate(gpu, requirements, wanted, debug_name, &out->memory);
+  VkMemoryPropertyFlags type_flags = 0;
+  Status status = allocate(gpu, requirements, wanted, debug_name, &out->memory, &type_flags);
   if (status.ok()) {
     result = vk.vkBindBufferMemory(vk.device, out->buffer, out->memory, 0);
     if (result != VK_SUCCESS) status = vk_failure("vkBindBufferMemory", debug_name, result);
@@ -100,6 +103,7 @@ Status make_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags 
   if (status.ok() && (wanted & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) != 0) {
     result = vk.vkMapMemory(vk.device, out->memory, 0, VK_WHOLE_SIZE, 0, &out->mapped);
     if (result != VK_SUCCESS) status = vk_failure("vkMapMemory", debug_name, result);
+    out->host_cached = (type_flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT) != 0;
   }
   if (!status.ok()) {
     destroy_buffer(gpu, out);

@@ -21,6 +21,7 @@ struct Buffer {
   VkDeviceMemory memory = VK_NULL_HANDLE;
   VkDeviceSize size = 0;
   void* mapped = nullptr;  // persistently mapped when created host-visible
+  bool host_cached = false;  // mapped memory the host reads as fast as its own
 };
 
 struct Image {

@@ -19,7 +19,9 @@
 #include "gltf_test_files.h"
 #include "gpu_test.h"
 #include "run_command.h"
+#include "default_river.h"
 #include "renderer_inspect.h"
+#include "river_simulation.h"
 #include "siviflow/host_frame.h"
 #include "siviflow/scene_river.h"
 
@@ -166,6 +168,26 @@ size_t differing_pixels(const Pane& a, const Pane& b, float* largest = nullptr) 
   }
   if (largest != nullptr) *largest = worst;
   return count;
+}
+
+TEST_F(SharedRiverTest, OnUnifiedMemoryTheFlowReadsTheMeshFromTheGpuBuffers) {
+  // Lavapipe's memory is the host's, and cached: a long river's mesh is held once, not twice.
+  const std::unique_ptr<Renderer> first = make({64, 48});
+  ASSERT_NE(first, nullptr);
+  EXPECT_TRUE(RendererInspector::flow_reads_gpu_mesh(*first));
+  const std::unique_ptr<Renderer> second = make({64, 48}, first.get());
+  ASSERT_NE(second, nullptr);
+  EXPECT_EQ(flow_field(*second).positions.data(), flow_field(*first).positions.data());
+  // What the particles read is the procedural river's mesh, from those buffers.
+  const ProceduralRiver procedural(default_river_params());
+  RiverInput input;
+  ASSERT_TRUE(procedural_river_input(procedural, &input).ok());
+  const RiverFlowField& field = flow_field(*first);
+  ASSERT_EQ(field.positions.size(), input.surface.node_positions().size());
+  EXPECT_TRUE(std::equal(field.positions.begin(), field.positions.end(),
+                         input.surface.node_positions().begin()));
+  EXPECT_TRUE(std::equal(field.indices.begin(), field.indices.end(),
+                         input.surface.triangles().begin()));
 }
 
 TEST_F(SharedRiverTest, TwoViewsInTwoImagesEqualEachAloneWithOneSolve) {

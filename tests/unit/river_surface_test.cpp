@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -185,6 +187,42 @@ TEST(RiverSurface, Deterministic) {
     EXPECT_EQ(a.node_section()[n], b.node_section()[n]);
   }
   EXPECT_TRUE(std::equal(a.triangles().begin(), a.triangles().end(), b.triangles().begin()));
+}
+
+TEST(RiverSurface, SharedMeshIsReadFromTheSharerAndFreesItsOwn) {
+  const TestMesh m = test::bend(5.0f, 9.0f, 2.0f, 40, 7);
+  RiverSurface s;
+  ASSERT_TRUE(build(m, &s).ok());
+  const size_t own_bytes = s.memory_bytes();
+  // What a unified-memory device's vertex and index buffers would hold.
+  const std::vector<glm::vec3> positions(s.node_positions().begin(), s.node_positions().end());
+  const std::vector<uint32_t> triangles(s.triangles().begin(), s.triangles().end());
+  ASSERT_TRUE(s.share_mesh(positions, triangles).ok());
+  EXPECT_EQ(s.node_positions().data(), positions.data());
+  EXPECT_EQ(s.triangles().data(), triangles.data());
+  EXPECT_EQ(s.triangle_count(), triangles.size() / 3);
+  EXPECT_EQ(s.memory_bytes(),
+            own_bytes - positions.size() * sizeof(glm::vec3) - triangles.size() * sizeof(uint32_t));
+  // A copy reads the same shared arrays.
+  const RiverSurface copy = s;
+  EXPECT_EQ(copy.node_positions().data(), positions.data());
+}
+
+TEST(RiverSurface, SharedMeshThatDiffersIsRefused) {
+  const TestMesh m = test::straight_channel(6.0f, 12.0f, 7, 4);
+  RiverSurface s;
+  ASSERT_TRUE(build(m, &s).ok());
+  std::vector<glm::vec3> positions(s.node_positions().begin(), s.node_positions().end());
+  const std::vector<uint32_t> triangles(s.triangles().begin(), s.triangles().end());
+  const glm::vec3* own = s.node_positions().data();
+  const Status shorter = s.share_mesh(std::span(positions).first(positions.size() - 1), triangles);
+  ASSERT_FALSE(shorter.ok());
+  EXPECT_NE(shorter.message().find("positions"), std::string::npos) << shorter.message();
+  positions[3].y += 0.5f;
+  const Status moved = s.share_mesh(positions, triangles);
+  ASSERT_FALSE(moved.ok());
+  EXPECT_NE(moved.message().find("differ"), std::string::npos) << moved.message();
+  EXPECT_EQ(s.node_positions().data(), own);  // its own, unchanged
 }
 
 // --- Bad meshes (reliability.md §5 rows 6-16) --------------------------------------------------

@@ -74,7 +74,9 @@ class RiverSurface {
   // --- Per node (welded vertex); every index below is a node index ---
   size_t node_count() const { return node_positions_.size(); }
   RiverVertex node(uint32_t n) const;
-  std::span<const glm::vec3> node_positions() const { return node_positions_; }
+  std::span<const glm::vec3> node_positions() const {
+    return shared_positions_.data() != nullptr ? shared_positions_ : std::span(node_positions_);
+  }
   std::span<const uint32_t> node_section() const { return node_section_; }
   std::span<const Bank> node_bank() const { return node_bank_; }
   std::span<const float> node_d_left() const { return node_d_left_; }
@@ -84,8 +86,10 @@ class RiverSurface {
 
   // Triangles in node indices, wound counter-clockwise seen from the river's upper side
   // (downstream x (left shore - right shore)), whatever the input winding was.
-  std::span<const uint32_t> triangles() const { return triangles_; }  // 3 per triangle
-  size_t triangle_count() const { return triangles_.size() / 3; }
+  std::span<const uint32_t> triangles() const {  // 3 per triangle
+    return shared_triangles_.data() != nullptr ? shared_triangles_ : std::span(triangles_);
+  }
+  size_t triangle_count() const { return triangles().size() / 3; }
   // Triangles around node n, ascending.
   std::span<const uint32_t> node_triangles(uint32_t n) const {
     return {node_tri_list_.data() + node_tri_start_[n], node_tri_start_[n + 1] - node_tri_start_[n]};
@@ -105,6 +109,12 @@ class RiverSurface {
   // Bytes of its arrays: what a long river costs to keep.
   size_t memory_bytes() const;
 
+  // From now on reads its node positions and triangles from `positions` and `triangles` (a
+  // unified-memory device's vertex and index buffers), which hold the same values and outlive
+  // it, and frees its own: a long river's mesh is then held once. Fails, changing nothing, when
+  // they differ from its own.
+  Status share_mesh(std::span<const glm::vec3> positions, std::span<const uint32_t> triangles);
+
  private:
   std::vector<uint32_t> node_of_vertex_;  // both empty when nothing was welded
   std::vector<uint32_t> node_vertex_;
@@ -118,6 +128,9 @@ class RiverSurface {
   std::vector<uint32_t> node_tri_list_;
   std::vector<RiverSection> sections_;
   std::vector<uint32_t> section_nodes_;
+  // After share_mesh: where the positions and triangles are read instead of the vectors above.
+  std::span<const glm::vec3> shared_positions_;
+  std::span<const uint32_t> shared_triangles_;
   float widest_ = 0.0f;
   float extent_ = 0.0f;
 };

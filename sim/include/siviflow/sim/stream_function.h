@@ -49,6 +49,10 @@ class StreamFunction {
   static Status create(RiverSurface surface, const FlowParams& params, StreamFunction* out);
 
   const RiverSurface& surface() const { return surface_; }
+  // RiverSurface::share_mesh of its surface.
+  Status share_mesh(std::span<const glm::vec3> positions, std::span<const uint32_t> triangles) {
+    return surface_.share_mesh(positions, triangles);
+  }
   const FlowParams& params() const { return params_; }  // search_radius resolved
   float search_radius() const { return params_.search_radius; }
 
