@@ -91,9 +91,9 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
   for (size_t v = 0; v < count; ++v) {
     section_speed_[section_[v]] += std::hypot(velocity[v].x, velocity[v].z) / float(section_size_[section_[v]]);
   }
-  // Per vertex: where the flow came from one step earlier (3 vertices and their weights; all 0
-  // weights when that point is off the river), and its own foam source.
-  std::vector<uint32_t> upstream_vertex(count * 3, 0);
+  // Per vertex: where the flow came from one step earlier (the triangle there and its corners'
+  // weights; all 0 weights when that point is off the river), and its own foam source.
+  std::vector<uint32_t> upstream_triangle(count, 0);
   std::vector<float> upstream_weight(count * 3, 0.0f);
   std::vector<float> source(count, 0.0f);
   const auto corner = [&](size_t i) { return indices_.empty() ? uint32_t(i) : indices_[i]; };
@@ -157,9 +157,10 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
     const glm::vec3 back = positions_[v] - p.step_s * glm::vec3(velocity[v].x, 0.0f, velocity[v].z);
     RayHit hit;
     float* weight = &upstream_weight[v * 3];
-    uint32_t* from = &upstream_vertex[v * 3];
     if (bvh_->intersect(back + glm::vec3(0.0f, kRayHeight, 0.0f), {0.0f, -1.0f, 0.0f},
                         2.0f * kRayHeight, &hit)) {
+      upstream_triangle[v] = hit.triangle;
+      uint32_t from[3];
       for (int c = 0; c < 3; ++c) from[c] = bvh_->triangle_vertex(hit.triangle, c);
       const glm::vec3 b = barycentric_xz(back, positions_[from[0]], positions_[from[1]],
                                          positions_[from[2]]);
@@ -175,10 +176,10 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
   std::vector<float> next(count);
   for (uint32_t step = 0; step < p.steps; ++step) {
     for (size_t v = 0; v < count; ++v) {
-      const uint32_t* from = &upstream_vertex[v * 3];
+      const size_t t = upstream_triangle[v];
       const float* weight = &upstream_weight[v * 3];
-      const float carried = weight[0] * foam[from[0]] + weight[1] * foam[from[1]] +
-                            weight[2] * foam[from[2]];
+      const float carried = weight[0] * foam[corner(3 * t)] + weight[1] * foam[corner(3 * t + 1)] +
+                            weight[2] * foam[corner(3 * t + 2)];
       next[v] = std::max(source[v], decay * carried);
     }
     std::copy(next.begin(), next.end(), foam.begin());
