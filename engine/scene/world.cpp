@@ -330,7 +330,7 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
   bind_host(w.depth, host_depth);
   b.bind_data(w.frame_data.draws, &w.main_draws);
   b.bind_data(w.frame_data.view, &w.frame);
-  b.set_render_area(w.color, w.frame.viewport);  // the view's part only: cleared, then drawn
+  b.set_render_area(w.color, w.frame.viewport);  // the view's part only: drawn whole
   VkClearValue far{};
   far.depthStencil = {far_depth(math.reverse_z), 0};
   b.set_clear(w.depth, far);
