@@ -24,6 +24,7 @@ struct LodPiece {
   std::vector<float> level_error;
   uint32_t level0_skirt_index_count = 0;  // of levels[0], the last this many (not solid ground)
   uint32_t material = 0;  // SceneDraw::material
+  bool one_sided = false;  // SceneDraw::one_sided
 };
 
 struct CullView {

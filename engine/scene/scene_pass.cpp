@@ -32,6 +32,7 @@ Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat 
   scene.color_format = color_format;
   scene.depth_format = depth_format;
   scene.dynamic_depth_compare = true;  // the view's depth convention
+  scene.dynamic_culling = true;        // the terrain's back faces, in any view, mirrored or not
   scene.bindings = {{0, sizeof(gpu::SceneVertex), VK_VERTEX_INPUT_RATE_VERTEX}};
   scene.attributes = {
       {SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(gpu::SceneVertex, position)},
@@ -100,7 +101,7 @@ ScenePass::FrameData ScenePass::declare(FrameGraph& graph, const char* pass_name
     const Frame& frame = ctx.data(data.view);
     set_viewport(ctx.table(), ctx.cmd(), frame.viewport);
     draw(ctx.table(), ctx.cmd(), ctx.buffer(h.vertices), ctx.buffer(h.indices),
-         ctx.data(data.draws), *frame.sky, frame.reverse_z);
+         ctx.data(data.draws), *frame.sky, frame);
     return Status::success();
   });
   return data;
@@ -108,7 +109,7 @@ ScenePass::FrameData ScenePass::declare(FrameGraph& graph, const char* pass_name
 
 void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices,
                      VkBuffer indices, const std::vector<SceneDraw>& draws,
-                     const gpu::SceneConstants& sky, bool reverse_z) const {
+                     const gpu::SceneConstants& sky, const Frame& view) const {
   constexpr VkShaderStageFlags kStages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
   // Terrain and objects first, so the sky's fragments are depth-tested away behind them.
   const VkDeviceSize offset = 0;
@@ -116,12 +117,20 @@ void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertic
   vk.vkCmdBindIndexBuffer(cmd, indices, 0, VK_INDEX_TYPE_UINT32);
   VkPipeline bound = VK_NULL_HANDLE;
   VkDescriptorSet bound_set = VK_NULL_HANDLE;
+  bool culling = false;
   for (const SceneDraw& d : draws) {
     const VkPipeline pipeline = d.material == 0 ? scene_pipeline_ : object_pipeline_;
     if (pipeline != bound) {
       vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-      vk.vkCmdSetDepthCompareOp(cmd, reverse_z ? VK_COMPARE_OP_GREATER : VK_COMPARE_OP_LESS);
+      vk.vkCmdSetDepthCompareOp(cmd, view.reverse_z ? VK_COMPARE_OP_GREATER : VK_COMPARE_OP_LESS);
+      vk.vkCmdSetFrontFace(cmd, view.outside_clockwise ? VK_FRONT_FACE_CLOCKWISE
+                                                       : VK_FRONT_FACE_COUNTER_CLOCKWISE);
+      culling = view.cull_back_faces && d.one_sided;
+      vk.vkCmdSetCullMode(cmd, culling ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE);
       bound = pipeline;
+    } else if ((view.cull_back_faces && d.one_sided) != culling) {
+      culling = !culling;
+      vk.vkCmdSetCullMode(cmd, culling ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE);
     }
     if (sets_[d.material] != bound_set) {
       bound_set = sets_[d.material];
@@ -132,7 +141,7 @@ void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertic
   }
   vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), &sky);
   vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, sky_pipeline_);
-  vk.vkCmdSetDepthCompareOp(cmd, reverse_z ? VK_COMPARE_OP_GREATER_OR_EQUAL
+  vk.vkCmdSetDepthCompareOp(cmd, view.reverse_z ? VK_COMPARE_OP_GREATER_OR_EQUAL
                                            : VK_COMPARE_OP_LESS_OR_EQUAL);
   vk.vkCmdDraw(cmd, 3, 1, 0, 0);
 }

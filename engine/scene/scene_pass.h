@@ -23,6 +23,8 @@ struct SceneDraw {
   // 0: terrain material (vertex colours and the ground detail); k > 0: object material with
   // base-colour texture k - 1 of ScenePass::set_textures.
   uint32_t material = 0;
+  // Seen only from outside (the terrain): its back faces are culled.
+  bool one_sided = false;
 };
 
 class ScenePass {
@@ -47,6 +49,10 @@ class ScenePass {
   // its viewport.
   struct Frame {
     bool reverse_z = false;
+    // One-sided draws' back faces are culled (the main view); outside_lands_clockwise of the
+    // view (view_math.h) says which faces those are.
+    bool cull_back_faces = false;
+    bool outside_clockwise = false;
     VkRect2D viewport{};
     const gpu::SceneConstants* sky = nullptr;  // the view's own constants
   };
@@ -59,10 +65,10 @@ class ScenePass {
   // new versions of colour and depth go back into `handles`.
   FrameData declare(FrameGraph& graph, const char* pass_name, Handles* handles);
   // Records `draws` then the sky (with `sky`, the view's own constants) into the rendering begun
-  // by the caller (viewport set).
+  // by the caller (viewport set). `view` says the depth convention and the culling.
   void draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertices, VkBuffer indices,
             const std::vector<SceneDraw>& draws, const gpu::SceneConstants& sky,
-            bool reverse_z) const;
+            const Frame& view) const;
 
  private:
   VkPipelineLayout layout_ = VK_NULL_HANDLE;

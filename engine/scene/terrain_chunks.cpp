@@ -82,20 +82,22 @@ class ChunkBuilder {
           indices.insert(indices.end(), {a, c, b, b, c, d});
         }
       }
+      // Each skirt faces out of the chunk: a crack is seen from the neighbour's side.
       const auto skirts_first = static_cast<uint32_t>(indices.size());
       for (size_t i = 0; i + 1 < cols.size(); ++i) {
-        add_skirt(cols[i], r0, cols[i + 1], r0);
+        add_skirt(cols[i + 1], r0, cols[i], r0);
         add_skirt(cols[i], r1, cols[i + 1], r1);
       }
       for (size_t j = 0; j + 1 < rows.size(); ++j) {
         add_skirt(c0, rows[j], c0, rows[j + 1]);
-        add_skirt(c1, rows[j], c1, rows[j + 1]);
+        add_skirt(c1, rows[j + 1], c1, rows[j]);
       }
       const auto end = static_cast<uint32_t>(indices.size());
       piece.levels.push_back({first, end - first});
       if (level == 0) piece.level0_skirt_index_count = end - skirts_first;
     }
     piece.lo.y -= skirt_depth_;
+    piece.one_sided = true;  // ground seen from above, its skirts from outside
     hung_.clear();  // each chunk its own copies: a neighbour may draw at another level
     return piece;
   }
@@ -116,7 +118,8 @@ class ChunkBuilder {
     return index;
   }
 
-  // A wall from the edge (c0, r0)-(c1, r1) down to its hung copy (the scene draws both faces).
+  // A wall from the edge (c0, r0)-(c1, r1) down to its hung copy, facing the side to the right of
+  // that edge seen from above (+Y).
   void add_skirt(uint32_t c0, uint32_t r0, uint32_t c1, uint32_t r1) {
     const uint32_t a = base_ + at(c0, r0);
     const uint32_t b = base_ + at(c1, r1);

@@ -302,6 +302,10 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
   }
   w.time = time_seconds;
   w.frame.reverse_z = math.reverse_z;
+  // Back faces of the ground are hidden behind its front faces in the main view. Not in the
+  // reflection: the water's edge, a little under the bank, reflects the bank's underside there.
+  w.frame.cull_back_faces = true;
+  w.frame.outside_clockwise = outside_lands_clockwise(math.view_proj, math.camera_position);
   // Nothing clipped in the main view.
   w.main_constants = w.view_constants(math.view_proj, math.camera_position,
                                       glm::vec4(0.0f, 0.0f, 0.0f, 1.0f), math.reverse_z);
@@ -374,9 +378,11 @@ void World::draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, voi
   w.select_draws(cull, w.reflection_constants, 1, &w.reflection_draws,
                  &w.stats.reflection_triangles);
   const ScenePass& pass = w.own_reflection_pass ? w.reflection_pass : w.main_pass;
+  ScenePass::Frame mirrored;
+  mirrored.reverse_z = view.reverse_z;
   pass.draw(w.table, cmd, w.assets.buffer(Impl::kVertices).buffer,
             w.assets.buffer(Impl::kIndices).buffer, w.reflection_draws, w.reflection_constants,
-            view.reverse_z);
+            mirrored);
 }
 
 }  // namespace siviflow

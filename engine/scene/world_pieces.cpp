@@ -54,7 +54,8 @@ void World::Impl::select_draws(const CullView& view, const gpu::SceneConstants& 
     const IndexRange& range = piece.levels[level];
     const glm::vec3 nearest = glm::clamp(view.camera, piece.lo, piece.hi);
     seen.push_back({glm::length(nearest - view.camera),
-                    {range.first_index, range.index_count, &constants, piece.material}});
+                    {range.first_index, range.index_count, &constants, piece.material,
+                     piece.one_sided}});
   }
   std::stable_sort(seen.begin(), seen.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });

@@ -57,6 +57,8 @@ namespace siviflow {
   X(vkCmdSetViewport)                  \
   X(vkCmdSetScissor)                   \
   X(vkCmdSetDepthCompareOp)            \
+  X(vkCmdSetCullMode)                  \
+  X(vkCmdSetFrontFace)                 \
   X(vkCmdDraw)                         \
   X(vkCmdDispatch)                     \
   X(vkCmdDrawIndexed)                  \

@@ -114,11 +114,15 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
     blend.attachmentCount = static_cast<uint32_t>(blend_attachments.size());
     blend.pAttachments = blend_attachments.data();
 
-    const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR,
-                                             VK_DYNAMIC_STATE_DEPTH_COMPARE_OP};
+    std::vector<VkDynamicState> dynamic_states = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    if (desc.dynamic_depth_compare) dynamic_states.push_back(VK_DYNAMIC_STATE_DEPTH_COMPARE_OP);
+    if (desc.dynamic_culling) {
+      dynamic_states.push_back(VK_DYNAMIC_STATE_CULL_MODE);
+      dynamic_states.push_back(VK_DYNAMIC_STATE_FRONT_FACE);
+    }
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dynamic.dynamicStateCount = desc.dynamic_depth_compare ? 3 : 2;
-    dynamic.pDynamicStates = dynamic_states;
+    dynamic.dynamicStateCount = static_cast<uint32_t>(dynamic_states.size());
+    dynamic.pDynamicStates = dynamic_states.data();
 
     VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
     rendering.colorAttachmentCount = static_cast<uint32_t>(color_formats.size());

@@ -35,6 +35,9 @@ struct GraphicsPipelineDesc {
   bool dynamic_depth_compare = false;  // set per draw (vkCmdSetDepthCompareOp): reverse-Z hosts
   VkCullModeFlags cull_mode = VK_CULL_MODE_NONE;
   VkFrontFace front_face = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  // Both set per draw (vkCmdSetCullMode, vkCmdSetFrontFace): one-sided and two-sided meshes,
+  // and mirrored views, share the pipeline.
+  bool dynamic_culling = false;
   bool alpha_blend = false;  // attachment 0: premultiplied-free "over" blending
 };
 

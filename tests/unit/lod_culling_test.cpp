@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
@@ -162,6 +163,26 @@ TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
         EXPECT_LE(p.x, piece.hi.x + 1e-4f);
         EXPECT_GE(p.z, piece.lo.z - 1e-4f);
         EXPECT_LE(p.z, piece.hi.z + 1e-4f);
+      }
+    }
+  }
+  // One-sided: every level's ground faces up and every skirt out of its chunk (a crack is seen
+  // from the neighbour's side), so culling back faces hides none of what the view sees.
+  for (const LodPiece& piece : geometry.pieces) {
+    EXPECT_TRUE(piece.one_sided);
+    const glm::vec3 centre = 0.5f * (piece.lo + piece.hi);
+    for (const IndexRange& level : piece.levels) {
+      for (uint32_t i = level.first_index; i < level.first_index + level.index_count; i += 3) {
+        const glm::vec3& a = geometry.vertices[geometry.indices[i]].position;
+        const glm::vec3& b = geometry.vertices[geometry.indices[i + 1]].position;
+        const glm::vec3& c = geometry.vertices[geometry.indices[i + 2]].position;
+        const glm::vec3 normal = glm::cross(b - a, c - a);
+        const glm::vec2 out(a.x + b.x + c.x - 3.0f * centre.x, a.z + b.z + c.z - 3.0f * centre.z);
+        if (std::abs(normal.y) > 1e-6f) {
+          EXPECT_GT(normal.y, 0.0f) << "ground triangle " << i / 3;
+        } else {
+          EXPECT_GT(normal.x * out.x + normal.z * out.y, 0.0f) << "skirt triangle " << i / 3;
+        }
       }
     }
   }

@@ -101,6 +101,45 @@ TEST(ViewMath, MirrorReflectsAboutTheWaterPlane) {
   for (int i = 0; i < 4; ++i) EXPECT_NEAR(a[i], b[i], 1e-4f);
 }
 
+// Vulkan's signed area of a triangle in framebuffer coordinates (x right, y down; the spec's
+// a = -1/2 sum(x_i y_i+1 - x_i+1 y_i)): positive is counter-clockwise.
+float framebuffer_area(const glm::mat4& view_proj, const glm::vec3 (&corners)[3]) {
+  glm::vec2 ndc[3];
+  for (int i = 0; i < 3; ++i) {
+    const glm::vec4 clip = view_proj * glm::vec4(corners[i], 1.0f);
+    ndc[i] = glm::vec2(clip) / clip.w;
+  }
+  float sum = 0.0f;
+  for (int i = 0; i < 3; ++i) {
+    const glm::vec2 a = ndc[i], b = ndc[(i + 1) % 3];
+    sum += a.x * b.y - b.x * a.y;
+  }
+  return -0.5f * sum;
+}
+
+TEST(ViewMath, OutsideFacesLandAsTheRasterizerSeesThem) {
+  // A patch of ground seen from above, its corners counter-clockwise about +Y (its outside).
+  const glm::vec3 ground[3] = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, {1.0f, 0.0f, 0.0f}};
+  ASSERT_GT(glm::cross(ground[1] - ground[0], ground[2] - ground[0]).y, 0.0f);
+  const glm::vec3 camera(1.0f, 5.0f, -20.0f);
+  for (const glm::mat4& projection : {standard(0.1f, 1000.0f), reverse_infinite(0.1f)}) {
+    const glm::mat4 view_proj = projection * kView;
+    const bool clockwise = outside_lands_clockwise(view_proj, camera);
+    EXPECT_EQ(framebuffer_area(view_proj, ground) < 0.0f, clockwise);
+    // The mirrored camera, under the water, sees a ceiling above the water from its outside
+    // (facing down): it lands the other way, and so does the answer.
+    const glm::mat4 mirrored = mirrored_view_proj(view_proj, 0.0f);
+    const glm::vec3 mirrored_camera = mirrored_point(camera, 0.0f);
+    const glm::vec3 lift(0.0f, 3.0f, 0.0f);
+    const glm::vec3 ceiling[3] = {ground[0] + lift, ground[2] + lift, ground[1] + lift};
+    EXPECT_EQ(outside_lands_clockwise(mirrored, mirrored_camera), !clockwise);
+    EXPECT_EQ(framebuffer_area(mirrored, ceiling) < 0.0f, !clockwise);
+  }
+  // Both depth conventions of one camera agree.
+  EXPECT_EQ(outside_lands_clockwise(standard(0.1f, 1000.0f) * kView, camera),
+            outside_lands_clockwise(reverse_infinite(0.1f) * kView, camera));
+}
+
 TEST(ViewMath, RefusesWhatIsNotAFinitePerspective) {
   ViewMath math;
   Status status = derive_view_math(kView, glm::orthoRH_ZO(-1.0f, 1.0f, -1.0f, 1.0f, 0.1f, 10.0f), &math);
