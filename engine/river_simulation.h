@@ -69,9 +69,9 @@ class RiverFlow {
                                         std::span<const uint32_t> indices, PlacedMesh* placed)>;
 
   // Solves the flow of `river` with the obstacles, and hands the mesh to `home` (if any) before
-  // anything reads it: a mesh placed there, outliving this flow, is then read from there and the
-  // flow's own copy freed (only a mesh read from the surface, see per_node_). Must not be moved
-  // after create(): the views keep spans into its per-vertex arrays.
+  // anything reads it: a mesh placed there, alive while anything reads this flow, is then read
+  // from there and the flow's own copy freed (only a mesh read from the surface, see per_node_).
+  // Must not be moved after create(): the views keep spans into its per-vertex arrays.
   Status create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
                 const MeshHome& home = {});
 

@@ -67,16 +67,14 @@ glm::mat4 shifted_by_pixels(const glm::mat4& m, glm::vec2 pixels, glm::vec2 size
   return out;
 }
 
-bool outside_lands_clockwise(const glm::mat4& view_proj, const glm::vec3& camera) {
-  // A triangle that lands on (0, 0), (1/2, 0), (0, 1/2) of normalized device space, halfway in
-  // depth, is clockwise there (y down). Brought back into the world, does it face the camera?
-  const glm::dmat4 inverse = glm::inverse(glm::dmat4(view_proj));
-  const auto world = [&inverse](double x, double y) {
-    const glm::dvec4 p = inverse * glm::dvec4(x, y, 0.5, 1.0);
-    return glm::dvec3(p) / p.w;
-  };
-  const glm::dvec3 a = world(0.0, 0.0), b = world(0.5, 0.0), c = world(0.0, 0.5);
-  return glm::dot(glm::cross(b - a, c - a), glm::dvec3(camera) - a) > 0.0;
+bool outside_lands_clockwise(const glm::mat4& view, const glm::mat4& projection) {
+  // Facing the camera, such a triangle is counter-clockwise in the view's x-y (y up) when the
+  // camera looks down its -z (clip w = -z); the projection's x-y part, a looking direction of +z
+  // and a mirrored view each turn it over. Clockwise is Vulkan's negative area.
+  const double screen = double(projection[0][0]) * projection[1][1] -
+                        double(projection[1][0]) * projection[0][1];
+  const double turns = screen * -double(projection[2][3]) * glm::determinant(glm::dmat3(view));
+  return turns > 0.0;
 }
 
 glm::mat4 mirrored_view_proj(const glm::mat4& view_proj, float height) {

@@ -38,11 +38,13 @@ glm::mat4 shifted_by_pixels(const glm::mat4& m, glm::vec2 pixels, glm::vec2 size
 // The far value of window depth under the convention.
 inline float far_depth(bool reverse_z) { return reverse_z ? 0.0f : 1.0f; }
 
-// Whether, under `view_proj` seen from `camera`, a triangle seen from its outside (its corners
-// counter-clockwise about its right-handed normal, towards the camera) lands clockwise in
-// Vulkan's framebuffer (x right, y down): the front face that culls what is seen from inside. A
-// mirrored view lands the other way; the depth convention does not change it.
-bool outside_lands_clockwise(const glm::mat4& view_proj, const glm::vec3& camera);
+// Whether, under `view` and the perspective `projection` (as derive_view_math takes them), a
+// triangle seen from its outside (its corners counter-clockwise about its right-handed normal,
+// towards the camera) lands clockwise in Vulkan's framebuffer (x right, y down): the front face
+// that culls what is seen from inside. From the matrices' signs alone, so exact at any distance
+// from the origin: a mirrored view or a flipped axis lands the other way, the depth convention
+// and an off-centre or jittered projection do not change it.
+bool outside_lands_clockwise(const glm::mat4& view, const glm::mat4& projection);
 
 // The view mirrored about the horizontal plane y = height, and the camera mirrored with it.
 glm::mat4 mirrored_view_proj(const glm::mat4& view_proj, float height);

@@ -32,7 +32,7 @@ Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat 
   scene.color_format = color_format;
   scene.depth_format = depth_format;
   scene.dynamic_depth_compare = true;  // the view's depth convention
-  scene.dynamic_culling = true;        // the terrain's back faces, in any view, mirrored or not
+  scene.dynamic_culling = true;        // the terrain's back faces in the main view only
   scene.bindings = {{0, sizeof(gpu::SceneVertex), VK_VERTEX_INPUT_RATE_VERTEX}};
   scene.attributes = {
       {SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(gpu::SceneVertex, position)},

@@ -305,7 +305,7 @@ Status World::Impl::record(VkCommandBuffer cmd, const View& view,
   // Back faces of the ground are hidden behind its front faces in the main view. Not in the
   // reflection: the water's edge, a little under the bank, reflects the bank's underside there.
   w.frame.cull_back_faces = true;
-  w.frame.outside_clockwise = outside_lands_clockwise(math.view_proj, math.camera_position);
+  w.frame.outside_clockwise = outside_lands_clockwise(view.view, view.projection);
   // Nothing clipped in the main view.
   w.main_constants = w.view_constants(math.view_proj, math.camera_position,
                                       glm::vec4(0.0f, 0.0f, 0.0f, 1.0f), math.reverse_z);

@@ -38,7 +38,9 @@ Status allocate(const GpuContext& gpu, const VkMemoryRequirements& requirements,
     return Status::error(std::string("no suitable memory type for '") + name + "'",
                          VK_ERROR_OUT_OF_DEVICE_MEMORY);
   }
-  if (type_flags != nullptr) *type_flags = gpu.memory_properties.memoryTypes[type_index].propertyFlags;
+  if (type_flags != nullptr) {
+    *type_flags = gpu.memory_properties.memoryTypes[type_index].propertyFlags;
+  }
   VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   info.allocationSize = requirements.size;
   info.memoryTypeIndex = type_index;
@@ -92,7 +94,12 @@ Status make_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags 
   if (memory == BufferMemory::kMappedIfUnified && unified_memory(gpu.memory_properties) &&
       find_memory_type(gpu.memory_properties, requirements.memoryTypeBits, wanted | kHost,
                        &shared_type)) {
-    wanted |= kHost;
+    // Cached where the device offers it: the host then reads it as fast as its own.
+    const VkMemoryPropertyFlags cached = wanted | kHost | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+    wanted = find_memory_type(gpu.memory_properties, requirements.memoryTypeBits, cached,
+                              &shared_type)
+                 ? cached
+                 : wanted | kHost;
   }
   VkMemoryPropertyFlags type_flags = 0;
   Status status = allocate(gpu, requirements, wanted, debug_name, &out->memory, &type_flags);

@@ -114,7 +114,8 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
     blend.attachmentCount = static_cast<uint32_t>(blend_attachments.size());
     blend.pAttachments = blend_attachments.data();
 
-    std::vector<VkDynamicState> dynamic_states = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    std::vector<VkDynamicState> dynamic_states = {VK_DYNAMIC_STATE_VIEWPORT,
+                                                  VK_DYNAMIC_STATE_SCISSOR};
     if (desc.dynamic_depth_compare) dynamic_states.push_back(VK_DYNAMIC_STATE_DEPTH_COMPARE_OP);
     if (desc.dynamic_culling) {
       dynamic_states.push_back(VK_DYNAMIC_STATE_CULL_MODE);

@@ -172,9 +172,12 @@ size_t differing_pixels(const Pane& a, const Pane& b, float* largest = nullptr) 
 
 TEST_F(SharedRiverTest, OnUnifiedMemoryTheFlowReadsTheMeshFromTheGpuBuffers) {
   // Lavapipe's memory is the host's, and cached: a long river's mesh is held once, not twice.
+  // (A discrete GPU's is not the host's: there the flow keeps its own, and the rest holds.)
   const std::unique_ptr<Renderer> first = make({64, 48});
   ASSERT_NE(first, nullptr);
-  EXPECT_TRUE(RendererInspector::flow_reads_gpu_mesh(*first));
+  if (context_->report().driver_id == VK_DRIVER_ID_MESA_LLVMPIPE) {
+    EXPECT_TRUE(RendererInspector::flow_reads_gpu_mesh(*first));
+  }
   const std::unique_ptr<Renderer> second = make({64, 48}, first.get());
   ASSERT_NE(second, nullptr);
   EXPECT_EQ(flow_field(*second).positions.data(), flow_field(*first).positions.data());

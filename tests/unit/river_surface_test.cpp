@@ -197,7 +197,11 @@ TEST(RiverSurface, SharedMeshIsReadFromTheSharerAndFreesItsOwn) {
   // What a unified-memory device's vertex and index buffers would hold.
   const std::vector<glm::vec3> positions(s.node_positions().begin(), s.node_positions().end());
   const std::vector<uint32_t> triangles(s.triangles().begin(), s.triangles().end());
+  const size_t nodes = s.node_count();
+  const size_t vertices = s.vertex_count();
   ASSERT_TRUE(s.share_mesh(positions, triangles).ok());
+  EXPECT_EQ(s.node_count(), nodes);
+  EXPECT_EQ(s.vertex_count(), vertices);
   EXPECT_EQ(s.node_positions().data(), positions.data());
   EXPECT_EQ(s.triangles().data(), triangles.data());
   EXPECT_EQ(s.triangle_count(), triangles.size() / 3);

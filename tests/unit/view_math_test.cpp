@@ -102,42 +102,63 @@ TEST(ViewMath, MirrorReflectsAboutTheWaterPlane) {
 }
 
 // Vulkan's signed area of a triangle in framebuffer coordinates (x right, y down; the spec's
-// a = -1/2 sum(x_i y_i+1 - x_i+1 y_i)): positive is counter-clockwise.
-float framebuffer_area(const glm::mat4& view_proj, const glm::vec3 (&corners)[3]) {
-  glm::vec2 ndc[3];
+// a = -1/2 sum(x_i y_i+1 - x_i+1 y_i)): positive is counter-clockwise. In doubles, so a view a
+// thousand kilometres out is measured exactly enough.
+double framebuffer_area(const glm::dmat4& view_proj, const glm::dvec3 (&corners)[3]) {
+  glm::dvec2 ndc[3];
   for (int i = 0; i < 3; ++i) {
-    const glm::vec4 clip = view_proj * glm::vec4(corners[i], 1.0f);
-    ndc[i] = glm::vec2(clip) / clip.w;
+    const glm::dvec4 clip = view_proj * glm::dvec4(corners[i], 1.0);
+    ndc[i] = glm::dvec2(clip) / clip.w;
   }
-  float sum = 0.0f;
+  double sum = 0.0;
   for (int i = 0; i < 3; ++i) {
-    const glm::vec2 a = ndc[i], b = ndc[(i + 1) % 3];
+    const glm::dvec2 a = ndc[i], b = ndc[(i + 1) % 3];
     sum += a.x * b.y - b.x * a.y;
   }
-  return -0.5f * sum;
+  return -0.5 * sum;
 }
 
 TEST(ViewMath, OutsideFacesLandAsTheRasterizerSeesThem) {
-  // A patch of ground seen from above, its corners counter-clockwise about +Y (its outside).
-  const glm::vec3 ground[3] = {{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, {1.0f, 0.0f, 0.0f}};
-  ASSERT_GT(glm::cross(ground[1] - ground[0], ground[2] - ground[0]).y, 0.0f);
-  const glm::vec3 camera(1.0f, 5.0f, -20.0f);
-  for (const glm::mat4& projection : {standard(0.1f, 1000.0f), reverse_infinite(0.1f)}) {
-    const glm::mat4 view_proj = projection * kView;
-    const bool clockwise = outside_lands_clockwise(view_proj, camera);
-    EXPECT_EQ(framebuffer_area(view_proj, ground) < 0.0f, clockwise);
-    // The mirrored camera, under the water, sees a ceiling above the water from its outside
-    // (facing down): it lands the other way, and so does the answer.
-    const glm::mat4 mirrored = mirrored_view_proj(view_proj, 0.0f);
-    const glm::vec3 mirrored_camera = mirrored_point(camera, 0.0f);
-    const glm::vec3 lift(0.0f, 3.0f, 0.0f);
-    const glm::vec3 ceiling[3] = {ground[0] + lift, ground[2] + lift, ground[1] + lift};
-    EXPECT_EQ(outside_lands_clockwise(mirrored, mirrored_camera), !clockwise);
-    EXPECT_EQ(framebuffer_area(mirrored, ceiling) < 0.0f, !clockwise);
+  glm::mat4 unflipped = standard(0.001f, 1000.0f);
+  unflipped[1][1] *= -1.0f;  // +Y up on screen: the image upside down, the winding reversed
+  glm::mat4 off_centre = reverse_infinite(0.001f);
+  off_centre[2][0] = 0.3f;  // an asymmetric frustum, or a TAA jitter
+  off_centre[2][1] = -0.2f;
+  const glm::mat4 projections[] = {standard(0.1f, 1000.0f), reverse_infinite(0.1f), unflipped,
+                                   off_centre};
+  glm::mat4 mirror(1.0f);  // about the water plane y = 2, as the reflection's view
+  mirror[1][1] = -1.0f;
+  mirror[3][1] = 4.0f;
+  int checked = 0;
+  for (const glm::vec3 eye : {glm::vec3(1.0f, 5.0f, -20.0f), glm::vec3(9.0e5f, 12.0f, -9.0e5f)}) {
+    const glm::mat4 looking =
+        glm::lookAtRH(eye, eye + glm::vec3(3.0f, -1.0f, 4.0f), glm::vec3(0.0f, 1.0f, 0.0f));
+    for (const glm::mat4& view : {looking, looking * mirror}) {
+      const glm::dmat4 inverse_view = glm::inverse(glm::dmat4(view));
+      const glm::dvec3 camera(inverse_view[3]);
+      for (const glm::mat4& projection : projections) {
+        const bool clockwise = outside_lands_clockwise(view, projection);
+        // Triangles ten metres in front of the eye, both windings: one is seen from outside.
+        for (const double turn : {1.0, -1.0}) {
+          const glm::dvec3 corners[3] = {
+              glm::dvec3(inverse_view * glm::dvec4(0.0, 0.0, -10.0, 1.0)),
+              glm::dvec3(inverse_view * glm::dvec4(1.0, 0.0, -10.0, 1.0)),
+              glm::dvec3(inverse_view * glm::dvec4(0.0, turn, -10.0, 1.0))};
+          const glm::dvec3 normal = glm::cross(corners[1] - corners[0], corners[2] - corners[0]);
+          const bool outside = glm::dot(normal, camera - corners[0]) > 0.0;
+          const double area = framebuffer_area(glm::dmat4(projection) * glm::dmat4(view), corners);
+          EXPECT_EQ(area < 0.0, outside == clockwise) << "eye " << eye.x << " turn " << turn;
+          ++checked;
+        }
+      }
+    }
   }
-  // Both depth conventions of one camera agree.
-  EXPECT_EQ(outside_lands_clockwise(standard(0.1f, 1000.0f) * kView, camera),
-            outside_lands_clockwise(reverse_infinite(0.1f) * kView, camera));
+  EXPECT_EQ(checked, 2 * 2 * 4 * 2);
+  // The main view and its mirror land the other way round; the depth convention changes nothing.
+  EXPECT_NE(outside_lands_clockwise(kView, standard(0.1f, 1000.0f)),
+            outside_lands_clockwise(kView * mirror, standard(0.1f, 1000.0f)));
+  EXPECT_EQ(outside_lands_clockwise(kView, standard(0.1f, 1000.0f)),
+            outside_lands_clockwise(kView, reverse_infinite(0.1f)));
 }
 
 TEST(ViewMath, RefusesWhatIsNotAFinitePerspective) {

@@ -1,7 +1,8 @@
 // The built-in world of SiViFlow's tools: sky, terrain, riverbed, a scene file's glTF objects,
-// a boulder at each obstacle, and the floating logs and leaves the host drifts. It is a host of the water renderer like any engine's world:
-// it draws into the host's colour and depth (every pixel of the view's) before the water is recorded, and
-// draws itself mirrored into the renderer's reflection through the reflection callback.
+// a boulder at each obstacle, and the floating logs and leaves the host drifts. It is a host of
+// the water renderer like any engine's world: it draws into the host's colour and depth (every
+// pixel of the view's) before the water is recorded, and draws itself mirrored into the
+// renderer's reflection through the reflection callback.
 //
 // Per frame, on the host's command buffer, with the host having waited for the slot:
 //   world->begin_frame(slot);
@@ -109,7 +110,8 @@ class World {
   Status begin_frame(uint32_t slot);
   // Records the world seen through `view` at `time_seconds` (obstacles where their keys put
   // them) into `color` and `depth`, writing every pixel of the view's viewport (depth cleared
-  // first, the sky where nothing else is), and leaves them in their final states. The depth convention (standard or reverse-Z) is the projection's.
+  // first, the sky where nothing else is), and leaves them in their final states. The depth
+  // convention (standard or reverse-Z) is the projection's.
   Status record(VkCommandBuffer cmd, const View& view, double time_seconds,
                 const ExternalImage& color, const ExternalImage& depth);
 

@@ -72,7 +72,7 @@ class RiverSurface {
   bool welded() const { return !node_of_vertex_.empty(); }
 
   // --- Per node (welded vertex); every index below is a node index ---
-  size_t node_count() const { return node_positions_.size(); }
+  size_t node_count() const { return node_positions().size(); }
   RiverVertex node(uint32_t n) const;
   std::span<const glm::vec3> node_positions() const {
     return shared_positions_.data() != nullptr ? shared_positions_ : std::span(node_positions_);
@@ -110,9 +110,9 @@ class RiverSurface {
   size_t memory_bytes() const;
 
   // From now on reads its node positions and triangles from `positions` and `triangles` (a
-  // unified-memory device's vertex and index buffers), which hold the same values and outlive
-  // it, and frees its own: a long river's mesh is then held once. Fails, changing nothing, when
-  // they differ from its own.
+  // unified-memory device's vertex and index buffers), which hold the same values and stay
+  // alive while anything reads the surface, and frees its own: a long river's mesh is then held
+  // once. Fails, changing nothing, when they differ from its own.
   Status share_mesh(std::span<const glm::vec3> positions, std::span<const uint32_t> triangles);
 
  private:
