@@ -391,6 +391,8 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   reflection_view.reverse_z = view.reverse_z;
 
   choose_water_draws();
+  reflection_view.area = reflection_area(water_bounds, look.reflection_distortion,
+                                         reflection_extent(info.extent));
   const FlowTextureLayout& layout = simulation.layout();
   water_frame.flow.view_proj = view.view_proj;
   water_frame.flow.camera_position = glm::vec4(view.camera_position, view.depth_ratio_constant);
@@ -435,8 +437,13 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
 // follows what is on screen, not its length.
 void Renderer::Impl::choose_water_draws() {
   water_draws.clear();
+  water_bounds = glm::vec4(1.0f, 1.0f, 0.0f, 0.0f);
   for (const SharedRiver::Chunk& chunk : river->chunks) {
     if (box_outside_view(chunk.lo, chunk.hi, view.view_proj)) continue;
+    const glm::vec4 bounds = box_screen_bounds(chunk.lo, chunk.hi, view.view_proj);
+    water_bounds = glm::vec4(glm::min(glm::vec2(water_bounds), glm::vec2(bounds)),
+                             glm::max(glm::vec2(water_bounds.z, water_bounds.w),
+                                      glm::vec2(bounds.z, bounds.w)));
     if (!water_draws.empty() && water_draws.back().first_index + water_draws.back().index_count ==
                                     chunk.indices.first_index) {
       water_draws.back().index_count += chunk.indices.index_count;
@@ -660,6 +667,12 @@ bool RendererInspector::flow_reads_gpu_mesh(const Renderer& renderer) {
   return river.flow.positions().data() ==
              river.assets.buffer(SharedRiver::kRiverVertices).mapped &&
          river.flow.indices().data() == river.assets.buffer(SharedRiver::kRiverIndices).mapped;
+}
+VkRect2D RendererInspector::reflection_area(const Renderer& renderer) {
+  return renderer.impl_->reflection_view.area;
+}
+VkExtent2D RendererInspector::reflection_extent(const Renderer& renderer) {
+  return siviflow::reflection_extent(renderer.impl_->info.extent);
 }
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 uint64_t Renderer::flow_solves() const { return impl_->river->flow.full_solves(); }

@@ -15,6 +15,17 @@ VkExtent2D reflection_extent(VkExtent2D extent) {
           std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
 }
 
+VkRect2D reflection_area(const glm::vec4& water, float distortion, VkExtent2D size) {
+  if (!(water.x <= water.z && water.y <= water.w)) return VkRect2D{};
+  const auto edge = [distortion](float uv, float sign, uint32_t texels) {
+    const float at = std::floor((uv + sign * distortion) * float(texels) + sign * 0.5f) + sign;
+    return static_cast<uint32_t>(std::clamp(at, 0.0f, float(texels)));
+  };
+  const uint32_t x0 = edge(water.x, -1.0f, size.width), x1 = edge(water.z, 1.0f, size.width);
+  const uint32_t y0 = edge(water.y, -1.0f, size.height), y1 = edge(water.w, 1.0f, size.height);
+  return {{static_cast<int32_t>(x0), static_cast<int32_t>(y0)}, {x1 - x0, y1 - y0}};
+}
+
 VkFormat reflection_format(VkFormat color_format) {
   if (color_channel_count(color_format) < 3) return VK_FORMAT_UNDEFINED;
   // Without alpha there is no "nothing reflected here, show the sky"; 32-bit floats add nothing

@@ -9,6 +9,7 @@
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
 
 #include "entry_guard.h"
 #include "gpu_timer.h"
@@ -63,6 +64,7 @@ struct Renderer::Impl {
   FrameBindings bindings;
   FlowPass::Frame water_frame;  // of the frame being prepared: push constants, look, host depth
   std::vector<IndexRange> water_draws;  // the surface's runs the frame's view sees, joined
+  glm::vec4 water_bounds{1.0f, 1.0f, 0.0f, 0.0f};  // their box_screen_bounds, joined (x0 > x1: none)
   // Where the graph's passes read this frame's upload list, readback copies, reflection view and
   // the viewport's offset in the host's images (the refraction copy's source).
   DataHandle<UploadList> uploads_data;
@@ -141,6 +143,10 @@ inline constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 inline constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
 // The reflection target's size for a view of `extent`.
 VkExtent2D reflection_extent(VkExtent2D extent);
+// The texels of a reflection target of `size` that the water samples: `water` (box_screen_bounds
+// of the water in view; x0 > x1 when none is) widened by `distortion` (texture coordinates per
+// unit of ripple tilt, which stays under 1) and a texel for the filter. Empty when no water is.
+VkRect2D reflection_area(const glm::vec4& water, float distortion, VkExtent2D size);
 
 inline constexpr std::string_view kRendererErrorPrefix = "siviflow::Renderer: ";
 

@@ -22,6 +22,9 @@ class RendererInspector {
   // Whether the flow reads the river's positions and indices from the GPU's vertex and index
   // buffers (a unified-memory device's) rather than from a copy of its own.
   static bool flow_reads_gpu_mesh(const Renderer& renderer);
+  // The last updated frame's ReflectionView::area, and the reflection target's size.
+  static VkRect2D reflection_area(const Renderer& renderer);
+  static VkExtent2D reflection_extent(const Renderer& renderer);
 };
 
 inline const ParticleField& particle_field(const Renderer& renderer) {

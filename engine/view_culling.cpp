@@ -31,4 +31,33 @@ bool box_outside_view(const glm::vec3& lo, const glm::vec3& hi, const glm::mat4&
                      [&](const glm::vec4& plane) { return below(lo, hi, plane); });
 }
 
+glm::vec4 box_screen_bounds(const glm::vec3& lo, const glm::vec3& hi, const glm::mat4& view_proj) {
+  // The part of the box in front of the eye: its corners there, and where its edges cross a plane
+  // a millimetre before the eye (clip coordinates are linear along an edge). Near the eye they
+  // land far off screen, on the side they are seen: clamped, the bounds stay whole.
+  constexpr float kNear = 1e-3f;
+  glm::vec4 clip[8];
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 p((corner & 1) != 0 ? hi.x : lo.x, (corner & 2) != 0 ? hi.y : lo.y,
+                      (corner & 4) != 0 ? hi.z : lo.z);
+    clip[corner] = view_proj * glm::vec4(p, 1.0f);
+  }
+  glm::vec2 low(1.0f), high(0.0f);
+  const auto add = [&](const glm::vec4& c) {
+    const glm::vec2 uv = glm::clamp(0.5f * glm::vec2(c) / c.w + 0.5f, -1.0f, 2.0f);
+    low = glm::min(low, uv);
+    high = glm::max(high, uv);
+  };
+  for (int a = 0; a < 8; ++a) {
+    if (clip[a].w >= kNear) add(clip[a]);
+    for (const int axis : {1, 2, 4}) {
+      const int b = a | axis;
+      if (b == a) continue;  // each edge once, from its lower corner
+      const float wa = clip[a].w - kNear, wb = clip[b].w - kNear;
+      if ((wa < 0.0f) != (wb < 0.0f)) add(clip[a] + (wa / (wa - wb)) * (clip[b] - clip[a]));
+    }
+  }
+  return {glm::clamp(low, 0.0f, 1.0f), glm::clamp(high, 0.0f, 1.0f)};
+}
+
 }  // namespace siviflow

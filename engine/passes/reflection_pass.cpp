@@ -17,6 +17,7 @@ DataHandle<ReflectionView> add_reflection_pass(FrameGraph& graph, ImageHandle* c
     ReflectionView mirrored = ctx.data(view);
     mirrored.extent = ctx.extent(target);
     set_viewport(ctx.table(), ctx.cmd(), mirrored.extent);
+    ctx.table().vkCmdSetScissor(ctx.cmd(), 0, 1, &mirrored.area);  // what the water samples
     callback(ctx.cmd(), mirrored, user);
     return Status::success();
   });

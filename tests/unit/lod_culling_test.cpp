@@ -10,6 +10,7 @@
 
 #include "scene/lod_culling.h"
 #include "scene/terrain_chunks.h"
+#include "view_culling.h"
 
 namespace siviflow {
 namespace {
@@ -135,6 +136,44 @@ TEST(LodCulling, ObjectsHaveOneLevelAtAnyDistance) {
   object.hi = {12.0f, 3.0f, 202.0f};
   object.levels = {{0, 300}};  // no level errors: one level
   EXPECT_EQ(choose_level(object, view_from({12.0f, 5.0f, 0.0f})), 0u);
+}
+
+TEST(ViewCulling, ScreenBoundsHoldTheBoxAndCutItAtTheEye) {
+  const CullView view = view_from({0.0f, 5.0f, 0.0f});  // looking along +Z, 5 m up
+  const auto inside = [&](const glm::vec4& b, const glm::vec3& lo, const glm::vec3& hi) {
+    // Every point of the box in front of the eye lands within the bounds.
+    for (int i = 0; i <= 8; ++i) {
+      for (int j = 0; j <= 8; ++j) {
+        for (int k = 0; k <= 8; ++k) {
+          const glm::vec3 p = lo + (hi - lo) * glm::vec3(i, j, k) / 8.0f;
+          const glm::vec4 clip = view.view_proj * glm::vec4(p, 1.0f);
+          if (clip.w < 0.01f) continue;
+          const glm::vec2 uv = glm::clamp(0.5f * glm::vec2(clip) / clip.w + 0.5f, 0.0f, 1.0f);
+          if (uv.x < b.x - 1e-5f || uv.x > b.z + 1e-5f || uv.y < b.y - 1e-5f || uv.y > b.w + 1e-5f) {
+            return false;
+          }
+        }
+      }
+    }
+    return true;
+  };
+  // A box ahead, below the horizon: a small part of the view, in its lower half.
+  const glm::vec3 ahead_lo(-1.0f, 0.0f, 20.0f), ahead_hi(1.0f, 1.0f, 24.0f);
+  const glm::vec4 ahead = box_screen_bounds(ahead_lo, ahead_hi, view.view_proj);
+  EXPECT_TRUE(inside(ahead, ahead_lo, ahead_hi));
+  EXPECT_LT(ahead.z - ahead.x, 0.2f);
+  EXPECT_GT(ahead.y, 0.5f);
+  // The water under the eye, reaching behind it: cut at the eye, it still leaves out the sky.
+  const glm::vec3 under_lo(-20.0f, -1.0f, -30.0f), under_hi(20.0f, 0.0f, 200.0f);
+  const glm::vec4 under = box_screen_bounds(under_lo, under_hi, view.view_proj);
+  EXPECT_TRUE(inside(under, under_lo, under_hi));
+  EXPECT_GT(under.y, 0.5f);
+  EXPECT_EQ(under.w, 1.0f);
+  EXPECT_EQ(under.x, 0.0f);
+  EXPECT_EQ(under.z, 1.0f);
+  // Wholly behind: nothing.
+  const glm::vec4 behind = box_screen_bounds({-1.0f, 0.0f, -10.0f}, {1.0f, 1.0f, -5.0f}, view.view_proj);
+  EXPECT_GT(behind.x, behind.z);
 }
 
 TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {

@@ -81,13 +81,17 @@ struct ReflectionView {
   VkExtent2D extent;     // of the reflection target
   bool reverse_z;        // the host's projection maps near to 1 and far to 0 (depth cleared to 0)
   VkFormat format;       // of the reflection target: reflection_format(CreateInfo::color_format)
+  // The part of the target the water samples this frame (the water on screen, widened by how far
+  // its ripples bend a sample); the scissor is set to it. Empty when no water is in view.
+  VkRect2D area;
 };
 // Records the host's world into the reflection target. Called inside the reflection pass, with
 // dynamic rendering begun (colour: ReflectionView::format, cleared to transparent black;
 // depth: VK_FORMAT_D32_SFLOAT, cleared to the far value of the view's depth convention) and
-// viewport and scissor set; the host binds its own pipelines (with that rendering format and
-// gl_ClipDistance against clip_plane) and must not end the rendering. Where the host leaves
-// the colour's alpha at 0, the water reflects the sky along the reflected ray.
+// viewport (the whole target) and scissor (ReflectionView::area) set; the host binds its own
+// pipelines (with that rendering format and gl_ClipDistance against clip_plane) and must not
+// end the rendering. Where the host leaves the colour's alpha at 0, the water reflects the sky
+// along the reflected ray.
 using ReflectionCallback = void (*)(VkCommandBuffer cmd, const ReflectionView& view, void* user);
 using LogCallback = void (*)(LogLevel level, const char* message, void* user);
 
