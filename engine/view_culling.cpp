@@ -60,4 +60,16 @@ glm::vec4 box_screen_bounds(const glm::vec3& lo, const glm::vec3& hi, const glm:
   return {glm::clamp(low, 0.0f, 1.0f), glm::clamp(high, 0.0f, 1.0f)};
 }
 
+glm::mat4 narrowed_view(const glm::mat4& view_proj, const glm::vec4& area) {
+  // In clip space the part spans x from (2 x0 - 1) w to (2 x1 - 1) w: recentred and rescaled.
+  const glm::vec2 centre = glm::vec2(area.x + area.z, area.y + area.w) - 1.0f;
+  const glm::vec2 half(area.z - area.x, area.w - area.y);
+  glm::mat4 narrow(1.0f);
+  narrow[0][0] = 1.0f / half.x;
+  narrow[1][1] = 1.0f / half.y;
+  narrow[3][0] = -centre.x / half.x;
+  narrow[3][1] = -centre.y / half.y;
+  return narrow * view_proj;
+}
+
 }  // namespace siviflow

@@ -18,4 +18,9 @@ bool box_outside_view(const glm::vec3& lo, const glm::vec3& hi, const glm::mat4&
 // behind the eye is cut there first. x0 > x1 when it lies wholly behind.
 glm::vec4 box_screen_bounds(const glm::vec3& lo, const glm::vec3& hi, const glm::mat4& view_proj);
 
+// `view_proj` narrowed to the part `area` (x0, y0, x1, y1 in texture coordinates, x0 < x1 and
+// y0 < y1) of its view: that part maps to the whole of clip space, so box_outside_view culls
+// what lies outside it.
+glm::mat4 narrowed_view(const glm::mat4& view_proj, const glm::vec4& area);
+
 }  // namespace siviflow

@@ -13,6 +13,7 @@
 #include "scene/scene_objects.h"
 #include "scene/world_impl.h"
 #include "siviflow/scene_river.h"
+#include "view_culling.h"
 #include "view_math.h"
 #include "vk/pipeline.h"
 #include "vk/vk_text.h"
@@ -369,14 +370,23 @@ void World::draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, voi
   std::memcpy(&clip_plane[0], view.clip_plane, sizeof(view.clip_plane));
   std::memcpy(&camera[0], view.camera_position, sizeof(view.camera_position));
   w.reflection_constants = w.view_constants(view_proj, camera, clip_plane, view.reverse_z);
+  // Only what the water samples (the scissor): the frustum narrowed to it.
+  const bool sampled = view.area.extent.width > 0 && view.area.extent.height > 0;
+  const glm::vec2 size(view.extent.width, view.extent.height);
+  const glm::vec2 lo = glm::vec2(view.area.offset.x, view.area.offset.y) / size;
+  const glm::vec2 hi = lo + glm::vec2(view.area.extent.width, view.area.extent.height) / size;
   CullView cull;
-  cull.view_proj = view_proj;
+  cull.view_proj = sampled ? narrowed_view(view_proj, glm::vec4(lo, hi)) : view_proj;
   cull.camera = camera;
   cull.clip_plane = clip_plane;
   cull.focal_pixels = focal_pixels(w.projection, float(view.extent.height));
   cull.max_error_pixels = kReflectionErrorPixels;
   w.select_draws(cull, w.reflection_constants, 1, &w.reflection_draws,
                  &w.stats.reflection_triangles);
+  if (!sampled) {
+    w.reflection_draws.clear();
+    w.stats.reflection_triangles = 0;
+  }
   const ScenePass& pass = w.own_reflection_pass ? w.reflection_pass : w.main_pass;
   ScenePass::Frame mirrored;
   mirrored.reverse_z = view.reverse_z;

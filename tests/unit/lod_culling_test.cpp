@@ -176,6 +176,29 @@ TEST(ViewCulling, ScreenBoundsHoldTheBoxAndCutItAtTheEye) {
   EXPECT_GT(behind.x, behind.z);
 }
 
+TEST(ViewCulling, ANarrowedViewCullsWhatLiesOutsideItsPart) {
+  const CullView view = view_from({0.0f, 5.0f, 0.0f});  // looking along +Z: -X to the right
+  // The lower half of the view, left third.
+  const glm::vec4 part(0.0f, 0.5f, 1.0f / 3.0f, 1.0f);
+  const glm::mat4 narrowed = narrowed_view(view.view_proj, part);
+  // That part now spans the whole of clip space: its corners land on clip space's.
+  const glm::vec4 lower_left = box_screen_bounds({12.0f, -2.0f, 20.0f}, {13.0f, -1.0f, 21.0f},
+                                                 view.view_proj);
+  ASSERT_GT(lower_left.x, part.x);  // on screen, inside the part
+  ASSERT_LT(lower_left.z, part.z);
+  ASSERT_GT(lower_left.y, part.y);
+  ASSERT_LT(lower_left.w, part.w);
+  const glm::vec4 same = box_screen_bounds({12.0f, -2.0f, 20.0f}, {13.0f, -1.0f, 21.0f}, narrowed);
+  EXPECT_NEAR(same.x, (lower_left.x - part.x) / (part.z - part.x), 1e-4f);
+  EXPECT_NEAR(same.y, (lower_left.y - part.y) / (part.w - part.y), 1e-4f);
+  EXPECT_FALSE(box_outside_view({12.0f, -2.0f, 20.0f}, {13.0f, -1.0f, 21.0f}, narrowed));
+  // A box in the view's upper half, or on its right, is outside the part.
+  EXPECT_FALSE(box_outside_view({-1.0f, 20.0f, 40.0f}, {1.0f, 21.0f, 41.0f}, view.view_proj));
+  EXPECT_TRUE(box_outside_view({-1.0f, 20.0f, 40.0f}, {1.0f, 21.0f, 41.0f}, narrowed));
+  EXPECT_FALSE(box_outside_view({-21.0f, -2.0f, 40.0f}, {-20.0f, -1.0f, 41.0f}, view.view_proj));
+  EXPECT_TRUE(box_outside_view({-21.0f, -2.0f, 40.0f}, {-20.0f, -1.0f, 41.0f}, narrowed));
+}
+
 TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
   const SceneGeometry geometry = rolling_grid(40, 20, 1.0f);
   // 40 x 20 quads in 16-quad chunks: 3 x 2, the last row and column narrower.
