@@ -391,8 +391,9 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   reflection_view.reverse_z = view.reverse_z;
 
   choose_water_draws();
-  reflection_view.area = reflection_area(water_bounds, look.reflection_distortion,
-                                         reflection_extent(info.extent));
+  reflection_view.area = sampled_area(water_bounds, look.reflection_distortion,
+                                      reflection_extent(info.extent));
+  refraction_copy.area = sampled_area(water_bounds, look.refraction_distortion, info.extent);
   const FlowTextureLayout& layout = simulation.layout();
   water_frame.flow.view_proj = view.view_proj;
   water_frame.flow.camera_position = glm::vec4(view.camera_position, view.depth_ratio_constant);
@@ -673,6 +674,9 @@ VkRect2D RendererInspector::reflection_area(const Renderer& renderer) {
 }
 VkExtent2D RendererInspector::reflection_extent(const Renderer& renderer) {
   return siviflow::reflection_extent(renderer.impl_->info.extent);
+}
+VkRect2D RendererInspector::refraction_area(const Renderer& renderer) {
+  return renderer.impl_->refraction_copy.area;
 }
 uint64_t Renderer::next_frame() const { return impl_->simulation.next_frame(); }
 uint64_t Renderer::flow_solves() const { return impl_->river->flow.full_solves(); }

@@ -15,7 +15,7 @@ VkExtent2D reflection_extent(VkExtent2D extent) {
           std::max(1u, static_cast<uint32_t>(std::lround(extent.height * kDefaultReflectionScale)))};
 }
 
-VkRect2D reflection_area(const glm::vec4& water, float distortion, VkExtent2D size) {
+VkRect2D sampled_area(const glm::vec4& water, float distortion, VkExtent2D size) {
   if (!(water.x <= water.z && water.y <= water.w)) return VkRect2D{};
   const auto edge = [distortion](float uv, float sign, uint32_t texels) {
     const float at = std::floor((uv + sign * distortion) * float(texels) + sign * 0.5f) + sign;
@@ -260,7 +260,8 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   b.bind_data(flow_pass.frame_data(), &water_frame);
   b.bind_data(uploads_data, &frame_uploads);
   b.bind_data(reflection_data, &reflection_view);
-  b.bind_data(refraction_data, &viewport.offset);
+  refraction_copy.viewport_offset = viewport.offset;
+  b.bind_data(refraction_data, &refraction_copy);
   if (readbacks_data.valid()) b.bind_data(readbacks_data, &readbacks);
   return Status::success();
 }

@@ -66,11 +66,12 @@ struct Renderer::Impl {
   std::vector<IndexRange> water_draws;  // the surface's runs the frame's view sees, joined
   glm::vec4 water_bounds{1.0f, 1.0f, 0.0f, 0.0f};  // their box_screen_bounds, joined (x0 > x1: none)
   // Where the graph's passes read this frame's upload list, readback copies, reflection view and
-  // the viewport's offset in the host's images (the refraction copy's source).
+  // refraction copy.
   DataHandle<UploadList> uploads_data;
   DataHandle<std::vector<ReadbackCopy>> readbacks_data;
   DataHandle<ReflectionView> reflection_data;
-  DataHandle<VkOffset2D> refraction_data;
+  DataHandle<RefractionCopy> refraction_data;
+  RefractionCopy refraction_copy;
   ViewMath view;        // of the frame being prepared, in river space, as drawn (jittered)
   glm::mat4 steady_view_proj{1.0f};  // river -> clip without the jitter: particles, motion
   glm::mat4 previous_view_proj{1.0f};  // what this frame's motion is measured from
@@ -143,10 +144,11 @@ inline constexpr VkFormat kParticleAuxFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 inline constexpr float kDefaultReflectionScale = 0.5f;  // reflection target size relative to the view
 // The reflection target's size for a view of `extent`.
 VkExtent2D reflection_extent(VkExtent2D extent);
-// The texels of a reflection target of `size` that the water samples: `water` (box_screen_bounds
-// of the water in view; x0 > x1 when none is) widened by `distortion` (texture coordinates per
-// unit of ripple tilt, which stays under 1) and a texel for the filter. Empty when no water is.
-VkRect2D reflection_area(const glm::vec4& water, float distortion, VkExtent2D size);
+// The texels of a view-covering target of `size` (the reflection, the refraction copy) that the
+// water samples: `water` (box_screen_bounds of the water in view; x0 > x1 when none is) widened
+// by `distortion` (texture coordinates per unit of ripple tilt, which stays under 1) and a texel
+// for the filter. Empty when no water is.
+VkRect2D sampled_area(const glm::vec4& water, float distortion, VkExtent2D size);
 
 inline constexpr std::string_view kRendererErrorPrefix = "siviflow::Renderer: ";
 

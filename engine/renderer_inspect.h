@@ -25,6 +25,8 @@ class RendererInspector {
   // The last updated frame's ReflectionView::area, and the reflection target's size.
   static VkRect2D reflection_area(const Renderer& renderer);
   static VkExtent2D reflection_extent(const Renderer& renderer);
+  // The last updated frame's part of the view the refraction copy takes (view pixels).
+  static VkRect2D refraction_area(const Renderer& renderer);
 };
 
 inline const ParticleField& particle_field(const Renderer& renderer) {

@@ -61,12 +61,18 @@ DataHandle<ReflectionView> add_reflection_pass(FrameGraph& graph, ImageHandle* c
 
 // ---- refraction copy: what the host drew, before the water, for the water to see through ----
 
+// What a frame's refraction copy takes: the viewport's offset in the host's image, and the part
+// of the view (its own pixels) the water samples; nothing is copied when that part is empty.
+struct RefractionCopy {
+  VkOffset2D viewport_offset{0, 0};
+  VkRect2D area{};
+};
 // Declares the copy of the view's viewport of the host's `color` into `copy` (the view's size,
 // the colour's format; its handle is replaced by the written version), which the water samples
 // where it refracts: an image cannot be sampled while it is drawn to. Each execute binds the
-// viewport's offset in the host's image to the returned handle.
-DataHandle<VkOffset2D> add_refraction_copy_pass(FrameGraph& graph, ImageHandle color,
-                                                ImageHandle* copy);
+// frame's RefractionCopy to the returned handle; the rest of `copy` is never sampled.
+DataHandle<RefractionCopy> add_refraction_copy_pass(FrameGraph& graph, ImageHandle color,
+                                                    ImageHandle* copy);
 
 // ---- flow: the water material of Algorithm 3, drawn over the scene ----
 

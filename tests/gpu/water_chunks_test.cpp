@@ -1,7 +1,7 @@
 // The water surface is drawn in chunks culled to the view, so a river's GPU cost follows the
 // screen: a view of a long river's first reach draws a small part of its triangles, a view
 // away from the water draws none, and the water a view sees is still all there. The reflection
-// is drawn only where the water on screen samples it.
+// is drawn, and the refraction copied, only where the water on screen samples them.
 #include <algorithm>
 #include <string>
 
@@ -53,42 +53,53 @@ TEST_F(WaterChunksTest, ALongRiverDrawsTheReachInView) {
   EXPECT_EQ(draw(above), total);
 }
 
-TEST_F(WaterChunksTest, TheReflectionIsDrawnWhereTheWaterSamplesIt) {
+TEST_F(WaterChunksTest, TheReflectionAndRefractionAreMadeWhereTheWaterSamplesThem) {
   ASSERT_TRUE(create_renderer(make_create_info(kWidth, kHeight)).ok());
   Frame frame;
   ASSERT_GT(draw(world_->scene_camera(0.0), &frame), 0u);
   // Every water pixel's reflection sample, bent by the ripples up to the look's distortion, lies
   // in the area the reflection is drawn in.
-  const VkRect2D area = RendererInspector::reflection_area(*renderer_);
-  const VkExtent2D size = RendererInspector::reflection_extent(*renderer_);
-  const float reach = WaterLook{}.reflection_distortion;
+  // The same holds for the refraction copy, bent by the refraction's distortion, in view pixels.
+  const VkRect2D reflected = RendererInspector::reflection_area(*renderer_);
+  const VkRect2D refracted = RendererInspector::refraction_area(*renderer_);
+  const VkExtent2D mirror_size = RendererInspector::reflection_extent(*renderer_);
+  const VkExtent2D view_size{kWidth, kHeight};
+  const WaterLook look;
+  const auto holds = [&](const VkRect2D& area, VkExtent2D size, float reach, uint32_t x,
+                         uint32_t y) {
+    for (const float dx : {-reach, reach}) {
+      for (const float dy : {-reach, reach}) {
+        const float u = std::clamp((x + 0.5f) / kWidth + dx, 0.0f, 1.0f) * size.width;
+        const float v = std::clamp((y + 0.5f) / kHeight + dy, 0.0f, 1.0f) * size.height;
+        if (u < float(area.offset.x) || u > float(area.offset.x + area.extent.width) ||
+            v < float(area.offset.y) || v > float(area.offset.y + area.extent.height)) {
+          return false;
+        }
+      }
+    }
+    return true;
+  };
   size_t water_pixels = 0;
   for (uint32_t y = 0; y < kHeight; ++y) {
     for (uint32_t x = 0; x < kWidth; ++x) {
       if (frame.water_mask[size_t{y} * kWidth + x] < 0.5f) continue;
       ++water_pixels;
-      for (const float dx : {-reach, reach}) {
-        for (const float dy : {-reach, reach}) {
-          const float u = std::clamp((x + 0.5f) / kWidth + dx, 0.0f, 1.0f) * size.width;
-          const float v = std::clamp((y + 0.5f) / kHeight + dy, 0.0f, 1.0f) * size.height;
-          ASSERT_GE(u, float(area.offset.x)) << x << "," << y;
-          ASSERT_LE(u, float(area.offset.x + area.extent.width)) << x << "," << y;
-          ASSERT_GE(v, float(area.offset.y)) << x << "," << y;
-          ASSERT_LE(v, float(area.offset.y + area.extent.height)) << x << "," << y;
-        }
-      }
+      ASSERT_TRUE(holds(reflected, mirror_size, look.reflection_distortion, x, y)) << x << "," << y;
+      ASSERT_TRUE(holds(refracted, view_size, look.refraction_distortion, x, y)) << x << "," << y;
     }
   }
   ASSERT_GT(water_pixels, 0u);
   // And the sky above the far bank is left out: the water is low on the screen.
-  EXPECT_GT(area.offset.y, 0);
-  EXPECT_LT(area.extent.height, size.height * 3 / 4);
+  EXPECT_GT(reflected.offset.y, 0);
+  EXPECT_LT(reflected.extent.height, mirror_size.height * 3 / 4);
+  EXPECT_LT(refracted.extent.height, kHeight * 3 / 4);
 
-  // Looking up into the sky, no water: nothing is drawn into the reflection.
+  // Looking up into the sky, no water: nothing is drawn into the reflection, nothing copied.
   Camera up = world_->scene_camera(0.0);
   up.target = up.position + glm::vec3(0.0f, 10.0f, 0.1f);
   EXPECT_EQ(draw(up), 0u);
   EXPECT_EQ(RendererInspector::reflection_area(*renderer_).extent.width, 0u);
+  EXPECT_EQ(RendererInspector::refraction_area(*renderer_).extent.width, 0u);
 }
 
 }  // namespace
