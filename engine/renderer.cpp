@@ -393,7 +393,8 @@ Status Renderer::Impl::simulate(const View& host_view, double time_seconds) {
   choose_water_draws();
   reflection_view.area = sampled_area(water_bounds, look.reflection_distortion,
                                       reflection_extent(info.extent));
-  refraction_copy.area = sampled_area(water_bounds, look.refraction_distortion, info.extent);
+  refraction_copy = {rect.offset,
+                     sampled_area(water_bounds, look.refraction_distortion, info.extent)};
   const FlowTextureLayout& layout = simulation.layout();
   water_frame.flow.view_proj = view.view_proj;
   water_frame.flow.camera_position = glm::vec4(view.camera_position, view.depth_ratio_constant);

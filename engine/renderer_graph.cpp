@@ -260,7 +260,6 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   b.bind_data(flow_pass.frame_data(), &water_frame);
   b.bind_data(uploads_data, &frame_uploads);
   b.bind_data(reflection_data, &reflection_view);
-  refraction_copy.viewport_offset = viewport.offset;
   b.bind_data(refraction_data, &refraction_copy);
   if (readbacks_data.valid()) b.bind_data(readbacks_data, &readbacks);
   return Status::success();

@@ -71,7 +71,7 @@ struct Renderer::Impl {
   DataHandle<std::vector<ReadbackCopy>> readbacks_data;
   DataHandle<ReflectionView> reflection_data;
   DataHandle<RefractionCopy> refraction_data;
-  RefractionCopy refraction_copy;
+  RefractionCopy refraction_copy;  // of the frame being prepared
   ViewMath view;        // of the frame being prepared, in river space, as drawn (jittered)
   glm::mat4 steady_view_proj{1.0f};  // river -> clip without the jitter: particles, motion
   glm::mat4 previous_view_proj{1.0f};  // what this frame's motion is measured from

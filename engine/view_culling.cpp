@@ -44,7 +44,7 @@ glm::vec4 box_screen_bounds(const glm::vec3& lo, const glm::vec3& hi, const glm:
   }
   glm::vec2 low(1.0f), high(0.0f);
   const auto add = [&](const glm::vec4& c) {
-    const glm::vec2 uv = glm::clamp(0.5f * glm::vec2(c) / c.w + 0.5f, -1.0f, 2.0f);
+    const glm::vec2 uv = 0.5f * glm::vec2(c) / c.w + 0.5f;
     low = glm::min(low, uv);
     high = glm::max(high, uv);
   };

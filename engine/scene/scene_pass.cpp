@@ -120,17 +120,18 @@ void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertic
   bool culling = false;
   for (const SceneDraw& d : draws) {
     const VkPipeline pipeline = d.material == 0 ? scene_pipeline_ : object_pipeline_;
-    if (pipeline != bound) {
+    const bool cull = view.cull_back_faces && d.one_sided;
+    const bool rebound = pipeline != bound;
+    if (rebound) {
       vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
       vk.vkCmdSetDepthCompareOp(cmd, view.reverse_z ? VK_COMPARE_OP_GREATER : VK_COMPARE_OP_LESS);
       vk.vkCmdSetFrontFace(cmd, view.outside_clockwise ? VK_FRONT_FACE_CLOCKWISE
                                                        : VK_FRONT_FACE_COUNTER_CLOCKWISE);
-      culling = view.cull_back_faces && d.one_sided;
-      vk.vkCmdSetCullMode(cmd, culling ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE);
       bound = pipeline;
-    } else if ((view.cull_back_faces && d.one_sided) != culling) {
-      culling = !culling;
-      vk.vkCmdSetCullMode(cmd, culling ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE);
+    }
+    if (rebound || cull != culling) {
+      vk.vkCmdSetCullMode(cmd, cull ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE);
+      culling = cull;
     }
     if (sets_[d.material] != bound_set) {
       bound_set = sets_[d.material];

@@ -381,9 +381,10 @@ void World::draw_reflection(VkCommandBuffer cmd, const ReflectionView& view, voi
   cull.clip_plane = clip_plane;
   cull.focal_pixels = focal_pixels(w.projection, float(view.extent.height));
   cull.max_error_pixels = kReflectionErrorPixels;
-  w.select_draws(cull, w.reflection_constants, 1, &w.reflection_draws,
-                 &w.stats.reflection_triangles);
-  if (!sampled) {
+  if (sampled) {
+    w.select_draws(cull, w.reflection_constants, 1, &w.reflection_draws,
+                   &w.stats.reflection_triangles);
+  } else {  // no water in view: nothing of the world is seen in it
     w.reflection_draws.clear();
     w.stats.reflection_triangles = 0;
   }

@@ -90,16 +90,17 @@ Status make_buffer(const GpuContext& gpu, VkDeviceSize size, VkBufferUsageFlags 
   VkMemoryPropertyFlags wanted = memory == BufferMemory::kHostVisible
                                      ? kHost
                                      : VkMemoryPropertyFlags{VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT};
-  uint32_t shared_type = 0;
-  if (memory == BufferMemory::kMappedIfUnified && unified_memory(gpu.memory_properties) &&
-      find_memory_type(gpu.memory_properties, requirements.memoryTypeBits, wanted | kHost,
-                       &shared_type)) {
+  if (memory == BufferMemory::kMappedIfUnified && unified_memory(gpu.memory_properties)) {
     // Cached where the device offers it: the host then reads it as fast as its own.
-    const VkMemoryPropertyFlags cached = wanted | kHost | VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
-    wanted = find_memory_type(gpu.memory_properties, requirements.memoryTypeBits, cached,
-                              &shared_type)
-                 ? cached
-                 : wanted | kHost;
+    uint32_t shared_type = 0;
+    for (const VkMemoryPropertyFlags shared :
+         {wanted | kHost | VK_MEMORY_PROPERTY_HOST_CACHED_BIT, wanted | kHost}) {
+      if (find_memory_type(gpu.memory_properties, requirements.memoryTypeBits, shared,
+                           &shared_type)) {
+        wanted = shared;
+        break;
+      }
+    }
   }
   VkMemoryPropertyFlags type_flags = 0;
   Status status = allocate(gpu, requirements, wanted, debug_name, &out->memory, &type_flags);
