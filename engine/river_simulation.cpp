@@ -183,14 +183,15 @@ void RiverFlow::query(std::span<const glm::vec3> points, std::span<WaterSample> 
 
 void RiverFlow::refresh_velocity() {
   for (size_t v = 0; v < velocity_copy_.size(); ++v) velocity_copy_[v] = flow_.velocity(v);
-  foam_field_.compute(field_.flow, bank_distance_, foam_);
+  // Only where the flow changed (everywhere after a full solve): a long river's foam is not
+  // derived again for a boulder moved at one place.
+  foam_field_.update(field_.flow, bank_distance_, flow_.last_update().velocity_changed, foam_);
 }
 
 Status RiverFlow::set_time(double time_seconds) {
   if (!has_keys_) return Status::success();
   SIVIFLOW_TRY(flow_.set_time(time_seconds));
   if (flow_.last_update().nodes_resolved == 0) return Status::success();  // nothing moved
-  // A few thousand vertices: re-reading them all costs less than tracking which changed.
   refresh_velocity();
   return Status::success();
 }

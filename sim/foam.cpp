@@ -30,6 +30,13 @@ glm::vec3 barycentric_xz(const glm::vec3& p, const glm::vec3& a, const glm::vec3
   return glm::clamp(glm::vec3(1.0f - v - w, v, w), 0.0f, 1.0f);
 }
 
+// A vertex's foam after one more transport step: its own source, or what the step carried to it
+// from its upstream corners, decayed. One expression for the whole river and for a window, so
+// both round alike.
+float transported(float source, float decay, const float* weight, float a, float b, float c) {
+  return std::max(source, decay * (weight[0] * a + weight[1] * b + weight[2] * c));
+}
+
 }  // namespace
 
 Status FoamField::create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
@@ -63,6 +70,11 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   for (size_t i = 0; i < corners; ++i) {
     if (corner(i) >= count) return Status::error("FoamField: index out of range");
   }
+  for (size_t i = 0; i < corners; ++i) {
+    const glm::vec3& a = positions[corner(i)];
+    const glm::vec3& b = positions[corner(i % 3 == 2 ? i - 2 : i + 1)];
+    field.longest_edge_ = std::max(field.longest_edge_, std::hypot(a.x - b.x, a.z - b.z));
+  }
   field.indices_ = indices;
   if (around.start.empty()) {
     // Counted, then filled in triangle order.
@@ -83,107 +95,217 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   return Status::success();
 }
 
+float FoamField::source_of(size_t v, std::span<const glm::vec3> velocity,
+                           std::span<const float> bank_distance,
+                           std::vector<uint32_t>* ring) const {
+  const FoamParams& p = params_;
+  // The one-ring through the triangles, each neighbour once, ascending.
+  ring->clear();
+  for (uint32_t k = around_.start[v]; k < around_.start[v + 1]; ++k) {
+    const size_t t = around_.list[k];
+    for (size_t c = 3 * t; c < 3 * t + 3; ++c) {
+      if (corner(c) != v) ring->push_back(corner(c));
+    }
+  }
+  std::sort(ring->begin(), ring->end());
+  ring->erase(std::unique(ring->begin(), ring->end()), ring->end());
+  // Least-squares horizontal velocity gradient over the one-ring: G = (sum du dx^T)(sum dx dx^T)^-1.
+  float axx = 0.0f, axz = 0.0f, azz = 0.0f;
+  float bxx = 0.0f, bxz = 0.0f, bzx = 0.0f, bzz = 0.0f;
+  for (const uint32_t j : *ring) {
+    const float dx = positions_[j].x - positions_[v].x;
+    const float dz = positions_[j].z - positions_[v].z;
+    const float dux = velocity[j].x - velocity[v].x;
+    const float duz = velocity[j].z - velocity[v].z;
+    axx += dx * dx;
+    axz += dx * dz;
+    azz += dz * dz;
+    bxx += dux * dx;
+    bxz += dux * dz;
+    bzx += duz * dx;
+    bzz += duz * dz;
+  }
+  const float det = axx * azz - axz * axz;
+  float g00 = 0.0f, g01 = 0.0f, g10 = 0.0f, g11 = 0.0f;  // d(u_x, u_z) / d(x, z)
+  if (det > 1e-12f) {
+    const float ixx = azz / det, ixz = -axz / det, izz = axx / det;
+    g00 = bxx * ixx + bxz * ixz;
+    g01 = bxx * ixz + bxz * izz;
+    g10 = bzx * ixx + bzz * ixz;
+    g11 = bzx * ixz + bzz * izz;
+  }
+  const float gradient = std::sqrt(g00 * g00 + g01 * g01 + g10 * g10 + g11 * g11);
+  const float speed = std::hypot(velocity[v].x, velocity[v].z);
+  const float section_speed = section_speed_[section_[v]];
+  const float deficit = section_speed > 0.0f ? 1.0f - speed / section_speed : 0.0f;
+  // How the speed changes along the flow (1/s): negative where the water slows towards an
+  // obstacle, positive where it gathers speed again in the lee.
+  float along = 0.0f;
+  if (speed > kMinDirectionSpeed) {
+    const float ux = velocity[v].x / speed, uz = velocity[v].z / speed;
+    along = ux * (g00 * ux + g01 * uz) + uz * (g10 * ux + g11 * uz);
+  }
+  const float lee = p.front_share + (1.0f - p.front_share) *
+                                        smoothstep(-p.lee_acceleration, p.lee_acceleration, along);
+  const float bank = p.bank_strength * std::exp(-bank_distance[v] / p.bank_width_m) *
+                     std::min(section_speed / p.bank_speed_full, 1.0f);
+  const float relative_gradient = gradient / std::max(section_speed, p.min_section_speed);
+  return std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
+                   lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
+}
+
+FoamField::Upstream FoamField::upstream_of(size_t v, std::span<const glm::vec3> velocity) const {
+  // Where this vertex's water was one step ago: cast down onto the surface there.
+  const glm::vec3 back =
+      positions_[v] - params_.step_s * glm::vec3(velocity[v].x, 0.0f, velocity[v].z);
+  Upstream up;
+  RayHit hit;
+  if (!bvh_->intersect(back + glm::vec3(0.0f, kRayHeight, 0.0f), {0.0f, -1.0f, 0.0f},
+                       2.0f * kRayHeight, &hit)) {
+    return up;  // came in over the inlet or a bank: none
+  }
+  up.triangle = hit.triangle;
+  uint32_t from[3];
+  for (int c = 0; c < 3; ++c) from[c] = bvh_->triangle_vertex(hit.triangle, c);
+  const glm::vec3 b =
+      barycentric_xz(back, positions_[from[0]], positions_[from[1]], positions_[from[2]]);
+  const float sum = std::max(b.x + b.y + b.z, 1e-6f);
+  for (int c = 0; c < 3; ++c) up.weight[c] = b[c] / sum;
+  return up;
+}
+
 void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
                         std::span<float> foam) {
   const size_t count = positions_.size();
-  const FoamParams& p = params_;
   std::fill(section_speed_.begin(), section_speed_.end(), 0.0f);
-  for (size_t v = 0; v < count; ++v) {
-    section_speed_[section_[v]] += std::hypot(velocity[v].x, velocity[v].z) / float(section_size_[section_[v]]);
-  }
-  // Per vertex: where the flow came from one step earlier (the triangle there and its corners'
-  // weights; all 0 weights when that point is off the river), and its own foam source.
-  std::vector<uint32_t> upstream_triangle(count, 0);
-  std::vector<float> upstream_weight(count * 3, 0.0f);
-  std::vector<float> source(count, 0.0f);
-  const auto corner = [&](size_t i) { return indices_.empty() ? uint32_t(i) : indices_[i]; };
+  for (size_t v = 0; v < count; ++v) add_speed(v, velocity);
+  computed_ = true;
+  last_rederived_ = count;
+  std::vector<Upstream> upstream(count);
+  std::vector<float> source(count);
   std::vector<uint32_t> ring;
   for (size_t v = 0; v < count; ++v) {
-    // The one-ring through the triangles, each neighbour once, ascending.
-    ring.clear();
-    for (uint32_t k = around_.start[v]; k < around_.start[v + 1]; ++k) {
-      const size_t t = around_.list[k];
-      for (size_t c = 3 * t; c < 3 * t + 3; ++c) {
-        if (corner(c) != v) ring.push_back(corner(c));
-      }
-    }
-    std::sort(ring.begin(), ring.end());
-    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
-    // Least-squares horizontal velocity gradient over the one-ring: G = (sum du dx^T)(sum dx dx^T)^-1.
-    float axx = 0.0f, axz = 0.0f, azz = 0.0f;
-    float bxx = 0.0f, bxz = 0.0f, bzx = 0.0f, bzz = 0.0f;
-    for (const uint32_t j : ring) {
-      const float dx = positions_[j].x - positions_[v].x;
-      const float dz = positions_[j].z - positions_[v].z;
-      const float dux = velocity[j].x - velocity[v].x;
-      const float duz = velocity[j].z - velocity[v].z;
-      axx += dx * dx;
-      axz += dx * dz;
-      azz += dz * dz;
-      bxx += dux * dx;
-      bxz += dux * dz;
-      bzx += duz * dx;
-      bzz += duz * dz;
-    }
-    const float det = axx * azz - axz * axz;
-    float g00 = 0.0f, g01 = 0.0f, g10 = 0.0f, g11 = 0.0f;  // d(u_x, u_z) / d(x, z)
-    if (det > 1e-12f) {
-      const float ixx = azz / det, ixz = -axz / det, izz = axx / det;
-      g00 = bxx * ixx + bxz * ixz;
-      g01 = bxx * ixz + bxz * izz;
-      g10 = bzx * ixx + bzz * ixz;
-      g11 = bzx * ixz + bzz * izz;
-    }
-    const float gradient = std::sqrt(g00 * g00 + g01 * g01 + g10 * g10 + g11 * g11);
-    const float speed = std::hypot(velocity[v].x, velocity[v].z);
-    const float section_speed = section_speed_[section_[v]];
-    const float deficit = section_speed > 0.0f ? 1.0f - speed / section_speed : 0.0f;
-    // How the speed changes along the flow (1/s): negative where the water slows towards an
-    // obstacle, positive where it gathers speed again in the lee.
-    float along = 0.0f;
-    if (speed > kMinDirectionSpeed) {
-      const float ux = velocity[v].x / speed, uz = velocity[v].z / speed;
-      along = ux * (g00 * ux + g01 * uz) + uz * (g10 * ux + g11 * uz);
-    }
-    const float lee = p.front_share + (1.0f - p.front_share) *
-                                          smoothstep(-p.lee_acceleration, p.lee_acceleration, along);
-    const float bank = p.bank_strength * std::exp(-bank_distance[v] / p.bank_width_m) *
-                       std::min(section_speed / p.bank_speed_full, 1.0f);
-    const float relative_gradient = gradient / std::max(section_speed, p.min_section_speed);
-    source[v] = std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
-                          lee * smoothstep(p.deficit_onset, p.deficit_full, deficit), bank});
-
-    // Where this vertex's water was one step ago: cast down onto the surface there.
-    const glm::vec3 back = positions_[v] - p.step_s * glm::vec3(velocity[v].x, 0.0f, velocity[v].z);
-    RayHit hit;
-    float* weight = &upstream_weight[v * 3];
-    if (bvh_->intersect(back + glm::vec3(0.0f, kRayHeight, 0.0f), {0.0f, -1.0f, 0.0f},
-                        2.0f * kRayHeight, &hit)) {
-      upstream_triangle[v] = hit.triangle;
-      uint32_t from[3];
-      for (int c = 0; c < 3; ++c) from[c] = bvh_->triangle_vertex(hit.triangle, c);
-      const glm::vec3 b = barycentric_xz(back, positions_[from[0]], positions_[from[1]],
-                                         positions_[from[2]]);
-      const float sum = std::max(b.x + b.y + b.z, 1e-6f);
-      for (int c = 0; c < 3; ++c) weight[c] = b[c] / sum;
-    } else {
-      for (int c = 0; c < 3; ++c) weight[c] = 0.0f;  // came in over the inlet or a bank: none
-    }
+    source[v] = source_of(v, velocity, bank_distance, &ring);
+    upstream[v] = upstream_of(v, velocity);
   }
   // Steady transport: each step the foam moves one step downstream and decays.
-  const float decay = std::exp(-p.step_s / p.lifetime_s);
+  const float decay = std::exp(-params_.step_s / params_.lifetime_s);
   std::copy(source.begin(), source.end(), foam.begin());
   std::vector<float> next(count);
-  for (uint32_t step = 0; step < p.steps; ++step) {
+  for (uint32_t step = 0; step < params_.steps; ++step) {
     for (size_t v = 0; v < count; ++v) {
-      const size_t t = upstream_triangle[v];
-      const float* weight = &upstream_weight[v * 3];
-      const float carried = weight[0] * foam[corner(3 * t)] + weight[1] * foam[corner(3 * t + 1)] +
-                            weight[2] * foam[corner(3 * t + 2)];
-      next[v] = std::max(source[v], decay * carried);
+      const size_t t = upstream[v].triangle;
+      next[v] = transported(source[v], decay, upstream[v].weight, foam[corner(3 * t)],
+                            foam[corner(3 * t + 1)], foam[corner(3 * t + 2)]);
     }
     std::copy(next.begin(), next.end(), foam.begin());
   }
+}
+
+// Why a window suffices: a vertex's foam after n transport steps reads its own source and the
+// foam, one step earlier, at the corners of its upstream triangle, which lie within
+// hop = step * |velocity| + the longest edge of it. So the foam can change only within n hops of
+// a vertex whose source or upstream point changed (those whose velocity or whose neighbours'
+// changed, and every vertex of a section whose mean speed changed), and those vertices' foam
+// reads nothing farther than n hops more: re-running the n steps on that window, whatever stands
+// outside it, gives the inner vertices their exact values.
+void FoamField::update(std::span<const glm::vec3> velocity,
+                       std::span<const float> bank_distance, std::span<const XzBox> changed,
+                       std::span<float> foam) {
+  const bool bounded = std::all_of(changed.begin(), changed.end(),
+                                   [](const XzBox& box) { return box.finite(); });
+  if (!computed_ || !bounded) {
+    compute(velocity, bank_distance, foam);
+    return;
+  }
+  last_rederived_ = 0;
+  if (changed.empty()) return;
+  const size_t count = positions_.size();
+  // The sources that can change: about each box, the changed vertices' one-rings, and their
+  // sections whole (each section grows the first box that reaches it).
+  std::vector<XzBox> sources;
+  for (const XzBox& box : changed) sources.push_back(box.widened(longest_edge_));
+  const auto first_holding = [](const std::vector<XzBox>& boxes, const glm::vec3& p) {
+    for (size_t b = 0; b < boxes.size(); ++b) {
+      if (boxes[b].holds(p)) return uint32_t(b + 1);
+    }
+    return 0u;
+  };
+  std::vector<uint32_t> section_box(section_speed_.size(), 0);  // box + 1; 0: unchanged
+  float fastest2 = 0.0f;
+  for (size_t v = 0; v < count; ++v) {
+    const uint32_t b = first_holding(sources, positions_[v]);
+    if (b != 0 && section_box[section_[v]] == 0) section_box[section_[v]] = b;
+    fastest2 = std::max(fastest2, velocity[v].x * velocity[v].x + velocity[v].z * velocity[v].z);
+  }
+  for (size_t s = 0; s < section_speed_.size(); ++s) {
+    if (section_box[s] != 0) section_speed_[s] = 0.0f;
+  }
+  for (size_t v = 0; v < count; ++v) {
+    const uint32_t b = section_box[section_[v]];
+    if (b == 0) continue;
+    add_speed(v, velocity);
+    sources[b - 1].grow(positions_[v]);
+  }
+  const double hop = double(params_.step_s) * std::sqrt(double(fastest2)) + longest_edge_;
+  const double reach = double(params_.steps) * hop * (1.0 + 1e-6) + 1e-3;  // float rounding
+  std::vector<XzBox> changed_foam, window_boxes;
+  for (const XzBox& box : sources) {
+    changed_foam.push_back(box.widened(reach));
+    window_boxes.push_back(box.widened(2.0 * reach));
+  }
+  std::vector<uint32_t> window;
+  for (size_t v = 0; v < count; ++v) {
+    if (first_holding(window_boxes, positions_[v]) != 0) window.push_back(uint32_t(v));
+  }
+  if (2 * window.size() > count) {
+    compute(velocity, bank_distance, foam);
+    return;
+  }
+  last_rederived_ = window.size();
+  // The window's vertices first, then the foam outside it that their upstream corners read
+  // (held as it was: only the window's outer steps see it).
+  const size_t inner = window.size();
+  std::vector<float> source(inner);
+  std::vector<Upstream> upstream(inner);
+  std::vector<uint32_t> slot(3 * inner);
+  std::vector<float> value;
+  std::vector<uint32_t> ring;
+  std::vector<uint32_t> outside;  // global vertex of value[inner + k]
+  const auto slot_of = [&](uint32_t vertex) {
+    const auto at = std::lower_bound(window.begin(), window.end(), vertex);
+    if (at != window.end() && *at == vertex) return uint32_t(at - window.begin());
+    outside.push_back(vertex);
+    return uint32_t(inner + outside.size() - 1);
+  };
+  for (size_t i = 0; i < inner; ++i) {
+    const uint32_t v = window[i];
+    source[i] = source_of(v, velocity, bank_distance, &ring);
+    upstream[i] = upstream_of(v, velocity);
+    const size_t t = upstream[i].triangle;
+    for (int c = 0; c < 3; ++c) slot[3 * i + c] = slot_of(corner(3 * t + c));
+  }
+  value.resize(inner + outside.size());
+  std::copy(source.begin(), source.end(), value.begin());
+  for (size_t k = 0; k < outside.size(); ++k) value[inner + k] = foam[outside[k]];
+  const float decay = std::exp(-params_.step_s / params_.lifetime_s);
+  std::vector<float> next(inner);
+  for (uint32_t step = 0; step < params_.steps; ++step) {
+    for (size_t i = 0; i < inner; ++i) {
+      const uint32_t* s = &slot[3 * i];
+      next[i] = transported(source[i], decay, upstream[i].weight, value[s[0]], value[s[1]],
+                            value[s[2]]);
+    }
+    std::copy(next.begin(), next.end(), value.begin());
+  }
+  for (size_t i = 0; i < inner; ++i) {
+    if (first_holding(changed_foam, positions_[window[i]]) != 0) foam[window[i]] = value[i];
+  }
+}
+
+void FoamField::add_speed(size_t v, std::span<const glm::vec3> velocity) {
+  section_speed_[section_[v]] +=
+      std::hypot(velocity[v].x, velocity[v].z) / float(section_size_[section_[v]]);
 }
 
 }  // namespace siviflow

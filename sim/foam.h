@@ -25,6 +25,7 @@
 #include <glm/vec3.hpp>
 
 #include "sim/triangle_bvh.h"
+#include "siviflow/sim/xz_box.h"
 #include "siviflow/status.h"
 
 namespace siviflow {
@@ -78,10 +79,33 @@ class FoamField {
   // the vertices). Its scratch (32 bytes a vertex) lives only during the call.
   void compute(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
                std::span<float> foam);
+  // The same, after the velocity changed only at vertices inside the `changed` boxes
+  // (StreamFunction's FlowUpdateStats), `foam` holding what compute() or update() last wrote:
+  // re-derives only the vertices whose foam can have changed and leaves the rest, so `foam`
+  // ends equal to compute()'s bit for bit. Its scratch is sized by the vertices re-derived.
+  // Falls back to compute() where they are most of the river, and before the first compute().
+  void update(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+              std::span<const XzBox> changed, std::span<float> foam);
+  // Vertices the last compute() or update() re-derived (all of them for compute()).
+  size_t last_rederived() const { return last_rederived_; }
 
   const FoamParams& params() const { return params_; }
 
  private:
+  // Where a vertex's water was one step earlier: the triangle there and its corners' weights
+  // (all 0 where that point is off the river).
+  struct Upstream {
+    uint32_t triangle = 0;
+    float weight[3] = {0.0f, 0.0f, 0.0f};
+  };
+  // Vertex v's foam source and upstream point; `ring` is scratch.
+  float source_of(size_t v, std::span<const glm::vec3> velocity,
+                  std::span<const float> bank_distance, std::vector<uint32_t>* ring) const;
+  Upstream upstream_of(size_t v, std::span<const glm::vec3> velocity) const;
+  // Adds vertex v's share to its section's mean speed.
+  void add_speed(size_t v, std::span<const glm::vec3> velocity);
+  uint32_t corner(size_t i) const { return indices_.empty() ? uint32_t(i) : indices_[i]; }
+
   std::span<const glm::vec3> positions_;
   std::span<const uint32_t> indices_;
   std::span<const uint32_t> section_;
@@ -94,6 +118,9 @@ class FoamField {
   std::vector<uint32_t> own_list_;
   std::vector<float> section_speed_;  // per section: its vertices' mean speed
   std::vector<uint32_t> section_size_;
+  float longest_edge_ = 0.0f;  // x/z: how far a triangle's corner lies from a point in it
+  bool computed_ = false;      // section_speed_ holds the last velocity's
+  size_t last_rederived_ = 0;
 };
 
 }  // namespace siviflow

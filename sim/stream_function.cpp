@@ -16,6 +16,18 @@ namespace {
 
 using DVec3 = glm::dvec3;
 
+// A full solve's statistics: every node and triangle, the velocity changed everywhere.
+FlowUpdateStats full_update(size_t nodes, size_t triangles) {
+  return {nodes, triangles, nodes, {XzBox::everywhere()}};
+}
+
+// Squared x/z distance from p to the box [lo, hi].
+double box_distance2(glm::dvec2 lo, glm::dvec2 hi, const glm::vec3& p) {
+  const glm::dvec2 at(p.x, p.z);
+  const glm::dvec2 d = glm::max(glm::max(lo - at, at - hi), glm::dvec2(0.0));
+  return d.x * d.x + d.y * d.y;
+}
+
 // The compact-support blend of eq. 2.3 as corrected: f(0) = 0, f(1) = 1, flat at both ends.
 double blend(double t) {
   t = std::clamp(t, 0.0, 1.0);
@@ -81,7 +93,7 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
   f.wet_.assign(nodes, 1);
   f.node_velocity_.resize(nodes);
   for (uint32_t n = 0; n < nodes; ++n) f.update_node_velocity(n);
-  f.stats_ = {nodes, tris, nodes};
+  f.stats_ = full_update(nodes, tris);
   *out = std::move(f);
   return Status::success();
 }
@@ -241,7 +253,7 @@ void StreamFunction::solve_full() {
     wet_[n] = wet ? 1 : 0;
   }
   for (uint32_t n = 0; n < nodes; ++n) update_node_velocity(n);
-  stats_ = {nodes, surface_.triangle_count(), nodes};
+  stats_ = full_update(nodes, surface_.triangle_count());
 }
 
 void StreamFunction::build_grids() {
@@ -502,6 +514,10 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
   gen = next_stamp();
   scratch_nodes_.clear();
   const auto tri = surface_.triangles();
+  const auto pos = surface_.node_positions();
+  // One box about the old place and one about the new, so an obstacle moved far away leaves the
+  // river between them alone; each node goes to the nearer footprint's.
+  XzBox near_old, near_new;
   for (const uint32_t t : scratch_triangles_) {
     for (int i = 0; i < 3; ++i) {
       const uint32_t n = tri[3 * size_t{t} + i];
@@ -509,8 +525,15 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
         node_stamp_[n] = gen;
         scratch_nodes_.push_back(n);
         update_node_velocity(n);
+        const bool old_side =
+            old_wet && (!new_wet || box_distance2(old_state.lo, old_state.hi, pos[n]) <=
+                                        box_distance2(new_state.lo, new_state.hi, pos[n]));
+        (old_side ? near_old : near_new).grow(pos[n]);
       }
     }
+  }
+  for (const XzBox& box : {near_old, near_new}) {
+    if (!box.empty()) stats_.velocity_changed.push_back(box);
   }
   stats_.nodes_resolved += resolved;
   stats_.triangles_updated += scratch_triangles_.size();

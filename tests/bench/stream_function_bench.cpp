@@ -1,14 +1,18 @@
 // Google Benchmark of the river simulation core: surface build, full solve and an obstacle move
-// on procedural rivers of 10k to 4M vertices (issue 3, "Speed").
+// on procedural rivers of 10k to 4M vertices (issue 3, "Speed"), and the foam after a move.
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
 #include "siviflow/sim/procedural_river.h"
 #include "siviflow/sim/river_surface.h"
 #include "siviflow/sim/stream_function.h"
+#include "sim/foam.h"
+#include "sim/triangle_bvh.h"
 
 namespace siviflow {
 namespace {
@@ -83,11 +87,59 @@ void BM_MoveObstacle(benchmark::State& state) {
   state.counters["resolved"] = double(flow.last_update().nodes_resolved);
 }
 
+// The foam after each move of BM_MoveObstacle's boat: derived again over the whole river
+// (range(1) 0) or only where the flow changed (1).
+void BM_FoamAfterMove(benchmark::State& state) {
+  const RiverMesh& mesh = river_mesh(state.range(0));
+  const bool local = state.range(1) != 0;
+  StreamFunction flow = make_flow(mesh);
+  Obstacle rock;
+  const glm::vec3 centre = mesh.positions[mesh.positions.size() / 2];
+  rock.centre = centre;
+  rock.radius = 1.5f;
+  TriangleBvh bvh;
+  if (!flow.set_obstacles({rock}).ok() || !TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok()) {
+    std::abort();
+  }
+  const size_t count = mesh.positions.size();
+  std::vector<float> bank(count);
+  std::vector<uint32_t> section(count);
+  for (size_t v = 0; v < count; ++v) {
+    const RiverVertex vertex = flow.surface().vertex(v);
+    bank[v] = std::min(vertex.d_left, vertex.d_right);
+    section[v] = vertex.section;
+  }
+  FoamField field;
+  if (!FoamField::create(mesh.positions, mesh.indices, section, &bvh, {}, &field).ok()) std::abort();
+  std::vector<glm::vec3> velocity(count);
+  std::vector<float> foam(count);
+  for (size_t v = 0; v < count; ++v) velocity[v] = flow.velocity(v);
+  field.compute(velocity, bank, foam);
+  int step = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const float dz = 0.05f * float(step % 40 < 20 ? step % 40 : 40 - step % 40);
+    if (!flow.move_obstacle(0, centre + glm::vec3(0.0f, 0.0f, dz)).ok()) std::abort();
+    for (size_t v = 0; v < count; ++v) velocity[v] = flow.velocity(v);
+    ++step;
+    state.ResumeTiming();
+    if (local) {
+      field.update(velocity, bank, flow.last_update().velocity_changed, foam);
+    } else {
+      field.compute(velocity, bank, foam);
+    }
+    benchmark::DoNotOptimize(foam.data());
+  }
+  state.counters["rederived"] = double(field.last_rederived());
+}
+
 BENCHMARK(BM_SurfaceBuild)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FullSolve)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MoveObstacle)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FoamAfterMove)->ArgsProduct({{100'000, 1'500'000}, {0, 1}})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace siviflow

@@ -4,7 +4,9 @@
 #include "sim/foam.h"
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -132,6 +134,70 @@ TEST_F(FoamTest, SharedAdjacencyGivesTheSameFoam) {
                                           FoamParams{}, &field, short_start);
   EXPECT_FALSE(status.ok());
   EXPECT_NE(status.message().find("around"), std::string::npos) << status.message();
+}
+
+// A long channel (2 km; 10 m wide, 1 m between vertices): an obstacle added, moved and removed
+// re-derives the foam only around where the flow changed, and the foam equals a full compute
+// bit for bit after each step.
+TEST(FoamUpdateTest, OnlyWhereTheFlowChangedAndEqualToAFullCompute) {
+  const test::TestMesh mesh = test::symmetric_channel(10.0f, 2000.0f, 2001, 11);
+  RiverSurface surface;
+  ASSERT_TRUE(RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok());
+  StreamFunction flow;
+  ASSERT_TRUE(StreamFunction::create(std::move(surface), {10.0f, 1.5f, 0.0f}, &flow).ok());
+  TriangleBvh bvh;
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok());
+  const size_t count = mesh.positions.size();
+  std::vector<float> bank(count);
+  std::vector<uint32_t> section(count);
+  for (size_t v = 0; v < count; ++v) {
+    const RiverVertex vertex = flow.surface().vertex(v);
+    bank[v] = std::min(vertex.d_left, vertex.d_right);
+    section[v] = vertex.section;
+  }
+  FoamField field, reference;
+  ASSERT_TRUE(FoamField::create(mesh.positions, mesh.indices, section, &bvh, {}, &field).ok());
+  ASSERT_TRUE(FoamField::create(mesh.positions, mesh.indices, section, &bvh, {}, &reference).ok());
+  std::vector<glm::vec3> velocity(count);
+  const auto read_velocity = [&] {
+    for (size_t v = 0; v < count; ++v) velocity[v] = flow.velocity(v);
+  };
+  std::vector<float> foam(count, -1.0f), expected(count);
+  read_velocity();
+  const FlowUpdateStats& last = flow.last_update();
+  field.update(velocity, bank, last.velocity_changed, foam);
+  EXPECT_EQ(field.last_rederived(), count) << "the first update computes everything";
+
+  Obstacle rock;
+  rock.centre = {1.0f, 0.0f, 300.0f};
+  rock.radius = 1.5f;
+  struct Step {
+    const char* what;
+    std::function<Status()> apply;
+  };
+  const std::vector<Step> steps = {
+      {"added", [&] { return flow.add_obstacle(rock); }},
+      {"moved a little", [&] { return flow.move_obstacle(0, {-1.0f, 0.0f, 302.0f}); }},
+      {"moved far", [&] { return flow.move_obstacle(0, {2.0f, 0.0f, 1500.0f}); }},
+      {"removed", [&] { return flow.remove_obstacle(0); }},
+  };
+  for (const Step& step : steps) {
+    ASSERT_TRUE(step.apply().ok()) << step.what;
+    read_velocity();
+    ASSERT_FALSE(last.velocity_changed.empty()) << step.what;
+    field.update(velocity, bank, last.velocity_changed, foam);
+    reference.compute(velocity, bank, expected);
+    EXPECT_EQ(foam, expected) << "bit for bit after the obstacle was " << step.what;
+    EXPECT_GT(field.last_rederived(), 0u) << step.what;
+    // Moved far, both the old and the new place are re-derived: a window at each end.
+    EXPECT_LT(field.last_rederived(), count / 2) << step.what;
+    std::printf("%s: %zu of %zu vertices re-derived\n", step.what, field.last_rederived(), count);
+  }
+  EXPECT_GT(*std::max_element(expected.begin(), expected.end()), 0.5f) << "foam to compare";
+
+  field.update(velocity, bank, {}, foam);  // nothing changed
+  EXPECT_EQ(field.last_rederived(), 0u);
+  EXPECT_EQ(foam, expected);
 }
 
 TEST(FoamParamsTest, BadParametersAreRefused) {

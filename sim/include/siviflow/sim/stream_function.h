@@ -25,6 +25,7 @@
 #include "siviflow/sim/river_surface.h"
 #include "siviflow/sim/river_tuning.h"
 #include "siviflow/sim/spatial_grid.h"
+#include "siviflow/sim/xz_box.h"
 #include "siviflow/status.h"
 
 namespace siviflow {
@@ -40,6 +41,10 @@ struct FlowUpdateStats {
   size_t nodes_resolved = 0;     // psi evaluated
   size_t triangles_updated = 0;  // triangle velocities recomputed
   size_t nodes_velocity = 0;     // vertex velocities recomputed
+  // Boxes holding every node whose velocity was recomputed, one about each place an obstacle
+  // left or reached (none when nothing changed; one box everywhere after a full solve): what
+  // depends on the velocity re-derives only there.
+  std::vector<XzBox> velocity_changed;
 };
 
 class StreamFunction {
