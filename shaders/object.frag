@@ -6,6 +6,7 @@
 
 layout(push_constant) uniform Push { SceneConstants scene; };
 layout(set = 0, binding = 0) uniform sampler2D base_color;
+layout(location = 0) in vec3 in_world;  // scene.vert's output, declared so that it is consumed
 layout(location = 1) in vec3 in_irradiance;
 layout(location = 2) in vec4 in_color;
 layout(location = 3) in vec2 in_texcoord;
