@@ -1,6 +1,7 @@
 #include "sim/foam.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -28,6 +29,11 @@ glm::vec3 barycentric_xz(const glm::vec3& p, const glm::vec3& a, const glm::vec3
   const float v = (px * e1z - e1x * pz) / det;
   const float w = (e0x * pz - px * e0z) / det;
   return glm::clamp(glm::vec3(1.0f - v - w, v, w), 0.0f, 1.0f);
+}
+
+// Squared horizontal speed.
+float speed2(const glm::vec3& velocity) {
+  return velocity.x * velocity.x + velocity.z * velocity.z;
 }
 
 // A vertex's foam after one more transport step: its own source, or what the step carried to it
@@ -74,6 +80,11 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
     const glm::vec3& a = positions[corner(i)];
     const glm::vec3& b = positions[corner(i % 3 == 2 ? i - 2 : i + 1)];
     field.longest_edge_ = std::max(field.longest_edge_, std::hypot(a.x - b.x, a.z - b.z));
+  }
+  std::vector<XzBox> section_bounds(sections);
+  for (size_t v = 0; v < count; ++v) section_bounds[section[v]].grow(positions[v]);
+  for (const XzBox& box : section_bounds) {
+    if (!box.empty()) field.widest_section_ = std::max(field.widest_section_, glm::length(box.hi - box.lo));
   }
   field.indices_ = indices;
   if (around.start.empty()) {
@@ -178,7 +189,11 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
                         std::span<float> foam) {
   const size_t count = positions_.size();
   std::fill(section_speed_.begin(), section_speed_.end(), 0.0f);
-  for (size_t v = 0; v < count; ++v) add_speed(v, velocity);
+  fastest2_ = 0.0f;
+  for (size_t v = 0; v < count; ++v) {
+    add_speed(v, velocity);
+    fastest2_ = std::max(fastest2_, speed2(velocity[v]));
+  }
   computed_ = true;
   last_rederived_ = count;
   std::vector<Upstream> upstream(count);
@@ -221,43 +236,58 @@ void FoamField::update(std::span<const glm::vec3> velocity,
   last_rederived_ = 0;
   if (changed.empty()) return;
   const size_t count = positions_.size();
-  // The sources that can change: about each box, the changed vertices' one-rings, and their
-  // sections whole (each section grows the first box that reaches it).
-  std::vector<XzBox> sources;
-  for (const XzBox& box : changed) sources.push_back(box.widened(longest_edge_));
+  // The vertices in the boxes, each once, ascending (a bit a vertex sorts them).
+  std::vector<uint32_t> found;
+  std::vector<uint64_t> seen((count + 63) / 64);
+  const auto vertices_in = [&](const std::vector<XzBox>& boxes) {
+    found.clear();
+    for (const XzBox& box : boxes) bvh_->append_vertices_in(box, &found);
+    std::fill(seen.begin(), seen.end(), 0);
+    for (const uint32_t v : found) seen[v / 64] |= uint64_t{1} << (v % 64);
+    std::vector<uint32_t> ascending;
+    for (size_t word = 0; word < seen.size(); ++word) {
+      for (uint64_t bits = seen[word]; bits != 0; bits &= bits - 1) {
+        ascending.push_back(uint32_t(64 * word + size_t(std::countr_zero(bits))));
+      }
+    }
+    return ascending;
+  };
   const auto first_holding = [](const std::vector<XzBox>& boxes, const glm::vec3& p) {
     for (size_t b = 0; b < boxes.size(); ++b) {
       if (boxes[b].holds(p)) return uint32_t(b + 1);
     }
     return 0u;
   };
+  // The sources that can change: about each box, the changed vertices' one-rings, and their
+  // sections whole (each section grows the first box that reaches it). The changed vertices lie
+  // in the boxes, so the fastest speed is kept up to date from them.
+  std::vector<XzBox> sources, sections_reach;
+  for (const XzBox& box : changed) {
+    sources.push_back(box.widened(longest_edge_));
+    sections_reach.push_back(sources.back().widened(widest_section_));
+  }
   std::vector<uint32_t> section_box(section_speed_.size(), 0);  // box + 1; 0: unchanged
-  float fastest2 = 0.0f;
-  for (size_t v = 0; v < count; ++v) {
+  for (const uint32_t v : vertices_in(sources)) {
     const uint32_t b = first_holding(sources, positions_[v]);
-    if (b != 0 && section_box[section_[v]] == 0) section_box[section_[v]] = b;
-    fastest2 = std::max(fastest2, velocity[v].x * velocity[v].x + velocity[v].z * velocity[v].z);
+    if (section_box[section_[v]] == 0) section_box[section_[v]] = b;
+    fastest2_ = std::max(fastest2_, speed2(velocity[v]));
   }
-  for (size_t s = 0; s < section_speed_.size(); ++s) {
-    if (section_box[s] != 0) section_speed_[s] = 0.0f;
-  }
-  for (size_t v = 0; v < count; ++v) {
-    const uint32_t b = section_box[section_[v]];
-    if (b == 0) continue;
+  // Every vertex of a section lies within the widest section of any other of its vertices.
+  std::vector<uint32_t> resummed = vertices_in(sections_reach);
+  std::erase_if(resummed, [&](uint32_t v) { return section_box[section_[v]] == 0; });
+  for (const uint32_t v : resummed) section_speed_[section_[v]] = 0.0f;
+  for (const uint32_t v : resummed) {  // ascending, as compute() sums them
     add_speed(v, velocity);
-    sources[b - 1].grow(positions_[v]);
+    sources[section_box[section_[v]] - 1].grow(positions_[v]);
   }
-  const double hop = double(params_.step_s) * std::sqrt(double(fastest2)) + longest_edge_;
+  const double hop = double(params_.step_s) * std::sqrt(double(fastest2_)) + longest_edge_;
   const double reach = double(params_.steps) * hop * (1.0 + 1e-6) + 1e-3;  // float rounding
   std::vector<XzBox> changed_foam, window_boxes;
   for (const XzBox& box : sources) {
     changed_foam.push_back(box.widened(reach));
     window_boxes.push_back(box.widened(2.0 * reach));
   }
-  std::vector<uint32_t> window;
-  for (size_t v = 0; v < count; ++v) {
-    if (first_holding(window_boxes, positions_[v]) != 0) window.push_back(uint32_t(v));
-  }
+  const std::vector<uint32_t> window = vertices_in(window_boxes);
   if (2 * window.size() > count) {
     compute(velocity, bank_distance, foam);
     return;

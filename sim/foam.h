@@ -118,7 +118,9 @@ class FoamField {
   std::vector<uint32_t> own_list_;
   std::vector<float> section_speed_;  // per section: its vertices' mean speed
   std::vector<uint32_t> section_size_;
-  float longest_edge_ = 0.0f;  // x/z: how far a triangle's corner lies from a point in it
+  float longest_edge_ = 0.0f;     // x/z: how far a triangle's corner lies from a point in it
+  double widest_section_ = 0.0;  // x/z: how far apart two vertices of one section lie at most
+  float fastest2_ = 0.0f;        // at least every vertex's squared speed since compute()
   bool computed_ = false;      // section_speed_ holds the last velocity's
   size_t last_rederived_ = 0;
 };

@@ -364,6 +364,30 @@ bool TriangleBvh::any_hit(const glm::vec3& origin, const glm::vec3& direction, f
   return trace<true>(origin, direction, t_min, t_max, nullptr);
 }
 
+void TriangleBvh::append_vertices_in(const XzBox& box, std::vector<uint32_t>* out) const {
+  if (nodes_.empty() || box.empty()) return;
+  const auto meets = [&](const Node& n) {
+    return n.hi.x >= box.lo.x && n.lo.x <= box.hi.x && n.hi.z >= box.lo.y && n.lo.z <= box.hi.y;
+  };
+  uint32_t stack[kStackSize];
+  int top = 0;
+  if (meets(nodes_[0])) stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (n.count == 0) {
+      if (meets(nodes_[n.first + 1])) stack[top++] = n.first + 1;
+      if (meets(nodes_[n.first])) stack[top++] = n.first;
+      continue;
+    }
+    for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t v = triangle_vertex(order_[i], k);
+        if (box.holds(positions_[v])) out->push_back(v);
+      }
+    }
+  }
+}
+
 uint32_t TriangleBvh::nearest_vertex(const glm::vec3& p, float radius,
                                      uint32_t hint_triangle) const {
   uint32_t best_v = triangle_vertex(hint_triangle, 0);

@@ -11,6 +11,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "siviflow/sim/xz_box.h"
 #include "siviflow/status.h"
 
 namespace siviflow {
@@ -59,6 +60,10 @@ class TriangleBvh {
   // The vertex nearest to `p` (ties: the lower index) among the vertices within `radius` of it;
   // when none is, the nearest corner of `hint_triangle` (usually the triangle `p` lies on).
   uint32_t nearest_vertex(const glm::vec3& p, float radius, uint32_t hint_triangle) const;
+
+  // Appends to `out` every vertex inside the x/z box (at any height), once per triangle it is a
+  // corner of: a caller that wants each once sorts and removes the repeats.
+  void append_vertices_in(const XzBox& box, std::vector<uint32_t>* out) const;
 
  private:
   struct Node {

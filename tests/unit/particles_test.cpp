@@ -137,6 +137,37 @@ TEST(TriangleBvh, NearestVertexIsTheBruteForceOne) {
   }
 }
 
+// The vertices in an x/z box are the brute-force ones (each at least once), at any height.
+TEST(TriangleBvh, VerticesInABoxAreTheBruteForceOnes) {
+  const GridRiver r = test::grid_river(
+      23, 31, {-5.0f, 0.0f}, {5.0f, 20.0f}, [](float x, float z) { return 3.0f * std::sin(x + z); },
+      [](float, float) { return glm::vec3(0.0f, 0.0f, 1.0f); }, 0.4f);
+  TriangleBvh bvh;
+  ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
+  uint64_t state = 7;
+  const auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return double(state >> 40) * 0x1.0p-24;
+  };
+  for (int n = 0; n < 500; ++n) {
+    const glm::dvec2 a(-6.0 + 12.0 * next(), -1.0 + 22.0 * next());
+    const glm::dvec2 b(a.x + 4.0 * next(), a.y + 4.0 * next());
+    const XzBox box{a, b};
+    std::vector<uint32_t> got;
+    bvh.append_vertices_in(box, &got);
+    std::sort(got.begin(), got.end());
+    got.erase(std::unique(got.begin(), got.end()), got.end());
+    std::vector<uint32_t> want;
+    for (uint32_t i = 0; i < r.positions.size(); ++i) {
+      if (box.holds(r.positions[i])) want.push_back(i);
+    }
+    ASSERT_EQ(got, want) << "box " << a.x << ", " << a.y << " to " << b.x << ", " << b.y;
+  }
+  std::vector<uint32_t> none;
+  bvh.append_vertices_in(XzBox{}, &none);
+  EXPECT_TRUE(none.empty());
+}
+
 // The closest hit of rays of every slope over a meandering procedural river (whose triangles
 // the build sorts on every axis) is the brute-force one: the same triangle (ties: the lower)
 // at the same t.
