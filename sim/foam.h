@@ -82,7 +82,8 @@ class FoamField {
   // The same, after the velocity changed only at vertices inside the `changed` boxes
   // (StreamFunction's FlowUpdateStats), `foam` holding what compute() or update() last wrote:
   // re-derives only the vertices whose foam can have changed and leaves the rest, so `foam`
-  // ends equal to compute()'s bit for bit. Its scratch is sized by the vertices re-derived.
+  // ends equal to compute()'s bit for bit. Its scratch is sized by the vertices re-derived (and
+  // a bit a vertex of the river).
   // Falls back to compute() where they are most of the river, and before the first compute().
   void update(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
               std::span<const XzBox> changed, std::span<float> foam);
