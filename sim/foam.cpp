@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <string>
 
 #include <glm/geometric.hpp>
 
@@ -81,6 +82,10 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
     const glm::vec3& b = positions[corner(i % 3 == 2 ? i - 2 : i + 1)];
     field.longest_edge_ = std::max(field.longest_edge_, std::hypot(a.x - b.x, a.z - b.z));
   }
+  // A step's upstream point is rounded to a float: off by up to half a float's spacing there.
+  float farthest = 0.0f;
+  for (const glm::vec3& p : positions) farthest = std::max({farthest, std::fabs(p.x), std::fabs(p.z)});
+  field.rounding_ = 2.0f * (std::nextafter(farthest, INFINITY) - farthest);
   std::vector<XzBox> section_bounds(sections);
   for (size_t v = 0; v < count; ++v) section_bounds[section[v]].grow(positions[v]);
   for (const XzBox& box : section_bounds) {
@@ -99,6 +104,13 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
     }
   } else if (around.start.size() != count + 1 || around.start.back() != around.list.size()) {
     return Status::error("FoamField: the triangles around the vertices do not fit the mesh");
+  }
+  // update() finds vertices through the triangles: one in none would be left out.
+  const std::span<const uint32_t> start = around.start.empty() ? field.own_start_ : around.start;
+  for (size_t v = 0; v < count; ++v) {
+    if (start[v + 1] == start[v]) {
+      return Status::error("FoamField: vertex " + std::to_string(v) + " is a corner of no triangle");
+    }
   }
   *out = std::move(field);
   // Spans into the moved vectors: a vector's move keeps its storage.
@@ -280,7 +292,8 @@ void FoamField::update(std::span<const glm::vec3> velocity,
     add_speed(v, velocity);
     sources[section_box[section_[v]] - 1].grow(positions_[v]);
   }
-  const double hop = double(params_.step_s) * std::sqrt(double(fastest2_)) + longest_edge_;
+  const double hop =
+      double(params_.step_s) * std::sqrt(double(fastest2_)) + longest_edge_ + rounding_;
   const double reach = double(params_.steps) * hop * (1.0 + 1e-6) + 1e-3;  // float rounding
   std::vector<XzBox> changed_foam, window_boxes;
   for (const XzBox& box : sources) {

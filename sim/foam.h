@@ -64,7 +64,7 @@ class FoamField {
   // vertex's cross-section (river_surface.h). `bvh` is built on the same positions and indices.
   // `around`: the triangles around each vertex where the caller keeps them (a river surface's,
   // when its nodes are the vertices); empty, the field builds its own. The spans and `bvh`
-  // outlive this object.
+  // outlive this object. Every vertex must be a corner of a triangle.
   static Status create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                        std::span<const uint32_t> section, const TriangleBvh* bvh,
                        const FoamParams& params, FoamField* out, VertexTriangles around = {});
@@ -83,8 +83,8 @@ class FoamField {
   // (StreamFunction's FlowUpdateStats), `foam` holding what compute() or update() last wrote:
   // re-derives only the vertices whose foam can have changed and leaves the rest, so `foam`
   // ends equal to compute()'s bit for bit. Its scratch is sized by the vertices re-derived (and
-  // a bit a vertex of the river).
-  // Falls back to compute() where they are most of the river, and before the first compute().
+  // a bit a vertex and a word a section of the river). Falls back to compute() where they are
+  // most of the river, for a box that is not finite, and before the first compute().
   void update(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
               std::span<const XzBox> changed, std::span<float> foam);
   // Vertices the last compute() or update() re-derived (all of them for compute()).
@@ -120,8 +120,11 @@ class FoamField {
   std::vector<float> section_speed_;  // per section: its vertices' mean speed
   std::vector<uint32_t> section_size_;
   float longest_edge_ = 0.0f;     // x/z: how far a triangle's corner lies from a point in it
+  float rounding_ = 0.0f;         // how far a rounded upstream point can lie from the true one
   double widest_section_ = 0.0;  // x/z: how far apart two vertices of one section lie at most
-  float fastest2_ = 0.0f;        // at least every vertex's squared speed since compute()
+  // At least every vertex's squared speed: set by compute(), only raised by update() (a bound
+  // kept from a faster moment widens later windows, never wrongs them).
+  float fastest2_ = 0.0f;
   bool computed_ = false;      // section_speed_ holds the last velocity's
   size_t last_rederived_ = 0;
 };

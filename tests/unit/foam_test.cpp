@@ -136,6 +136,21 @@ TEST_F(FoamTest, SharedAdjacencyGivesTheSameFoam) {
   EXPECT_NE(status.message().find("around"), std::string::npos) << status.message();
 }
 
+// A vertex that no triangle uses is refused: update() finds vertices through the triangles.
+TEST_F(FoamTest, AVertexOfNoTriangleIsRefused) {
+  std::vector<glm::vec3> positions = mesh_.positions;
+  positions.push_back({0.0f, 0.0f, 30.0f});
+  std::vector<uint32_t> section = section_;
+  section.push_back(section_[at(0.0f, 30.0f)]);
+  FoamField field;
+  const Status status =
+      FoamField::create(positions, mesh_.indices, section, &bvh_, FoamParams{}, &field);
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.message().find("vertex " + std::to_string(positions.size() - 1)),
+            std::string::npos)
+      << status.message();
+}
+
 // A long channel (2 km; 10 m wide, 1 m between vertices): an obstacle added, moved and removed
 // re-derives the foam only around where the flow changed, and the foam equals a full compute
 // bit for bit after each step.
