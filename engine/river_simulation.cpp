@@ -189,6 +189,7 @@ void RiverFlow::refresh_velocity() {
 }
 
 Status RiverFlow::set_time(double time_seconds) {
+  time_ = time_seconds;  // where an obstacle keyed later starts
   if (!has_keys_) return Status::success();
   SIVIFLOW_TRY(flow_.set_time(time_seconds));
   if (flow_.last_update().nodes_resolved == 0) return Status::success();  // nothing moved
@@ -197,13 +198,17 @@ Status RiverFlow::set_time(double time_seconds) {
 }
 
 Status RiverFlow::add_obstacle(Obstacle obstacle) {
-  SIVIFLOW_TRY(flow_.add_obstacle(std::move(obstacle)));
+  const bool keyed = !obstacle.keys.empty();
+  SIVIFLOW_TRY(flow_.add_obstacle(std::move(obstacle), time_));
+  has_keys_ = has_keys_ || keyed;
   refresh_velocity();
   return Status::success();
 }
 
 Status RiverFlow::replace_obstacle(size_t index, Obstacle obstacle) {
-  SIVIFLOW_TRY(flow_.replace_obstacle(index, std::move(obstacle)));
+  const bool keyed = !obstacle.keys.empty();
+  SIVIFLOW_TRY(flow_.replace_obstacle(index, std::move(obstacle), time_));
+  has_keys_ = has_keys_ || keyed;
   refresh_velocity();
   return Status::success();
 }

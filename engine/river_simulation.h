@@ -85,7 +85,8 @@ class RiverFlow {
   void dry_footprints(std::vector<DryFootprint>* out) const;
 
   // Obstacles placed at runtime, by their index in the flow's list (add appends): each re-solves
-  // the flow only around the old and new footprint.
+  // the flow only around the old and new footprint. A keyed one starts where its keys put it at
+  // the last set_time()'s time, and moves with the later ones.
   Status add_obstacle(Obstacle obstacle);
   Status replace_obstacle(size_t index, Obstacle obstacle);
   Status move_obstacle(size_t index, const glm::vec3& centre);
@@ -128,6 +129,7 @@ class RiverFlow {
   std::vector<float> foam_;          // 0..1 per vertex (sim/foam.h)
   FoamField foam_field_;
   bool has_keys_ = false;            // some obstacle moves: re-solve as time goes
+  double time_ = 0.0;                // the last set_time()'s
   RiverFlowField field_;
   std::shared_ptr<const TriangleBvh> bvh_;
   WaterQuery water_query_;

@@ -65,5 +65,22 @@ TEST(RiverFlowTest, FoamAfterMovesEqualsAFreshRiversWithTheObstaclesThere) {
   expect_same_foam(*flow, *fresh, "the rock moved");
 }
 
+// A keyed obstacle added at runtime to a river with no keyed one starts where its keys put it
+// at the river's time, and moves as the time goes on (Renderer::add_obstacle's contract).
+TEST(RiverFlowTest, AKeyedObstacleAddedAtRuntimeMovesWithTheTime) {
+  const test::TestMesh mesh = test::symmetric_channel(10.0f, 400.0f, 401, 11);
+  const FlowParams params{10.0f, 1.5f, 0.0f};
+  auto flow = test::river_flow(mesh, params);
+  ASSERT_TRUE(flow->set_time(5.0).ok());
+  Obstacle boat = rock({0.0f, 0.0f, 100.0f});
+  boat.keys = {{0.0, {0.0f, 0.0f, 100.0f}}, {10.0, {0.0f, 0.0f, 200.0f}}};
+  ASSERT_TRUE(flow->add_obstacle(boat).ok());
+  EXPECT_EQ(flow->obstacle_centre(0), glm::vec3(0.0f, 0.0f, 150.0f));
+  ASSERT_TRUE(flow->set_time(8.0).ok());
+  EXPECT_EQ(flow->obstacle_centre(0), glm::vec3(0.0f, 0.0f, 180.0f));
+  auto fresh = test::river_flow(mesh, params, standing_at({boat}, 8.0));
+  expect_same_foam(*flow, *fresh, "the added boat at t 8");
+}
+
 }  // namespace
 }  // namespace siviflow
