@@ -13,6 +13,7 @@
 #include "siviflow/sim/stream_function.h"
 #include "sim/foam.h"
 #include "sim/triangle_bvh.h"
+#include "unit/foam_inputs.h"
 
 namespace siviflow {
 namespace {
@@ -102,13 +103,7 @@ void BM_FoamAfterMove(benchmark::State& state) {
     std::abort();
   }
   const size_t count = mesh.positions.size();
-  std::vector<float> bank(count);
-  std::vector<uint32_t> section(count);
-  for (size_t v = 0; v < count; ++v) {
-    const RiverVertex vertex = flow.surface().vertex(v);
-    bank[v] = std::min(vertex.d_left, vertex.d_right);
-    section[v] = vertex.section;
-  }
+  const auto [bank, section] = test::foam_inputs(flow.surface(), count);
   FoamField field;
   if (!FoamField::create(mesh.positions, mesh.indices, section, &bvh, {}, &field).ok()) std::abort();
   std::vector<glm::vec3> velocity(count);

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "siviflow/sim/stream_function.h"
+#include "unit/foam_inputs.h"
 #include "unit/river_test_meshes.h"
 
 namespace siviflow {
@@ -29,11 +30,9 @@ class FoamTest : public ::testing::Test {
     ASSERT_TRUE(RiverSurface::build(mesh_.positions, mesh_.indices, {}, &surface).ok());
     ASSERT_TRUE(StreamFunction::create(std::move(surface), {kQ, 1.5f, 0.0f}, &flow_).ok());
     ASSERT_TRUE(TriangleBvh::build(mesh_.positions, mesh_.indices, &bvh_).ok());
-    for (size_t v = 0; v < mesh_.positions.size(); ++v) {
-      const RiverVertex vertex = flow_.surface().vertex(v);
-      bank_.push_back(std::min(vertex.d_left, vertex.d_right));
-      section_.push_back(vertex.section);
-    }
+    test::FoamInputs in = test::foam_inputs(flow_.surface(), mesh_.positions.size());
+    bank_ = std::move(in.bank);
+    section_ = std::move(in.section);
     ASSERT_TRUE(FoamField::create(mesh_.positions, mesh_.indices, section_, &bvh_, FoamParams{},
                                   &field_).ok());
   }
@@ -163,13 +162,7 @@ TEST(FoamUpdateTest, OnlyWhereTheFlowChangedAndEqualToAFullCompute) {
   TriangleBvh bvh;
   ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok());
   const size_t count = mesh.positions.size();
-  std::vector<float> bank(count);
-  std::vector<uint32_t> section(count);
-  for (size_t v = 0; v < count; ++v) {
-    const RiverVertex vertex = flow.surface().vertex(v);
-    bank[v] = std::min(vertex.d_left, vertex.d_right);
-    section[v] = vertex.section;
-  }
+  const auto [bank, section] = test::foam_inputs(flow.surface(), count);
   FoamField field, reference;
   ASSERT_TRUE(FoamField::create(mesh.positions, mesh.indices, section, &bvh, {}, &field).ok());
   ASSERT_TRUE(FoamField::create(mesh.positions, mesh.indices, section, &bvh, {}, &reference).ok());
