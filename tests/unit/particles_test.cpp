@@ -25,6 +25,27 @@ namespace {
 
 using test::GridRiver;
 
+// A repeatable stream of uniform values in [0, 1): a 64-bit LCG's top 24 bits.
+class UnitRandom {
+ public:
+  explicit UnitRandom(uint64_t seed) : state_(seed) {}
+  float next() {
+    state_ = state_ * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<float>(state_ >> 40) * 0x1.0p-24f;
+  }
+
+ private:
+  uint64_t state_;
+};
+
+// A 23 x 31 grid river over x [-5, 5], z [0, 20], its surface a sine wave `amplitude` metres high.
+GridRiver wavy_grid(float amplitude) {
+  return test::grid_river(
+      23, 31, {-5.0f, 0.0f}, {5.0f, 20.0f},
+      [amplitude](float x, float z) { return amplitude * std::sin(x + z); },
+      [](float, float) { return glm::vec3(0.0f, 0.0f, 1.0f); }, 0.4f);
+}
+
 constexpr glm::uvec2 kSmall{640u, 360u};
 constexpr float kDt = 1.0f / 60.0f;
 
@@ -104,17 +125,13 @@ TEST(TriangleBvh, RayHitsTheSurfaceAndMissesBesideIt) {
 }
 
 TEST(TriangleBvh, NearestVertexIsTheBruteForceOne) {
-  const GridRiver r = test::grid_river(
-      23, 31, {-5.0f, 0.0f}, {5.0f, 20.0f}, [](float x, float z) { return 0.2f * std::sin(x + z); },
-      [](float, float) { return glm::vec3(0.0f, 0.0f, 1.0f); }, 0.4f);
+  const GridRiver r = wavy_grid(0.2f);
   TriangleBvh bvh;
   ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
-  uint64_t state = 99;
+  UnitRandom random(99);
   for (int n = 0; n < 2000; ++n) {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    const float u = static_cast<float>(state >> 40) * 0x1.0p-24f;
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    const float v = static_cast<float>(state >> 40) * 0x1.0p-24f;
+    const float u = random.next();
+    const float v = random.next();
     RayHit hit;
     ASSERT_TRUE(bvh.intersect({-4.9f + 9.8f * u, 5.0f, 0.1f + 19.8f * v}, {0.0f, -10.0f, 0.0f},
                               1.0f, &hit));
@@ -139,19 +156,13 @@ TEST(TriangleBvh, NearestVertexIsTheBruteForceOne) {
 
 // The vertices in an x/z box are the brute-force ones (each at least once), at any height.
 TEST(TriangleBvh, VerticesInABoxAreTheBruteForceOnes) {
-  const GridRiver r = test::grid_river(
-      23, 31, {-5.0f, 0.0f}, {5.0f, 20.0f}, [](float x, float z) { return 3.0f * std::sin(x + z); },
-      [](float, float) { return glm::vec3(0.0f, 0.0f, 1.0f); }, 0.4f);
+  const GridRiver r = wavy_grid(3.0f);
   TriangleBvh bvh;
   ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
-  uint64_t state = 7;
-  const auto next = [&] {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return double(state >> 40) * 0x1.0p-24;
-  };
+  UnitRandom random(7);
   for (int n = 0; n < 500; ++n) {
-    const glm::dvec2 a(-6.0 + 12.0 * next(), -1.0 + 22.0 * next());
-    const glm::dvec2 b(a.x + 4.0 * next(), a.y + 4.0 * next());
+    const glm::dvec2 a(-6.0 + 12.0 * random.next(), -1.0 + 22.0 * random.next());
+    const glm::dvec2 b(a.x + 4.0 * random.next(), a.y + 4.0 * random.next());
     const XzBox box{a, b};
     std::vector<uint32_t> got;
     bvh.append_vertices_in(box, &got);
@@ -204,11 +215,8 @@ TEST(TriangleBvh, ClosestHitIsTheBruteForceOne) {
     }
     return found;
   };
-  uint64_t state = 7;
-  const auto next = [&] {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<float>(state >> 40) * 0x1.0p-24f;
-  };
+  UnitRandom random(7);
+  const auto next = [&] { return random.next(); };
   int hits = 0;
   for (int n = 0; n < 400; ++n) {
     const glm::vec3& at = r.positions[static_cast<size_t>(next() * float(r.positions.size() - 1))];
@@ -233,11 +241,8 @@ TEST(TriangleBvh, AnyHitAgreesWithTheClosestHitOverTheSegment) {
       [](float, float) { return glm::vec3(0.0f, 0.0f, 1.0f); }, 0.4f);
   TriangleBvh bvh;
   ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
-  uint64_t state = 5;
-  const auto next = [&state] {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<float>(state >> 40) * 0x1.0p-24f * 2.0f - 1.0f;  // [-1, 1)
-  };
+  UnitRandom random(5);
+  const auto next = [&random] { return random.next() * 2.0f - 1.0f; };  // [-1, 1)
   int hits = 0, misses = 0;
   for (int n = 0; n < 3000; ++n) {
     const glm::vec3 from(6.0f * next(), 2.0f * next(), 6.0f * next());
