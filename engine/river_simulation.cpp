@@ -182,10 +182,22 @@ void RiverFlow::query(std::span<const glm::vec3> points, std::span<WaterSample> 
 }
 
 void RiverFlow::refresh_velocity() {
-  for (size_t v = 0; v < velocity_copy_.size(); ++v) velocity_copy_[v] = flow_.velocity(v);
-  // Only where the flow changed (everywhere after a full solve): a long river's foam is not
-  // derived again for a boulder moved at one place.
-  foam_field_.update(field_.flow, bank_distance_, flow_.last_update().velocity_changed, foam_);
+  // Only where the flow changed (everywhere after a full solve): a long river's velocities and
+  // foam are not derived again for a boulder moved at one place. (A welded vertex stands exactly
+  // on its node, so the nodes' boxes hold it.)
+  const std::vector<XzBox>& changed = flow_.last_update().velocity_changed;
+  if (!velocity_copy_.empty()) {
+    const bool everywhere =
+        std::any_of(changed.begin(), changed.end(), [](const XzBox& box) { return !box.finite(); });
+    if (everywhere) {
+      for (size_t v = 0; v < velocity_copy_.size(); ++v) velocity_copy_[v] = flow_.velocity(v);
+    } else {
+      std::vector<uint32_t> moved;
+      for (const XzBox& box : changed) bvh_->append_vertices_in(box, &moved);
+      for (const uint32_t v : moved) velocity_copy_[v] = flow_.velocity(v);
+    }
+  }
+  foam_field_.update(field_.flow, bank_distance_, changed, foam_);
 }
 
 Status RiverFlow::set_time(double time_seconds) {
