@@ -37,6 +37,15 @@ float speed2(const glm::vec3& velocity) {
   return velocity.x * velocity.x + velocity.z * velocity.z;
 }
 
+// 1 + the index of the first box holding p; 0 when none does (the boxes are few: one or two per
+// obstacle moved).
+uint32_t first_holding(std::span<const XzBox> boxes, const glm::vec3& p) {
+  for (size_t b = 0; b < boxes.size(); ++b) {
+    if (boxes[b].holds(p)) return uint32_t(b + 1);
+  }
+  return 0u;
+}
+
 // A vertex's foam after one more transport step: its own source, or what the step carried to it
 // from its upstream corners, decayed. One expression for the whole river and for a window, so
 // both round alike.
@@ -84,12 +93,16 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   }
   // A step's upstream point is rounded to a float: off by up to half a float's spacing there.
   float farthest = 0.0f;
-  for (const glm::vec3& p : positions) farthest = std::max({farthest, std::fabs(p.x), std::fabs(p.z)});
+  for (const glm::vec3& p : positions) {
+    farthest = std::max({farthest, std::fabs(p.x), std::fabs(p.z)});
+  }
   field.rounding_ = 2.0f * (std::nextafter(farthest, INFINITY) - farthest);
   std::vector<XzBox> section_bounds(sections);
   for (size_t v = 0; v < count; ++v) section_bounds[section[v]].grow(positions[v]);
   for (const XzBox& box : section_bounds) {
-    if (!box.empty()) field.widest_section_ = std::max(field.widest_section_, glm::length(box.hi - box.lo));
+    if (!box.empty()) {
+      field.widest_section_ = std::max(field.widest_section_, glm::length(box.hi - box.lo));
+    }
   }
   field.indices_ = indices;
   if (around.start.empty()) {
@@ -109,7 +122,8 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   const std::span<const uint32_t> start = around.start.empty() ? field.own_start_ : around.start;
   for (size_t v = 0; v < count; ++v) {
     if (start[v + 1] == start[v]) {
-      return Status::error("FoamField: vertex " + std::to_string(v) + " is a corner of no triangle");
+      return Status::error("FoamField: vertex " + std::to_string(v) +
+                           " is a corner of no triangle");
     }
   }
   *out = std::move(field);
@@ -236,43 +250,38 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
 // changed, and every vertex of a section whose mean speed changed), and those vertices' foam
 // reads nothing farther than n hops more: re-running the n steps on that window, whatever stands
 // outside it, gives the inner vertices their exact values.
-void FoamField::update(std::span<const glm::vec3> velocity,
-                       std::span<const float> bank_distance, std::span<const XzBox> changed,
-                       std::span<float> foam) {
-  const bool bounded = std::all_of(changed.begin(), changed.end(),
-                                   [](const XzBox& box) { return box.finite(); });
+void FoamField::update(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+                       std::span<const XzBox> changed, std::span<float> foam) {
+  const bool bounded =
+      std::all_of(changed.begin(), changed.end(), [](const XzBox& box) { return box.finite(); });
   if (!computed_ || !bounded) {
     compute(velocity, bank_distance, foam);
     return;
   }
   last_rederived_ = 0;
   if (changed.empty()) return;
-  const size_t count = positions_.size();
-  // The vertices in the boxes, each once, ascending (a bit a vertex sorts them).
-  std::vector<uint32_t> found;
-  std::vector<uint64_t> seen((count + 63) / 64);
-  const auto vertices_in = [&](const std::vector<XzBox>& boxes) {
-    found.clear();
-    for (const XzBox& box : boxes) bvh_->append_vertices_in(box, &found);
-    std::fill(seen.begin(), seen.end(), 0);
-    for (const uint32_t v : found) seen[v / 64] |= uint64_t{1} << (v % 64);
-    std::vector<uint32_t> ascending;
-    for (size_t word = 0; word < seen.size(); ++word) {
-      for (uint64_t bits = seen[word]; bits != 0; bits &= bits - 1) {
-        ascending.push_back(uint32_t(64 * word + size_t(std::countr_zero(bits))));
-      }
-    }
-    return ascending;
-  };
-  const auto first_holding = [](const std::vector<XzBox>& boxes, const glm::vec3& p) {
-    for (size_t b = 0; b < boxes.size(); ++b) {
-      if (boxes[b].holds(p)) return uint32_t(b + 1);
-    }
-    return 0u;
-  };
-  // The sources that can change: about each box, the changed vertices' one-rings, and their
-  // sections whole (each section grows the first box that reaches it). The changed vertices lie
-  // in the boxes, so the fastest speed is kept up to date from them.
+  const std::vector<XzBox> sources = resum_sections(velocity, changed);
+  const double hop =
+      double(params_.step_s) * std::sqrt(double(fastest2_)) + longest_edge_ + rounding_;
+  const double reach = double(params_.steps) * hop * (1.0 + 1e-6) + 1e-3;  // float rounding
+  std::vector<XzBox> changed_foam, window_boxes;
+  for (const XzBox& box : sources) {
+    changed_foam.push_back(box.widened(reach));
+    window_boxes.push_back(box.widened(2.0 * reach));
+  }
+  const std::vector<uint32_t> window = vertices_in(window_boxes);
+  if (2 * window.size() > positions_.size()) {
+    compute(velocity, bank_distance, foam);
+    return;
+  }
+  rederive(window, changed_foam, velocity, bank_distance, foam);
+}
+
+std::vector<XzBox> FoamField::resum_sections(std::span<const glm::vec3> velocity,
+                                             std::span<const XzBox> changed) {
+  // About each box, the changed vertices' one-rings, and their sections whole (each section
+  // grows the first box that reaches it). The changed vertices lie in the boxes, so the fastest
+  // speed is kept up to date from them.
   std::vector<XzBox> sources, sections_reach;
   for (const XzBox& box : changed) {
     sources.push_back(box.widened(longest_edge_));
@@ -292,19 +301,12 @@ void FoamField::update(std::span<const glm::vec3> velocity,
     add_speed(v, velocity);
     sources[section_box[section_[v]] - 1].grow(positions_[v]);
   }
-  const double hop =
-      double(params_.step_s) * std::sqrt(double(fastest2_)) + longest_edge_ + rounding_;
-  const double reach = double(params_.steps) * hop * (1.0 + 1e-6) + 1e-3;  // float rounding
-  std::vector<XzBox> changed_foam, window_boxes;
-  for (const XzBox& box : sources) {
-    changed_foam.push_back(box.widened(reach));
-    window_boxes.push_back(box.widened(2.0 * reach));
-  }
-  const std::vector<uint32_t> window = vertices_in(window_boxes);
-  if (2 * window.size() > count) {
-    compute(velocity, bank_distance, foam);
-    return;
-  }
+  return sources;
+}
+
+void FoamField::rederive(std::span<const uint32_t> window, std::span<const XzBox> changed_foam,
+                         std::span<const glm::vec3> velocity,
+                         std::span<const float> bank_distance, std::span<float> foam) {
   last_rederived_ = window.size();
   // The window's vertices first, then the foam outside it that their upstream corners read
   // (held as it was: only the window's outer steps see it).
@@ -312,7 +314,6 @@ void FoamField::update(std::span<const glm::vec3> velocity,
   std::vector<float> source(inner);
   std::vector<Upstream> upstream(inner);
   std::vector<uint32_t> slot(3 * inner);
-  std::vector<float> value;
   std::vector<uint32_t> ring;
   std::vector<uint32_t> outside;  // global vertex of value[inner + k]
   const auto slot_of = [&](uint32_t vertex) {
@@ -328,7 +329,7 @@ void FoamField::update(std::span<const glm::vec3> velocity,
     const size_t t = upstream[i].triangle;
     for (int c = 0; c < 3; ++c) slot[3 * i + c] = slot_of(corner(3 * t + c));
   }
-  value.resize(inner + outside.size());
+  std::vector<float> value(inner + outside.size());
   std::copy(source.begin(), source.end(), value.begin());
   for (size_t k = 0; k < outside.size(); ++k) value[inner + k] = foam[outside[k]];
   const float decay = std::exp(-params_.step_s / params_.lifetime_s);
@@ -336,14 +337,29 @@ void FoamField::update(std::span<const glm::vec3> velocity,
   for (uint32_t step = 0; step < params_.steps; ++step) {
     for (size_t i = 0; i < inner; ++i) {
       const uint32_t* s = &slot[3 * i];
-      next[i] = transported(source[i], decay, upstream[i].weight, value[s[0]], value[s[1]],
-                            value[s[2]]);
+      next[i] =
+          transported(source[i], decay, upstream[i].weight, value[s[0]], value[s[1]], value[s[2]]);
     }
     std::copy(next.begin(), next.end(), value.begin());
   }
   for (size_t i = 0; i < inner; ++i) {
     if (first_holding(changed_foam, positions_[window[i]]) != 0) foam[window[i]] = value[i];
   }
+}
+
+std::vector<uint32_t> FoamField::vertices_in(std::span<const XzBox> boxes) const {
+  std::vector<uint32_t> found;
+  for (const XzBox& box : boxes) bvh_->append_vertices_in(box, &found);
+  // Each once, ascending: a bit a vertex sorts them.
+  std::vector<uint64_t> seen((positions_.size() + 63) / 64, 0);
+  for (const uint32_t v : found) seen[v / 64] |= uint64_t{1} << (v % 64);
+  std::vector<uint32_t> ascending;
+  for (size_t word = 0; word < seen.size(); ++word) {
+    for (uint64_t bits = seen[word]; bits != 0; bits &= bits - 1) {
+      ascending.push_back(uint32_t(64 * word + size_t(std::countr_zero(bits))));
+    }
+  }
+  return ascending;
 }
 
 void FoamField::add_speed(size_t v, std::span<const glm::vec3> velocity) {

@@ -105,6 +105,16 @@ class FoamField {
   Upstream upstream_of(size_t v, std::span<const glm::vec3> velocity) const;
   // Adds vertex v's share to its section's mean speed.
   void add_speed(size_t v, std::span<const glm::vec3> velocity);
+  // update()'s halves: the sections about the changed boxes summed again (and the fastest speed
+  // raised), giving the boxes whose sources can have changed; then the transport re-run on the
+  // window's vertices (ascending), written back where inside `changed_foam`.
+  std::vector<XzBox> resum_sections(std::span<const glm::vec3> velocity,
+                                    std::span<const XzBox> changed);
+  void rederive(std::span<const uint32_t> window, std::span<const XzBox> changed_foam,
+                std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+                std::span<float> foam);
+  // The vertices inside the boxes, each once, ascending.
+  std::vector<uint32_t> vertices_in(std::span<const XzBox> boxes) const;
   uint32_t corner(size_t i) const { return indices_.empty() ? uint32_t(i) : indices_[i]; }
 
   std::span<const glm::vec3> positions_;
@@ -119,13 +129,13 @@ class FoamField {
   std::vector<uint32_t> own_list_;
   std::vector<float> section_speed_;  // per section: its vertices' mean speed
   std::vector<uint32_t> section_size_;
-  float longest_edge_ = 0.0f;     // x/z: how far a triangle's corner lies from a point in it
-  float rounding_ = 0.0f;         // how far a rounded upstream point can lie from the true one
+  float longest_edge_ = 0.0f;    // x/z: how far a triangle's corner lies from a point in it
+  float rounding_ = 0.0f;        // how far a rounded upstream point can lie from the true one
   double widest_section_ = 0.0;  // x/z: how far apart two vertices of one section lie at most
   // At least every vertex's squared speed: set by compute(), only raised by update() (a bound
   // kept from a faster moment widens later windows, never wrongs them).
   float fastest2_ = 0.0f;
-  bool computed_ = false;      // section_speed_ holds the last velocity's
+  bool computed_ = false;  // section_speed_ holds the last velocity's
   size_t last_rederived_ = 0;
 };
 

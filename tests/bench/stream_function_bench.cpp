@@ -70,6 +70,11 @@ void BM_FullSolve(benchmark::State& state) {
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(mesh.positions.size()));
 }
 
+// A boat drifting 5 cm per frame, back and forth: its offset at frame `step`.
+glm::vec3 boat_drift(int step) {
+  return {0.0f, 0.0f, 0.05f * float(step % 40 < 20 ? step % 40 : 40 - step % 40)};
+}
+
 void BM_MoveObstacle(benchmark::State& state) {
   const RiverMesh& mesh = river_mesh(state.range(0));
   StreamFunction flow = make_flow(mesh);
@@ -80,9 +85,7 @@ void BM_MoveObstacle(benchmark::State& state) {
   if (!flow.set_obstacles({rock}).ok()) std::abort();
   int step = 0;
   for (auto _ : state) {
-    // A boat drifting 5 cm per frame, back and forth.
-    const float dz = 0.05f * float(step % 40 < 20 ? step % 40 : 40 - step % 40);
-    if (!flow.move_obstacle(0, centre + glm::vec3(0.0f, 0.0f, dz)).ok()) std::abort();
+    if (!flow.move_obstacle(0, centre + boat_drift(step)).ok()) std::abort();
     ++step;
   }
   state.counters["resolved"] = double(flow.last_update().nodes_resolved);
@@ -99,13 +102,16 @@ void BM_FoamAfterMove(benchmark::State& state) {
   rock.centre = centre;
   rock.radius = 1.5f;
   TriangleBvh bvh;
-  if (!flow.set_obstacles({rock}).ok() || !TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok()) {
+  if (!flow.set_obstacles({rock}).ok() ||
+      !TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok()) {
     std::abort();
   }
   const size_t count = mesh.positions.size();
   const auto [bank, section] = test::foam_inputs(flow.surface(), count);
   FoamField field;
-  if (!FoamField::create(mesh.positions, mesh.indices, section, &bvh, {}, &field).ok()) std::abort();
+  if (!FoamField::create(mesh.positions, mesh.indices, section, &bvh, {}, &field).ok()) {
+    std::abort();
+  }
   std::vector<glm::vec3> velocity(count);
   std::vector<float> foam(count);
   for (size_t v = 0; v < count; ++v) velocity[v] = flow.velocity(v);
@@ -113,8 +119,7 @@ void BM_FoamAfterMove(benchmark::State& state) {
   int step = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    const float dz = 0.05f * float(step % 40 < 20 ? step % 40 : 40 - step % 40);
-    if (!flow.move_obstacle(0, centre + glm::vec3(0.0f, 0.0f, dz)).ok()) std::abort();
+    if (!flow.move_obstacle(0, centre + boat_drift(step)).ok()) std::abort();
     for (size_t v = 0; v < count; ++v) velocity[v] = flow.velocity(v);
     ++step;
     state.ResumeTiming();
