@@ -14,6 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "siviflow/sim/river_tuning.h"
+#include "strip_layering.h"
 #include "siviflow/text_format.h"
 
 namespace siviflow {
@@ -40,173 +41,6 @@ uint64_t hash_position(const glm::vec3& p) {
     h ^= h >> 31;
   }
   return h;
-}
-
-// A CSR adjacency: neighbours of node n are list[start[n] .. start[n+1]).
-struct Csr {
-  std::vector<uint32_t> start;
-  std::vector<uint32_t> list;
-  std::span<const uint32_t> of(uint32_t n) const {
-    return {list.data() + start[n], start[n + 1] - start[n]};
-  }
-};
-
-// What a successful layering from one candidate upstream end gives.
-struct Layering {
-  std::vector<uint32_t> layer;          // section of every node
-  std::vector<uint32_t> chain_start;    // per section, offset into chain_nodes (+1 at the end)
-  std::vector<uint32_t> chain_nodes;    // sections, each from bank_a to bank_b
-  std::vector<uint32_t> bank_a;         // shore node of every section on one bank
-  std::vector<uint32_t> bank_b;         // ... and on the other
-};
-
-// Everything the layering reads: the welded mesh and its border.
-struct MeshView {
-  const std::vector<uint32_t>* tris;
-  const Csr* adjacency;
-  const std::vector<uint32_t>* node_vertex;  // node -> first input vertex, for messages
-};
-
-std::string vertex_name(const MeshView& mesh, uint32_t node) {
-  return std::to_string((*mesh.node_vertex)[node]);
-}
-
-// Splits the mesh into sections by hop distance from the upstream end `end_a` (a border path),
-// then checks that the result is a strip: every triangle joins two neighbouring sections, every
-// section is one chain from bank to bank, each bank holds exactly one vertex per section, and the
-// last section is the far end `end_b`. bank_1 runs from end_a.back() to end_b.front(), bank_2
-// from end_a.front() to end_b.back().
-Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
-                   const std::vector<uint32_t>& end_b, const std::vector<uint32_t>& bank_1,
-                   const std::vector<uint32_t>& bank_2, Layering* out) {
-  const Csr& adj = *mesh.adjacency;
-  const std::vector<uint32_t>& tris = *mesh.tris;
-  const size_t node_count = adj.start.size() - 1;
-
-  if (bank_1.size() != bank_2.size()) {
-    return Status::error(text_format(
-        "the river mesh is not a strip of sections: its banks have different vertex counts "
-        "(%zu from vertex %s and %zu from vertex %s)",
-        bank_1.size(), vertex_name(mesh, bank_1.front()).c_str(), bank_2.size(),
-        vertex_name(mesh, bank_2.front()).c_str()));
-  }
-
-  std::vector<uint32_t> layer(node_count, kUnset);
-  std::vector<uint32_t> queue;
-  queue.reserve(node_count);
-  for (const uint32_t n : end_a) {
-    layer[n] = 0;
-    queue.push_back(n);
-  }
-  for (size_t head = 0; head < queue.size(); ++head) {
-    const uint32_t n = queue[head];
-    for (const uint32_t m : adj.of(n)) {
-      if (layer[m] == kUnset) {
-        layer[m] = layer[n] + 1;
-        queue.push_back(m);
-      }
-    }
-  }
-  uint32_t max_layer = 0;
-  for (const uint32_t l : layer) max_layer = std::max(max_layer, l);  // connected: all set
-  const size_t section_count = size_t{max_layer} + 1;
-  if (section_count < 2) {
-    return Status::error("the river mesh has a single section: a river needs at least two");
-  }
-
-  for (size_t t = 0; t < tris.size() / 3; ++t) {
-    const uint32_t a = tris[3 * t], b = tris[3 * t + 1], c = tris[3 * t + 2];
-    if (layer[a] == layer[b] && layer[b] == layer[c]) {
-      return Status::error(text_format(
-          "the river mesh is not a strip of sections: triangle %zu (vertices %s, %s, %s) lies "
-          "inside section %u instead of joining two neighbouring sections",
-          t, vertex_name(mesh, a).c_str(), vertex_name(mesh, b).c_str(),
-          vertex_name(mesh, c).c_str(), layer[a]));
-    }
-  }
-
-  for (size_t i = 0; i < bank_1.size(); ++i) {
-    for (const uint32_t n : {bank_1[i], bank_2[i]}) {
-      if (layer[n] != i) {
-        return Status::error(text_format(
-            "the river mesh is not a strip of sections: bank vertex %s is the bank's vertex %zu "
-            "but lies in section %u",
-            vertex_name(mesh, n).c_str(), i, layer[n]));
-      }
-    }
-  }
-  if (bank_1.size() != section_count) {
-    return Status::error(text_format(
-        "the river mesh is not a strip of sections: it has %zu sections but %zu vertices on each "
-        "bank",
-        section_count, bank_1.size()));
-  }
-  for (const uint32_t n : end_b) {
-    if (layer[n] != max_layer) {
-      return Status::error(text_format(
-          "the river mesh is not a strip of sections: vertex %s on the downstream end lies in "
-          "section %u, not in the last section %u",
-          vertex_name(mesh, n).c_str(), layer[n], max_layer));
-    }
-  }
-
-  // Nodes by section, each section in node order.
-  std::vector<uint32_t> layer_start(section_count + 1, 0);
-  for (const uint32_t l : layer) ++layer_start[l + 1];
-  for (size_t k = 0; k < section_count; ++k) layer_start[k + 1] += layer_start[k];
-  std::vector<uint32_t> by_layer(node_count);
-  {
-    std::vector<uint32_t> fill(layer_start.begin(), layer_start.end() - 1);
-    for (uint32_t n = 0; n < node_count; ++n) by_layer[fill[layer[n]]++] = n;
-  }
-
-  out->chain_start.assign(section_count + 1, 0);
-  out->chain_nodes.clear();
-  out->chain_nodes.reserve(node_count);
-  for (uint32_t k = 0; k < section_count; ++k) {
-    const uint32_t size = layer_start[k + 1] - layer_start[k];
-    if (size < 2) {
-      return Status::error(text_format(
-          "section %u of the river has a single vertex (%s): a section needs a non-zero width",
-          k, vertex_name(mesh, by_layer[layer_start[k]]).c_str()));
-    }
-    // Walk the chain of same-section edges from one shore to the other.
-    uint32_t prev = kUnset;
-    uint32_t cur = bank_1[k];
-    for (uint32_t steps = 0; cur != kUnset; ++steps) {
-      if (steps >= size) break;  // a cycle: reported below as an incomplete chain
-      out->chain_nodes.push_back(cur);
-      uint32_t next = kUnset;
-      uint32_t same = 0;
-      for (const uint32_t m : adj.of(cur)) {
-        if (layer[m] != k) continue;
-        ++same;
-        if (m != prev && next == kUnset) next = m;
-      }
-      const uint32_t allowed = (prev == kUnset) ? 1 : 2;  // a shore has one neighbour in its section
-      if (same > allowed) {
-        return Status::error(text_format(
-            "the river mesh is not a strip of sections: section %u branches at vertex %s "
-            "(%u neighbours in the same section)",
-            k, vertex_name(mesh, cur).c_str(), same));
-      }
-      prev = cur;
-      cur = next;
-    }
-    const uint32_t walked = static_cast<uint32_t>(out->chain_nodes.size()) - out->chain_start[k];
-    if (walked != size || out->chain_nodes.back() != bank_2[k]) {
-      return Status::error(text_format(
-          "the river mesh is not a strip of sections: section %u is not one chain of edges "
-          "from bank vertex %s to bank vertex %s (%u of its %u vertices reached)",
-          k, vertex_name(mesh, bank_1[k]).c_str(), vertex_name(mesh, bank_2[k]).c_str(), walked,
-          size));
-    }
-    out->chain_start[k + 1] = static_cast<uint32_t>(out->chain_nodes.size());
-  }
-  out->layer = std::move(layer);
-  out->bank_a = bank_1;
-  out->bank_b = bank_2;
-  return Status::success();
 }
 
 // Sum of the triangle angles at every node: about 90 degrees at the four corners of a strip,
@@ -242,6 +76,8 @@ RiverVertex RiverSurface::node(uint32_t n) const {
   v.width = sections_[v.section].width;
   v.d_left = node_d_left_[n];
   v.d_right = node_d_right_[n];
+  v.left_border = node_left_border(n);
+  v.right_border = node_right_border(n);
   v.flow_direction = sections_[v.section].flow_direction;
   return v;
 }
@@ -251,7 +87,8 @@ size_t RiverSurface::memory_bytes() const {
   return bytes(node_of_vertex_) + bytes(node_vertex_) + bytes(node_positions_) +
          bytes(node_section_) + bytes(node_bank_) + bytes(node_d_left_) + bytes(node_d_right_) +
          bytes(triangles_) + bytes(node_tri_start_) + bytes(node_tri_list_) + bytes(sections_) +
-         bytes(section_nodes_);
+         bytes(section_nodes_) + bytes(node_left_border_) + bytes(node_right_border_) +
+         bytes(islands_) + bytes(island_nodes_);
 }
 
 Status RiverSurface::share_mesh(std::span<const glm::vec3> positions,
@@ -271,6 +108,73 @@ Status RiverSurface::share_mesh(std::span<const glm::vec3> positions,
   shared_triangles_ = triangles;
   node_positions_ = std::vector<glm::vec3>();
   triangles_ = std::vector<uint32_t>();
+  return Status::success();
+}
+
+Status RiverSurface::measure_arms(std::span<const uint32_t> chain,
+                                  std::span<const glm::vec3> pos,
+                                  const std::vector<uint32_t>& node_island,
+                                  const std::vector<uint32_t>& node_vertex, size_t section,
+                                  double min_arm, double* width) {
+  auto border_of = [&](size_t i) -> int {
+    if (i == 0) return kLeftBankBorder;
+    if (i + 1 == chain.size()) return kRightBankBorder;
+    const uint32_t island = node_island[chain[i]];
+    return island == kNoNode ? -1 : static_cast<int>(island_border(island));
+  };
+  // Forward: the border last passed and the distance from it; the water between two borders
+  // is an arm, and the section's width is the sum of its arms.
+  *width = 0.0;
+  int last = kLeftBankBorder;
+  size_t last_at = 0;
+  double from_last = 0.0;
+  for (size_t i = 1; i < chain.size(); ++i) {
+    const int border = border_of(i);
+    const bool along_one_border = border >= 0 && border == border_of(i - 1);
+    if (!along_one_border) {  // over water (a jump across an island joins two nodes of one border)
+      from_last += glm::distance(glm::dvec3(pos[chain[i - 1]]), glm::dvec3(pos[chain[i]]));
+    }
+    if (border < 0) {
+      node_left_border_[chain[i]] = static_cast<uint16_t>(last);
+      node_d_left_[chain[i]] = static_cast<float>(from_last);
+      continue;
+    }
+    if (!along_one_border) {
+      if (!(from_last > min_arm)) {
+        return Status::error(text_format(
+            "section %zu of the river has a zero-width neck (%g m of water between vertices %u "
+            "and %u): an island touches a bank or another island there",
+            section, from_last, node_vertex[chain[last_at]], node_vertex[chain[i]]));
+      }
+      *width += from_last;
+    }
+    if (i + 1 == chain.size()) {  // the right shore: its far side is the last arm away
+      node_left_border_[chain[i]] = static_cast<uint16_t>(last);
+      node_d_left_[chain[i]] = static_cast<float>(from_last);
+    } else {
+      node_left_border_[chain[i]] = node_right_border_[chain[i]] = static_cast<uint16_t>(border);
+    }
+    last = border;
+    last_at = i;
+    from_last = 0.0;
+  }
+  // Backward: the next border and the distance to it.
+  int next = kRightBankBorder;
+  double to_next = 0.0;
+  for (size_t i = chain.size() - 1; i-- > 0;) {
+    const int border = border_of(i);
+    if (!(border >= 0 && border == border_of(i + 1))) {
+      to_next += glm::distance(glm::dvec3(pos[chain[i + 1]]), glm::dvec3(pos[chain[i]]));
+    }
+    if (border < 0 || i == 0) {
+      node_right_border_[chain[i]] = static_cast<uint16_t>(next);
+      node_d_right_[chain[i]] = static_cast<float>(to_next);
+    }
+    if (border >= 0) {
+      next = border;
+      to_next = 0.0;
+    }
+  }
   return Status::success();
 }
 
@@ -339,7 +243,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     }
   }
   const size_t node_count = pos.size();
-  const MeshView view_for_names{nullptr, nullptr, &node_vertex};
+  const MeshView view_for_names{nullptr, nullptr, nullptr, &node_vertex, nullptr, nullptr};
 
   // --- Triangles on nodes; reject degenerate ones (they have no normal and no gradient).
   std::vector<uint32_t> tris(index_count);
@@ -433,7 +337,8 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
             } else {
               return Status::error(text_format(
                   "the river mesh is non-manifold at vertex %u: more than two border edges meet "
-                  "there (two parts of the mesh touch at a single vertex)",
+                  "there (two parts of the mesh, an island and a bank, or a border and itself touch at a "
+                  "single vertex)",
                   node_vertex[x]));
             }
             on_border[x] = 1;
@@ -474,11 +379,20 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     }
   }
 
-  // --- The border: exactly one loop.
+  // --- The border: the outer loop, holding the upstream vertex, and one loop per island.
+  if (std::find(on_border.begin(), on_border.end(), 1) == on_border.end()) {
+    return Status::error("the river mesh is closed (it has no border): a river is an open strip");
+  }
+  const uint32_t upstream_node = node_of_vertex[options.upstream_vertex];
+  if (!on_border[upstream_node]) {
+    return Status::error(text_format(
+        "river vertex %u marks the upstream end but is not on the border of the mesh: the "
+        "upstream end is the end section holding it (a corner, in the paper's meshes)",
+        options.upstream_vertex));
+  }
   std::vector<uint32_t> loop;
+  std::vector<std::vector<uint32_t>> island_loops;
   {
-    uint32_t loops = 0;
-    uint32_t second_loop_node = kUnset;
     std::vector<uint8_t> seen(node_count, 0);
     for (uint32_t s = 0; s < node_count; ++s) {
       if (!on_border[s] || seen[s]) continue;
@@ -487,39 +401,47 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
             "the river mesh is non-manifold at vertex %u: a single border edge ends there",
             node_vertex[s]));
       }
-      if (loops == 1) second_loop_node = s;
-      ++loops;
+      std::vector<uint32_t> walked;
       uint32_t prev = kUnset, cur = s;
       do {
-        if (loops == 1) loop.push_back(cur);
+        walked.push_back(cur);
         seen[cur] = 1;
         const uint32_t next = border_next[cur][0] != prev ? border_next[cur][0] : border_next[cur][1];
         prev = cur;
         cur = next;
       } while (cur != s && cur != kUnset && !seen[cur]);
+      if (std::find(walked.begin(), walked.end(), upstream_node) != walked.end()) {
+        loop = std::move(walked);
+      } else {
+        island_loops.push_back(std::move(walked));
+      }
     }
-    if (loops == 0) {
-      return Status::error("the river mesh is closed (it has no border): a river is an open strip");
-    }
-    if (loops > 1) {
+    if (island_loops.size() > kMaxRiverIslands) {
       return Status::error(text_format(
-          "the river mesh has %u border loops where a strip has one: there is a hole (an island?) "
-          "at vertex %u; cut islands out as obstacles instead",
-          loops, node_vertex[second_loop_node]));
+          "the river mesh has %zu holes (islands), more than the limit of %zu",
+          island_loops.size(), kMaxRiverIslands));
     }
   }
   const long euler = static_cast<long>(node_count) - static_cast<long>(edge_count) +
                      static_cast<long>(tri_count);
-  if (euler != 1) {
+  if (euler != 1 - static_cast<long>(island_loops.size())) {
     return Status::error(text_format(
-        "the river mesh is not a disc (Euler characteristic %ld, a strip has 1): it has handles",
-        euler));
+        "the river mesh is not a disc with holes (Euler characteristic %ld, a strip with %zu "
+        "islands has %ld): it has handles",
+        euler, island_loops.size(), 1 - static_cast<long>(island_loops.size())));
   }
   if (loop.size() < 4) {
     return Status::error(text_format(
         "the river mesh has only %zu border vertices: a river needs at least two sections of two "
         "vertices each",
         loop.size()));
+  }
+  std::vector<uint32_t> node_island;
+  if (!island_loops.empty()) {
+    node_island.assign(node_count, kNoNode);
+    for (uint32_t i = 0; i < island_loops.size(); ++i) {
+      for (const uint32_t n : island_loops[i]) node_island[n] = i;
+    }
   }
 
   // --- Corners: the four sharpest border vertices (about 90 degrees; banks and ends are about
@@ -547,13 +469,6 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   };
   const std::array<std::vector<uint32_t>, 4> sides = {side(0), side(1), side(2), side(3)};
 
-  const uint32_t upstream_node = node_of_vertex[options.upstream_vertex];
-  if (!on_border[upstream_node]) {
-    return Status::error(text_format(
-        "river vertex %u marks the upstream end but is not on the border of the mesh: the "
-        "upstream end is the end section holding it (a corner, in the paper's meshes)",
-        options.upstream_vertex));
-  }
   // Candidate upstream ends: the sides holding the marker, shortest first (a river is longer
   // than it is wide, so when the marker is a corner the short side is the end).
   std::vector<int> candidates;
@@ -566,7 +481,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     return path_length(pos, sides[i]) < path_length(pos, sides[j]);
   });
 
-  const MeshView mesh{&tris, &adj, &node_vertex};
+  const MeshView mesh{&pos, &tris, &adj, &node_vertex, &island_loops, &node_island};
   Layering layering;
   Status first_error;
   bool found = false;
@@ -631,6 +546,15 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   s.node_bank_.assign(node_count, Bank::kNone);
   s.node_d_left_.assign(node_count, 0.0f);
   s.node_d_right_.assign(node_count, 0.0f);
+  if (!island_loops.empty()) {
+    s.node_left_border_.assign(node_count, kLeftBankBorder);
+    s.node_right_border_.assign(node_count, kRightBankBorder);
+    for (const std::vector<uint32_t>& island : island_loops) {
+      s.islands_.push_back({static_cast<uint32_t>(s.island_nodes_.size()),
+                            static_cast<uint32_t>(island.size())});
+      s.island_nodes_.insert(s.island_nodes_.end(), island.begin(), island.end());
+    }
+  }
   double along = 0.0;
   for (size_t k = 0; k < section_count; ++k) {
     RiverSection& sec = s.sections_[k];
@@ -646,20 +570,26 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     sec.node_count = static_cast<uint32_t>(end - begin);
     const std::span<const uint32_t> chain(s.section_nodes_.data() + sec.first_node, sec.node_count);
 
-    std::vector<double> arc(chain.size(), 0.0);
-    for (size_t i = 1; i < chain.size(); ++i) {
-      arc[i] = arc[i - 1] + glm::distance(to_d(pos[chain[i - 1]]), to_d(pos[chain[i]]));
-    }
-    const double width = arc.back();
     const uint32_t left = chain.front(), right = chain.back();
+    double width = 0.0;
+    if (island_loops.empty()) {
+      std::vector<double> arc(chain.size(), 0.0);
+      for (size_t i = 1; i < chain.size(); ++i) {
+        arc[i] = arc[i - 1] + glm::distance(to_d(pos[chain[i - 1]]), to_d(pos[chain[i]]));
+      }
+      width = arc.back();
+      for (size_t i = 0; i < chain.size(); ++i) {
+        s.node_d_left_[chain[i]] = static_cast<float>(arc[i]);
+        s.node_d_right_[chain[i]] = static_cast<float>(width - arc[i]);
+      }
+    } else {
+      SIVIFLOW_TRY(s.measure_arms(chain, pos, node_island, node_vertex, k,
+                                  kMinSectionWidthRelative * extent, &width));
+    }
     if (!(width > kMinSectionWidthRelative * extent)) {
       return Status::error(text_format(
           "section %zu of the river has zero width (%g m between its shore vertices %u and %u)",
           k, width, node_vertex[left], node_vertex[right]));
-    }
-    for (size_t i = 0; i < chain.size(); ++i) {
-      s.node_d_left_[chain[i]] = static_cast<float>(arc[i]);
-      s.node_d_right_[chain[i]] = static_cast<float>(width - arc[i]);
     }
     s.node_bank_[left] = Bank::kLeft;
     s.node_bank_[right] = Bank::kRight;

@@ -2,6 +2,8 @@
 // and every bad river mesh of reliability.md §5 that reaches the sim.
 #include "siviflow/sim/river_surface.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -11,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "siviflow/sim/river_tuning.h"
+#include "sim/grid_holes.h"
 #include "unit/river_test_meshes.h"
 
 namespace siviflow {
@@ -311,8 +314,9 @@ TEST(RiverSurfaceBad, UnusedVertex) {
   expect_error(m, {"vertex 15", "not used"});
 }
 
-TEST(RiverSurfaceBad, HoleIsNotAStrip) {
-  // A 5x5 grid of vertices missing its middle quad.
+TEST(RiverSurfaceIsland, AHoleIsAnIslandBetweenTwoArms) {
+  // A 5x5 grid of vertices 2 m apart (x = 4 .. -4, z = 0 .. 8) missing the quad at x in [0, 2],
+  // z in [2, 4]: a left arm 2 m wide and a right arm 4 m wide.
   TestMesh m = test::straight_channel(8, 8, 5, 5);
   std::vector<uint32_t> kept;
   for (size_t t = 0; t < m.indices.size(); t += 3) {
@@ -320,12 +324,71 @@ TEST(RiverSurfaceBad, HoleIsNotAStrip) {
     for (int i = 0; i < 3; ++i) {
       const uint32_t v = m.indices[t + i];
       const uint32_t k = v / 5, j = v % 5;
-      middle = middle && (k == 2 || k == 3) && (j == 2 || j == 3);
+      middle = middle && (k == 1 || k == 2) && (j == 1 || j == 2);
     }
     if (!middle) kept.insert(kept.end(), m.indices.begin() + long(t), m.indices.begin() + long(t) + 3);
   }
   m.indices = kept;
-  expect_error(m, {"border loops"});
+  RiverSurface s;
+  const Status status = build(m, &s);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(s.islands().size(), 1u);
+  EXPECT_EQ(s.island_nodes(0).size(), 4u);
+  ASSERT_EQ(s.sections().size(), 5u);
+  for (uint32_t n = 0; n < s.node_count(); ++n) {
+    const RiverVertex v = s.node(n);
+    const glm::vec3 p = s.node_positions()[n];
+    EXPECT_EQ(v.section, uint32_t(std::lround(p.z / 2))) << "vertex " << n;
+    const bool beside = v.section == 1 || v.section == 2;
+    const bool shore = beside && p.x > -1.0f && p.x < 3.0f;
+    EXPECT_EQ(s.on_island(n), shore) << "vertex " << n;
+    if (shore || !beside) continue;
+    const bool left = p.x > 0.0f;
+    EXPECT_EQ(v.left_border, left ? kLeftBankBorder : island_border(0)) << "vertex " << n;
+    EXPECT_EQ(v.right_border, left ? island_border(0) : kRightBankBorder) << "vertex " << n;
+    EXPECT_NEAR(v.d_left + v.d_right, left ? 2.0f : 4.0f, 1e-5f) << "vertex " << n;
+    EXPECT_NEAR(left ? v.d_left : v.d_right, 4.0f - std::abs(p.x), 1e-5f) << "vertex " << n;
+    EXPECT_NEAR(v.width, 6.0f, 1e-5f) << "vertex " << n;
+  }
+}
+
+TEST(RiverSurfaceIsland, AnEllipticIslandKeepsEverySectionFromBankToBank) {
+  const TestMesh m = test::channel_with_island(10, 60, 61, 21, 1.0f, 30.0f, 2.0f, 12.0f);
+  RiverSurface s;
+  const Status status = build(m, &s);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(s.islands().size(), 1u);
+  ASSERT_EQ(s.sections().size(), 61u);
+  size_t parted = 0;
+  for (size_t k = 0; k < s.sections().size(); ++k) {
+    const auto nodes = s.section_nodes(k);
+    EXPECT_EQ(s.node_bank()[nodes.front()], Bank::kLeft);
+    EXPECT_EQ(s.node_bank()[nodes.back()], Bank::kRight);
+    bool island = false;
+    for (const uint32_t n : nodes) {
+      island = island || s.on_island(n);
+      EXPECT_NEAR(s.node_positions()[n].z, float(k), 1e-4f) << "section " << k;
+    }
+    parted += island ? 1 : 0;
+  }
+  // Quad centres at z = k + 0.5 inside |z - 30| < 12 cut 24 rows of quads: 25 sections meet it.
+  EXPECT_EQ(parted, 25u);
+}
+
+TEST(RiverSurfaceBad, IslandTouchingABank) {
+  // A 5x5 grid (vertex k * 5 + j) missing quad (1, 1) and the triangle of quad (1, 0) that
+  // reaches the left bank's vertex 10: the island's shore passes through the bank there.
+  TestMesh m = test::straight_channel(8, 8, 5, 5);
+  std::vector<uint32_t> kept;
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    const std::array<uint32_t, 3> tri{m.indices[t], m.indices[t + 1], m.indices[t + 2]};
+    const bool island = std::find(tri.begin(), tri.end(), 7u) != tri.end() &&
+                        std::find(tri.begin(), tri.end(), 11u) != tri.end();
+    const bool pinch = tri == std::array<uint32_t, 3>{6, 11, 10};
+    if (!island && !pinch) kept.insert(kept.end(), tri.begin(), tri.end());
+  }
+  m.indices = kept;
+  expect_error(m, {"vertex 10", "an island and a bank"});
 }
 
 TEST(RiverSurfaceBad, NonManifoldEdge) {

@@ -13,6 +13,7 @@
 #include <glm/vec3.hpp>
 
 #include "siviflow/sim/stream_function.h"
+#include "sim/grid_holes.h"
 
 namespace siviflow::test {
 
@@ -92,6 +93,23 @@ inline TestMesh symmetric_channel(float width, float length, uint32_t sections, 
       }
     }
   }
+  return m;
+}
+
+// symmetric_channel with an island: the quads whose centres lie in the ellipse about (x, z)
+// with half-axes rx across and rz along the flow cut out.
+inline TestMesh channel_with_island(float width, float length, uint32_t sections, uint32_t across,
+                                    float x, float z, float rx, float rz) {
+  TestMesh m = symmetric_channel(width, length, sections, across);
+  const float dx = width / float(across - 1), dz = length / float(sections - 1);
+  cut_grid_quads(
+      across,
+      [&](uint32_t k, uint32_t j) {
+        const float qx = 0.5f * width - dx * (float(j) + 0.5f) - x;
+        const float qz = dz * (float(k) + 0.5f) - z;
+        return (qx / rx) * (qx / rx) + (qz / rz) * (qz / rz) < 1.0f;
+      },
+      &m.positions, &m.indices);
   return m;
 }
 

@@ -4,7 +4,9 @@
 //
 // The mesh must be a strip: a triangulated band whose rows (sections) run from bank to bank,
 // every triangle joining two neighbouring sections. Sections may differ in width and in vertex
-// count. The vertex order does not matter, except that the upstream end is the end section
+// count. The strip may have holes, the islands: a section that meets an island goes on from its
+// far side, so the island's shore is a border like the banks, between two arms of the river.
+// An island vertex has no distance to either side (d_left = d_right = 0, both borders its own). The vertex order does not matter, except that the upstream end is the end section
 // holding vertex `RiverSurfaceOptions::upstream_vertex` (vertex 0 by default: the paper's "first
 // vertex is a corner"). The left bank is on the left looking downstream with +Y up (glTF).
 //
@@ -41,13 +43,29 @@ struct RiverSection {
   glm::vec3 flow_direction{0.0f};  // unit, horizontal, downstream (paper §2.1)
 };
 
+// The borders of the water: the two banks and the islands' shores. Every vertex lies between a
+// border on its left and one on its right along its section (the two banks, where no island
+// parts the river).
+using BorderId = uint16_t;
+inline constexpr BorderId kLeftBankBorder = 0;
+inline constexpr BorderId kRightBankBorder = 1;
+inline constexpr BorderId island_border(size_t island) { return static_cast<BorderId>(2 + island); }
+
+// One island: a hole in the river mesh, its shore a closed loop of nodes.
+struct RiverIsland {
+  uint32_t first_node = 0;  // offset into RiverSurface::island_nodes()
+  uint32_t node_count = 0;  // the shore's nodes in border order
+};
+
 // What Algorithm 1 stores per vertex.
 struct RiverVertex {
   uint32_t section = 0;
   Bank bank = Bank::kNone;
-  float width = 0.0f;    // width of the vertex's section
-  float d_left = 0.0f;   // distance along the section to the left shore
-  float d_right = 0.0f;  // distance along the section to the right shore
+  float width = 0.0f;    // width of the vertex's section (the sum of its arms around islands)
+  float d_left = 0.0f;   // distance along the section to the border on the left
+  float d_right = 0.0f;  // distance along the section to the border on the right
+  BorderId left_border = kLeftBankBorder;
+  BorderId right_border = kRightBankBorder;
   glm::vec3 flow_direction{0.0f};  // the section's flow direction
 };
 
@@ -57,7 +75,8 @@ class RiverSurface {
   // non-indexed (every three positions make a triangle). Fails, naming the vertex, triangle or
   // section, on: no or too many vertices, non-finite positions, indices out of range or not a
   // multiple of three, degenerate triangles, unused vertices, non-manifold edges or vertices,
-  // several pieces or holes, anything that is not a strip of >= 2 sections, zero-width sections.
+  // several pieces, anything that is not a strip of >= 2 sections (with islands, each crossed by
+  // a section once), zero-width sections, islands touching a bank or each other.
   // `out` is left untouched on failure.
   static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                       const RiverSurfaceOptions& options, RiverSurface* out);
@@ -81,6 +100,24 @@ class RiverSurface {
   std::span<const Bank> node_bank() const { return node_bank_; }
   std::span<const float> node_d_left() const { return node_d_left_; }
   std::span<const float> node_d_right() const { return node_d_right_; }
+  BorderId node_left_border(uint32_t n) const {
+    return node_left_border_.empty() ? kLeftBankBorder : node_left_border_[n];
+  }
+  BorderId node_right_border(uint32_t n) const {
+    return node_right_border_.empty() ? kRightBankBorder : node_right_border_[n];
+  }
+  // Whether node n lies on an island's shore, and which.
+  bool on_island(uint32_t n) const {
+    return !node_left_border_.empty() && node_left_border_[n] >= island_border(0) &&
+           node_d_left_[n] == 0.0f && node_d_right_[n] == 0.0f;
+  }
+  size_t island_of(uint32_t n) const { return node_left_border_[n] - island_border(0); }
+
+  std::span<const RiverIsland> islands() const { return islands_; }
+  // The shore of island i, in border order (closed: the last node neighbours the first).
+  std::span<const uint32_t> island_nodes(size_t i) const {
+    return {island_nodes_.data() + islands_[i].first_node, islands_[i].node_count};
+  }
   // The first input vertex welded into node n (what error messages call "vertex").
   uint32_t vertex_of_node(uint32_t n) const { return welded() ? node_vertex_[n] : n; }
 
@@ -116,6 +153,13 @@ class RiverSurface {
   Status share_mesh(std::span<const glm::vec3> positions, std::span<const uint32_t> triangles);
 
  private:
+  // With islands: the distances, borders and arms of section `section` (`chain`, left to right);
+  // its width, the sum of its arms, in `width`. Fails on an arm narrower than `min_arm`.
+  Status measure_arms(std::span<const uint32_t> chain, std::span<const glm::vec3> pos,
+                      const std::vector<uint32_t>& node_island,
+                      const std::vector<uint32_t>& node_vertex, size_t section, double min_arm,
+                      double* width);
+
   std::vector<uint32_t> node_of_vertex_;  // both empty when nothing was welded
   std::vector<uint32_t> node_vertex_;
   std::vector<glm::vec3> node_positions_;
@@ -128,6 +172,11 @@ class RiverSurface {
   std::vector<uint32_t> node_tri_list_;
   std::vector<RiverSection> sections_;
   std::vector<uint32_t> section_nodes_;
+  // Only with islands: the border on each side of every node, and the islands' shores.
+  std::vector<BorderId> node_left_border_;
+  std::vector<BorderId> node_right_border_;
+  std::vector<RiverIsland> islands_;
+  std::vector<uint32_t> island_nodes_;
   // After share_mesh: where the positions and triangles are read instead of the vectors above.
   std::span<const glm::vec3> shared_positions_;
   std::span<const uint32_t> shared_triangles_;

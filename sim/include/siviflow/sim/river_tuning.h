@@ -18,6 +18,8 @@ inline constexpr float kDefaultSearchRadiusFactor = 3.0f;
 // Caps that keep every internal 32-bit index and every allocation sane before we allocate.
 inline constexpr size_t kMaxRiverVertices = size_t{1} << 27;
 inline constexpr size_t kMaxRiverTriangles = size_t{1} << 28;
+// Islands (holes in the river mesh) take a 16-bit border index beside the two banks.
+inline constexpr size_t kMaxRiverIslands = 65000;
 // Obstacles are few (objects touching the water); polygons are footprints, not meshes.
 inline constexpr size_t kMaxObstacles = 4096;
 inline constexpr size_t kMaxPolygonPoints = 4096;
