@@ -8,6 +8,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "island_circulation.h"
 #include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
 
@@ -43,6 +44,8 @@ double ratio_pow(double r, double p) {
 }
 
 glm::dvec2 xz(const glm::vec3& v) { return {v.x, v.z}; }
+
+glm::vec3 pos_of(const RiverSurface& s, uint32_t n) { return s.node_positions()[n]; }
 
 }  // namespace
 
@@ -84,6 +87,18 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
     }
   }
 
+  SIVIFLOW_TRY(island_stream_values(s, params.discharge, &f.island_psi_));
+  for (size_t i = 0; i < s.islands().size(); ++i) {
+    const auto shore = s.island_nodes(i);
+    for (size_t j = 0; j < shore.size(); ++j) {
+      const glm::vec3 d = pos_of(s, shore[(j + 1) % shore.size()]) -
+                          pos_of(s, shore[(j + shore.size() - 1) % shore.size()]);
+      f.island_tangent_.push_back({shore[j], glm::normalize(d)});
+    }
+  }
+  std::sort(f.island_tangent_.begin(), f.island_tangent_.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+
   // No obstacles yet: the field is the obstacle-free one.
   f.psi_.resize(nodes);
   for (uint32_t n = 0; n < nodes; ++n) {
@@ -101,7 +116,8 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
 double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const {
   *wet = true;
   const double s = params_.search_radius;
-  const double q = params_.discharge;
+  const BorderId left = surface_.node_left_border(n), right = surface_.node_right_border(n);
+  const double psi_left = border_psi(left), psi_right = border_psi(right);
   double dl = surface_.node_d_left()[n];
   double dr = surface_.node_d_right()[n];
 
@@ -124,9 +140,9 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
         return st.psi;
       }
       if (st.merged == Bank::kLeft) {
-        dl = std::min(dl, d);
+        if (left == kLeftBankBorder) dl = std::min(dl, d);
       } else if (st.merged == Bank::kRight) {
-        dr = std::min(dr, d);
+        if (right == kRightBankBorder) dr = std::min(dr, d);
       } else {
         if (d == 0.0 && on_obstacle == nullptr) on_obstacle = &st.psi;
         nearest = std::min(nearest, d);
@@ -140,8 +156,8 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
   }
   if (dl < s) nearest = std::min(nearest, dl);
   if (dr < s) nearest = std::min(nearest, dr);
-  if (dl <= 0.0) return q;
-  if (dr <= 0.0) return 0.0;
+  if (dl <= 0.0) return psi_left;
+  if (dr <= 0.0) return psi_right;
   if (on_obstacle != nullptr) return *on_obstacle;
 
   // Pass 2: w_i scaled by nearest^p, which is the product form of algorithms.md §1.1 divided by
@@ -153,8 +169,8 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
     num += w * value;
     den += w;
   };
-  if (dl < s) add(dl, q);
-  if (dr < s) add(dr, 0.0);
+  if (dl < s) add(dl, psi_left);
+  if (dr < s) add(dr, psi_right);
   if (reached <= kKept) {
     for (size_t i = 0; i < reached; ++i) add(kept_d[i], kept_psi[i]);
   } else {
@@ -202,7 +218,18 @@ StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t) const {
 
 glm::vec3 StreamFunction::triangle_velocity(uint32_t t) const { return triangle_flow(t).velocity; }
 
+double StreamFunction::border_psi(BorderId border) const {
+  if (border == kLeftBankBorder) return params_.discharge;
+  if (border == kRightBankBorder) return 0.0;
+  return island_psi_[border - island_border(0)];
+}
+
 glm::vec3 StreamFunction::bank_tangent(uint32_t n) const {
+  if (surface_.on_island(n)) {
+    const auto it = std::lower_bound(island_tangent_.begin(), island_tangent_.end(), n,
+                                     [](const auto& entry, uint32_t node) { return entry.first < node; });
+    return it->second;
+  }
   const Bank bank = surface_.node_bank()[n];
   if (bank == Bank::kNone) return glm::vec3(0.0f);
   const auto sections = surface_.sections();
@@ -238,6 +265,7 @@ void StreamFunction::update_node_velocity(uint32_t n) {
 size_t StreamFunction::memory_bytes() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return surface_.memory_bytes() + bytes(psi_) + bytes(wet_) + bytes(node_velocity_) +
+         bytes(island_psi_) + bytes(island_tangent_) +
          bytes(obstacles_) + bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
          triangle_grid_.memory_bytes() + bytes(node_stamp_) + bytes(triangle_stamp_) +
          bytes(scratch_nodes_) + bytes(scratch_triangles_);

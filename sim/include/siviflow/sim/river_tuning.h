@@ -14,6 +14,12 @@ inline constexpr float kDefaultShepardPower = 1.5f;
 // close to the pure power law (algorithms.md §6.2 shows how s near W sharpens it).
 inline constexpr float kDefaultSearchRadiusFactor = 3.0f;
 
+// Islands' psi (island_circulation.h): each cluster of islands is solved on the sections within
+// this many widest-section widths of it, to this relative residual, in at most this many steps.
+inline constexpr double kIslandSolveMarginWidths = 2.0;
+inline constexpr double kIslandSolveTolerance = 1e-10;
+inline constexpr int kIslandSolveMaxIterations = 20000;
+
 // --- Input limits (reliability.md §5 rows 8 and 17) -----------------------------------------
 // Caps that keep every internal 32-bit index and every allocation sane before we allocate.
 inline constexpr size_t kMaxRiverVertices = size_t{1} << 27;

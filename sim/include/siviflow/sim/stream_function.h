@@ -3,8 +3,9 @@
 // psi(P) = sum_i w(d_i) psi_i / sum_i w(d_i),  w(d) = d^-p f(1 - d/s) for d < s, else 0,
 // f(t) = 6t^5 - 15t^4 + 10t^3 (t clamped to [0, 1]).
 //
-// Boundaries: the left bank (psi = Q), the right bank (psi = 0), with in-river distances measured
-// along each vertex's section, and the obstacles in the water, at the XZ distance to their
+// Boundaries: the left bank (psi = Q), the right bank (psi = 0), each island's shore (the psi
+// of zero circulation about it, island_circulation.h), with in-river distances measured along
+// each vertex's section to the border on either side of it, and the obstacles in the water, at the XZ distance to their
 // footprint, each with psi = the obstacle-free field at its centre (so the total discharge is
 // kept). An obstacle whose footprint crosses one bank is part of that bank: it takes the bank's
 // psi (no water passes between them) and the bank's distance becomes the nearer of the two, so
@@ -16,6 +17,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -98,6 +100,12 @@ class StreamFunction {
   // Computed when asked (a long river cannot keep 12 bytes per triangle for it).
   glm::vec3 triangle_velocity(uint32_t t) const;
 
+  // --- Per island: psi on its shore. The discharge passing on its left is psi_left_border -
+  // island_psi, on its right island_psi - psi_right_border.
+  double island_psi(size_t i) const { return island_psi_[i]; }
+  // Q on the left bank, 0 on the right, island_psi on an island's shore.
+  double border_psi(BorderId border) const;
+
   // --- Per obstacle.
   glm::vec3 obstacle_centre(size_t i) const { return state_[i].centre; }
   bool obstacle_in_water(size_t i) const { return state_[i].in_water; }
@@ -140,6 +148,9 @@ class StreamFunction {
   std::vector<double> psi_;
   std::vector<uint8_t> wet_;
   std::vector<glm::vec3> node_velocity_;
+  std::vector<double> island_psi_;
+  // Every island shore node's tangent (a shore is a streamline, as a bank is), by node.
+  std::vector<std::pair<uint32_t, glm::vec3>> island_tangent_;
   std::vector<Obstacle> obstacles_;
   std::vector<ObstacleState> state_;
   std::vector<uint32_t> active_;             // obstacles in the water, ascending
