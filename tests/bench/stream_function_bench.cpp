@@ -12,6 +12,7 @@
 #include "siviflow/sim/river_surface.h"
 #include "siviflow/sim/stream_function.h"
 #include "sim/foam.h"
+#include "sim/grid_holes.h"
 #include "sim/triangle_bvh.h"
 #include "unit/foam_inputs.h"
 
@@ -45,6 +46,44 @@ StreamFunction make_flow(const RiverMesh& mesh) {
     std::abort();
   }
   return flow;
+}
+
+// The river above with ten islands cut out along it, alternately left and right of the middle:
+// each 9 quads across (of 40) and 80 sections (24 m) long.
+const RiverMesh& river_with_islands(int64_t vertices) {
+  static std::map<int64_t, std::unique_ptr<RiverMesh>> cache;
+  auto& slot = cache[vertices];
+  if (!slot) {
+    slot = std::make_unique<RiverMesh>(river_mesh(vertices));
+    const double sections = double(slot->section_count);
+    cut_grid_quads(
+        kAcross,
+        [&](uint32_t k, uint32_t j) {
+          const int island = int(double(k) * 10.0 / sections);
+          const double dk = (double(k) + 0.5 - (island + 0.5) * sections / 10.0) / 40.0;
+          const double dj = (double(j) + 0.5 - (island % 2 == 0 ? 16.0 : 24.0)) / 4.5;
+          return dk * dk + dj * dj < 1.0;
+        },
+        &slot->positions, &slot->indices, &slot->depth);
+  }
+  return *slot;
+}
+
+// The surface and the obstacle-free solve, as a river is loaded: a strip against the same river
+// with ten islands (issue 29: at most 2x).
+void BM_LoadFlow(benchmark::State& state) {
+  const RiverMesh& mesh = state.range(1) != 0 ? river_with_islands(state.range(0)) : river_mesh(state.range(0));
+  for (auto _ : state) {
+    RiverSurface surface;
+    StreamFunction flow;
+    if (!RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok() ||
+        !StreamFunction::create(std::move(surface), {20.0f, 1.5f, 0.0f}, &flow).ok()) {
+      state.SkipWithError("the river did not load");
+      return;
+    }
+    benchmark::DoNotOptimize(flow.node_psi().data());
+  }
+  state.counters["islands"] = double(state.range(1) != 0 ? 10 : 0);
 }
 
 void BM_SurfaceBuild(benchmark::State& state) {
@@ -138,6 +177,7 @@ BENCHMARK(BM_SurfaceBuild)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000
 BENCHMARK(BM_FullSolve)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MoveObstacle)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LoadFlow)->ArgsProduct({{100'000}, {0, 1}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FoamAfterMove)->ArgsProduct({{100'000, 1'500'000}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 
