@@ -4,9 +4,8 @@
 
 #include <cstdint>
 #include <functional>
-#include <vector>
-
 #include <glm/vec3.hpp>
+#include <vector>
 
 namespace siviflow {
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
@@ -32,8 +31,10 @@ std::vector<Cluster> clusters_of(const RiverSurface& surface) {
       k0 = std::min(k0, surface.node_section()[n]);
       k1 = std::max(k1, surface.node_section()[n]);
     }
-    // An island's shore never holds an end section's vertex: k0 >= 1, k1 <= last - 1.
-    uint32_t first = k0 - 1, last = k1 + 1;
+    // An island's shore never holds an end section's vertex (those are the outer border's), so
+    // the closing sections lie beyond it; clamped all the same.
+    uint32_t first = k0 > 0 ? k0 - 1 : 0;
+    uint32_t last = std::min<uint32_t>(k1 + 1, uint32_t(sections.size() - 1));
     while (first > 0 && sections[k0].along - sections[first].along < margin) --first;
     while (last + 1 < sections.size() && sections[last].along - sections[k1].along < margin) ++last;
     spans.push_back({first, last, {i}});
@@ -54,8 +55,8 @@ std::vector<Cluster> clusters_of(const RiverSurface& surface) {
 
 // One edge of a triangle with its half-cotangent weight, in unknowns (or fixed values).
 struct Edge {
-  int32_t du, dv;    // unknown of each end, or kFixed
-  double fu, fv;     // the fixed value of an end that has no unknown
+  int32_t du, dv;  // unknown of each end, or kFixed
+  double fu, fv;   // the fixed value of an end that has no unknown
   double weight;
 };
 
@@ -150,7 +151,8 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
       double water = 0.0;  // arc over water from the left bank (no island on a closing section)
       for (size_t i = 0; i < chain.size(); ++i) {
         const uint32_t n = chain[i];
-        if (i > 0 && closing) water += glm::distance(glm::dvec3(pos[chain[i - 1]]), glm::dvec3(pos[n]));
+        if (i > 0 && closing)
+          water += glm::distance(glm::dvec3(pos[chain[i - 1]]), glm::dvec3(pos[n]));
         nodes.push_back(n);
         if (surface.on_island(n)) {
           const auto it = std::find(cluster.islands.begin(), cluster.islands.end(),
@@ -180,7 +182,8 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
       const uint32_t c[3] = {tris[3 * t], tris[3 * t + 1], tris[3 * t + 2]};
       for (int i = 0; i < 3; ++i) {
         const uint32_t a = c[i], b = c[(i + 1) % 3], o = c[(i + 2) % 3];
-        const double w = 0.5 * cotangent(glm::dvec3(pos[a]), glm::dvec3(pos[b]), glm::dvec3(pos[o]));
+        const double w =
+            0.5 * cotangent(glm::dvec3(pos[a]), glm::dvec3(pos[b]), glm::dvec3(pos[o]));
         edges.push_back({unknown[a], unknown[b], fixed_value[a], fixed_value[b], w});
       }
     }
@@ -194,7 +197,8 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
       return Status::error(text_format(
           "the flow about island %u (at river vertex %u) did not converge: its mesh may have "
           "inverted or degenerate triangles",
-          cluster.islands.front(), surface.vertex_of_node(surface.island_nodes(cluster.islands.front())[0])));
+          cluster.islands.front(),
+          surface.vertex_of_node(surface.island_nodes(cluster.islands.front())[0])));
     }
     for (size_t i = 0; i < cluster.islands.size(); ++i) values[cluster.islands[i]] = x[i];
   }

@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <deque>
-#include <tuple>
-
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include <tuple>
 
 #include "siviflow/text_format.h"
 
@@ -43,7 +42,9 @@ std::vector<std::array<uint32_t, 2>> across_island_edges(const MeshView& mesh,
                                                          const std::vector<uint32_t>& bank_1,
                                                          const std::vector<uint32_t>& bank_2) {
   const std::vector<glm::vec3>& pos = *mesh.positions;
-  const auto midpoint = [&](size_t k) { return 0.5 * (glm::dvec3(pos[bank_1[k]]) + glm::dvec3(pos[bank_2[k]])); };
+  const auto midpoint = [&](size_t k) {
+    return 0.5 * (glm::dvec3(pos[bank_1[k]]) + glm::dvec3(pos[bank_2[k]]));
+  };
   const size_t last = bank_1.size() - 1;
   std::vector<std::array<uint32_t, 2>> across(up.size(), {kNoNode, kNoNode});
   for (const std::vector<uint32_t>& loop : *mesh.islands) {
@@ -105,7 +106,8 @@ struct IslandRows {
   std::span<const std::tuple<uint32_t, uint32_t, uint32_t>> of(uint32_t island,
                                                                uint32_t layer) const {
     const auto lo = std::lower_bound(sorted.begin(), sorted.end(), std::tuple{island, layer, 0u});
-    const auto hi = std::lower_bound(sorted.begin(), sorted.end(), std::tuple{island, layer + 1, 0u});
+    const auto hi =
+        std::lower_bound(sorted.begin(), sorted.end(), std::tuple{island, layer + 1, 0u});
     return {lo, hi};
   }
 };
@@ -192,8 +194,8 @@ Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
     const uint32_t size = layer_size[k];
     if (size < 2) {
       return Status::error(text_format(
-          "section %u of the river has a single vertex (%s): a section needs a non-zero width",
-          k, vertex_name(mesh, bank_1[k]).c_str()));
+          "section %u of the river has a single vertex (%s): a section needs a non-zero width", k,
+          vertex_name(mesh, bank_1[k]).c_str()));
     }
     // Walk the chain of same-section edges from one shore to the other, going on from an
     // island's far side where the chain ends on it.
@@ -210,7 +212,8 @@ Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
         ++same;
         if (m != prev && next == kNoNode) next = m;
       }
-      const uint32_t allowed = (prev == kNoNode) ? 1 : 2;  // a shore has one neighbour in its section
+      const uint32_t allowed =
+          (prev == kNoNode) ? 1 : 2;  // a shore has one neighbour in its section
       if (same > allowed) {
         return Status::error(text_format(
             "the river mesh is not a strip of sections: section %u branches at vertex %s "

@@ -235,7 +235,9 @@ Status gltf_river_data(TriangleMesh gltf, SceneRiverData* out) {
   out->slope.resize(count);
   for (size_t v = 0; v < count; ++v) {
     const RiverVertex vertex = surface.vertex(v);
-    const float w2 = vertex.width * vertex.width;
+    // Across the vertex's arm: from bank to bank, or to an island's shore (where it is 0 deep).
+    const float arm = vertex.d_left + vertex.d_right;
+    const float w2 = arm > 0.0f ? arm * arm : 1.0f;
     out->mesh.depth[v] = kGltfRiverDepth * 4.0f * vertex.d_left * vertex.d_right / w2;
     out->slope[v] = std::abs(kGltfRiverDepth * 4.0f * (vertex.d_right - vertex.d_left) / w2);
   }

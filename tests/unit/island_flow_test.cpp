@@ -2,13 +2,13 @@
 // Laplace's equation for psi on a fine grid over the same channel and island, the island's psi
 // set by zero circulation about it (superposition of two solves). The discharge split, the
 // velocity field and the flux through every arm.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
 #include <utility>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "siviflow/sim/stream_function.h"
 #include "unit/river_test_meshes.h"
@@ -43,7 +43,8 @@ QuadIsland island_of(const TestMesh& m) {
   std::set<std::pair<int, int>> present;
   for (size_t t = 0; t < m.indices.size(); t += 3) {
     const glm::vec3 c = (m.positions[m.indices[t]] + m.positions[m.indices[t + 1]] +
-                         m.positions[m.indices[t + 2]]) / 3.0f;
+                         m.positions[m.indices[t + 2]]) /
+                        3.0f;
     present.insert({int(std::floor(c.z)), int(std::floor((0.5f * kWidth - c.x) / 0.5f))});
   }
   QuadIsland island;
@@ -79,8 +80,9 @@ class LaplaceOracle {
     const int i = std::clamp(int(fi), 1, nx_ - 3), k = std::clamp(int(fk), 1, nz_ - 3);
     const double u = fi - i, w = fk - k;
     glm::dvec3 v(0.0);
-    for (const auto& [di, dk, weight] : {std::tuple{0, 0, (1 - u) * (1 - w)}, std::tuple{1, 0, u * (1 - w)},
-                                         std::tuple{0, 1, (1 - u) * w}, std::tuple{1, 1, u * w}}) {
+    for (const auto& [di, dk, weight] :
+         {std::tuple{0, 0, (1 - u) * (1 - w)}, std::tuple{1, 0, u * (1 - w)},
+          std::tuple{0, 1, (1 - u) * w}, std::tuple{1, 1, u * w}}) {
       const int a = i + di, b = k + dk;
       // x decreases with i.
       const double dpsi_dx = -(psi_[index(a + 1, b)] - psi_[index(a - 1, b)]) / (2 * h_);
@@ -126,7 +128,8 @@ class LaplaceOracle {
     for (int k = 0; k < nz_; ++k) {
       for (int i = 0; i < nx_; ++i) {
         if (!island_[index(i, k)]) continue;
-        i0 = std::min(i0, i - 2), i1 = std::max(i1, i + 2), k0 = std::min(k0, k - 2), k1 = std::max(k1, k + 2);
+        i0 = std::min(i0, i - 2), i1 = std::max(i1, i + 2), k0 = std::min(k0, k - 2),
+        k1 = std::max(k1, k + 2);
       }
     }
     const auto p = [&](int i, int k) { return psi[index(i, k)]; };
@@ -164,7 +167,8 @@ StreamFunction flow_around(const TestMesh& m, float p, float search_radius = 0.0
 }
 
 TEST(IslandFlow, ASymmetricIslandSplitsTheDischargeInHalves) {
-  const TestMesh m = test::channel_with_island(kWidth, kLength, kSections, kAcross, 0.0f, 30.0f, 2.0f, 10.0f);
+  const TestMesh m =
+      test::channel_with_island(kWidth, kLength, kSections, kAcross, 0.0f, 30.0f, 2.0f, 10.0f);
   const StreamFunction flow = flow_around(m, 1.0f);
   ASSERT_EQ(flow.surface().islands().size(), 1u);
   EXPECT_NEAR(flow.island_psi(0) / kQ, 0.5, 0.01 * 0.5);
@@ -174,7 +178,8 @@ TEST(IslandFlow, ASymmetricIslandSplitsTheDischargeInHalves) {
 
 TEST(IslandFlow, AnOffCentreIslandSplitsTheDischargeAsLaplaceDoes) {
   for (const auto& [x, rx, rz] : {std::tuple{1.5f, 1.5f, 12.0f}, std::tuple{-2.0f, 1.0f, 6.0f}}) {
-    const TestMesh m = test::channel_with_island(kWidth, kLength, kSections, kAcross, x, 30.0f, rx, rz);
+    const TestMesh m =
+        test::channel_with_island(kWidth, kLength, kSections, kAcross, x, 30.0f, rx, rz);
     const StreamFunction flow = flow_around(m, 1.0f);
     const LaplaceOracle oracle(island_of(m), 0.125);
     // The right arm carries psi_island - 0, the left Q - psi_island: the smaller within 3 %.
@@ -182,12 +187,14 @@ TEST(IslandFlow, AnOffCentreIslandSplitsTheDischargeAsLaplaceDoes) {
     const double smaller = std::min(right_oracle, kQ - right_oracle);
     EXPECT_NEAR(right, right_oracle, 0.03 * smaller) << "island at x = " << x;
     // Not the width's share: an island's arms carry less than their widths say where narrower.
-    RecordProperty("split", std::to_string(right / kQ) + " vs " + std::to_string(right_oracle / kQ));
+    RecordProperty("split",
+                   std::to_string(right / kQ) + " vs " + std::to_string(right_oracle / kQ));
   }
 }
 
 TEST(IslandFlow, VelocitiesAgreeWithLaplaceAwayFromTheEnds) {
-  const TestMesh m = test::channel_with_island(kWidth, kLength, kSections, kAcross, 1.5f, 30.0f, 1.5f, 12.0f);
+  const TestMesh m =
+      test::channel_with_island(kWidth, kLength, kSections, kAcross, 1.5f, 30.0f, 1.5f, 12.0f);
   // p = 1 with a search radius far beyond the width: psi linear across each arm, plug flow, which
   // is what potential flow gives in a straight arm (the default p = 1.5 slows the water at the
   // shores on purpose, and potential flow does not).
@@ -200,7 +207,8 @@ TEST(IslandFlow, VelocitiesAgreeWithLaplaceAwayFromTheEnds) {
     // Not on the island's shore: the oracle's central differences there reach into the island.
     if (p.z < 10.0f || p.z > 50.0f || s.on_island(n)) continue;
     const glm::dvec3 expected = oracle.velocity(p.x, p.z);
-    errors.push_back(glm::length(glm::dvec3(flow.node_velocity()[n]) - expected) / glm::length(expected));
+    errors.push_back(glm::length(glm::dvec3(flow.node_velocity()[n]) - expected) /
+                     glm::length(expected));
   }
   std::nth_element(errors.begin(), errors.begin() + long(errors.size() / 2), errors.end());
   EXPECT_LT(errors[errors.size() / 2], 0.05);
@@ -247,7 +255,8 @@ std::vector<ArmFlux> arm_fluxes(const StreamFunction& flow) {
 }
 
 TEST(IslandFlow, EveryArmOfEverySectionCarriesItsDischarge) {
-  const TestMesh m = test::channel_with_island(kWidth, kLength, kSections, kAcross, 1.5f, 30.0f, 1.5f, 12.0f);
+  const TestMesh m =
+      test::channel_with_island(kWidth, kLength, kSections, kAcross, 1.5f, 30.0f, 1.5f, 12.0f);
   for (const float p : {1.0f, 1.5f}) {
     const StreamFunction flow = flow_around(m, p);
     const std::vector<ArmFlux> arms = arm_fluxes(flow);
@@ -258,7 +267,8 @@ TEST(IslandFlow, EveryArmOfEverySectionCarriesItsDischarge) {
       EXPECT_NEAR(arm.from_triangles, arm.expected, 1e-9 * kQ) << "section " << arm.section;
       // Where the island's shore steps (the quads cut from the grid), an arm is half a metre
       // wider than the one before it and the vertex velocities average the two: within 8 %.
-      EXPECT_NEAR(arm.from_vertices, arm.expected, 0.08 * arm.expected) << "section " << arm.section;
+      EXPECT_NEAR(arm.from_vertices, arm.expected, 0.08 * arm.expected)
+          << "section " << arm.section;
       // The arms as wide as in the sections on both sides: within 1 %.
       const auto same = [&](size_t j) {
         return j < arms.size() && arms[j].section != arm.section &&
@@ -267,7 +277,8 @@ TEST(IslandFlow, EveryArmOfEverySectionCarriesItsDischarge) {
       const bool before = (i >= 1 && same(i - 1)) || (i >= 2 && same(i - 2));
       const bool after = same(i + 1) || same(i + 2);
       if (!before || !after) continue;
-      EXPECT_NEAR(arm.from_vertices, arm.expected, 0.01 * arm.expected) << "section " << arm.section;
+      EXPECT_NEAR(arm.from_vertices, arm.expected, 0.01 * arm.expected)
+          << "section " << arm.section;
       ++smooth;
     }
     EXPECT_GT(smooth, arms.size() / 2);
