@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/vec2.hpp>
 
+#include "grid_holes.h"
 #include "siviflow/sim/river_tuning.h"
 #include "siviflow/text_format.h"
 
@@ -59,7 +61,12 @@ float ProceduralRiver::terrain_height(float x, float z) const {
   if (d < half_width) {
     // Riverbed: a smooth bowl from -depth at the centre up to the waterline at the bank.
     const float t = d / half_width;
-    return -params_.depth * (1.0f - t * t);
+    const float bed = -params_.depth * (1.0f - t * t);
+    if (params_.islands.empty()) return bed;
+    // An island: a dome rising to the banks' height, its shore at the waterline, its shelf
+    // sloping under the water into the bed.
+    const float r = island_radius(x, z);
+    return std::max(bed, params_.bank_height * (1.0f - r * r));
   }
   // Bank: rises to bank_height over a few metres, then the valley floor climbs to the walls.
   const float bank_run = 3.0f;
@@ -79,6 +86,17 @@ float ProceduralRiver::terrain_height(float x, float z) const {
                        (std::sin(0.045f * z + phase_a_) * std::sin(0.05f * x + phase_w_) +
                         0.4f * std::sin(0.13f * z + 2.0f * phase_b_));
   return bank + wall + undulation * wall_t + crests;
+}
+
+float ProceduralRiver::island_radius(float x, float z) const {
+  float nearest = std::numeric_limits<float>::max();
+  for (const ProceduralIsland& island : params_.islands) {
+    const float along = (z - island.center_z) / (0.5f * island.length);
+    if (std::abs(along) >= 2.0f) continue;  // the shelf reaches no further
+    const float across = (lateral_distance(x, z) - island.offset) / (0.5f * island.width);
+    nearest = std::min(nearest, std::sqrt(along * along + across * across));
+  }
+  return nearest;
 }
 
 float ProceduralRiver::depth_at(float x, float z) const {
@@ -125,6 +143,27 @@ Status ProceduralRiver::validate(const ProceduralRiverParams& p) {
     return Status::error(text_format(
         "procedural river: vertices_across = %u must be at least 2 (one per bank)",
         p.vertices_across));
+  }
+  if (p.islands.size() > kMaxRiverIslands) {
+    return Status::error(text_format("procedural river: %zu islands, more than the limit of %zu",
+                                     p.islands.size(), kMaxRiverIslands));
+  }
+  for (size_t i = 0; i < p.islands.size(); ++i) {
+    const ProceduralIsland& island = p.islands[i];
+    const struct {
+      const char* name;
+      float value;
+      bool positive;
+    } fields[] = {{"center_z", island.center_z, false},
+                  {"offset", island.offset, false},
+                  {"length", island.length, true},
+                  {"width", island.width, true}};
+    for (const auto& f : fields) {
+      if (!std::isfinite(f.value) || (f.positive && !(f.value > 0.0f))) {
+        return Status::error(text_format("procedural river: islands[%zu].%s = %g must be finite%s",
+                                         i, f.name, f.value, f.positive ? " and > 0" : ""));
+      }
+    }
   }
   // Bound the mesh size before allocating: the centreline's slope is at most 1.26 A k.
   const double k = glm::two_pi<double>() / p.meander_wavelength;
@@ -211,7 +250,71 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
       }
     }
   }
+  if (!params_.islands.empty()) SIVIFLOW_TRY(cut_islands(&mesh));
   *out = std::move(mesh);
+  return Status::success();
+}
+
+Status ProceduralRiver::cut_islands(RiverMesh* mesh) const {
+  const uint32_t across = mesh->vertices_across, sections = mesh->section_count;
+  const auto& pos = mesh->positions;
+  // The island whose ellipse holds quad (k, j)'s centre, or -1.
+  const auto island_at = [&](uint32_t k, uint32_t j) {
+    const uint32_t a = k * across + j;
+    const glm::vec3 c = 0.25f * (pos[a] + pos[a + 1] + pos[a + across] + pos[a + across + 1]);
+    for (size_t i = 0; i < params_.islands.size(); ++i) {
+      const ProceduralIsland& island = params_.islands[i];
+      const float along = (c.z - island.center_z) / (0.5f * island.length);
+      const float side = (lateral_distance(c.x, c.z) - island.offset) / (0.5f * island.width);
+      if (along * along + side * side < 1.0f) return static_cast<int>(i);
+    }
+    return -1;
+  };
+  std::vector<int> owner(size_t{sections - 1} * (across - 1));
+  std::vector<size_t> quads(params_.islands.size(), 0);
+  for (uint32_t k = 0; k + 1 < sections; ++k) {
+    for (uint32_t j = 0; j + 1 < across; ++j) {
+      const int i = owner[size_t{k} * (across - 1) + j] = island_at(k, j);
+      if (i < 0) continue;
+      ++quads[size_t(i)];
+      // Two cells from a bank or an end: the mesh keeps a whole vertex between them.
+      if (j < 2 || j + 4 > across || k < 2 || k + 4 > sections) {
+        return Status::error(text_format(
+            "procedural river: islands[%d] comes within two cells of the %s near z = %g: move it "
+            "or make it smaller",
+            i, (j < 2 || j + 4 > across) ? "bank" : "river's end", pos[k * across + j].z));
+      }
+    }
+  }
+  for (size_t i = 0; i < quads.size(); ++i) {
+    if (quads[i] == 0) {
+      return Status::error(text_format(
+          "procedural river: islands[%zu] covers no cell of the mesh (at z = %g): it is outside "
+          "the river or smaller than a cell",
+          i, double(params_.islands[i].center_z)));
+    }
+  }
+  // Two islands at least two cells apart, so neither fills the gap between them when cut.
+  for (uint32_t k = 0; k + 1 < sections; ++k) {
+    for (uint32_t j = 0; j + 1 < across; ++j) {
+      const int a = owner[size_t{k} * (across - 1) + j];
+      if (a < 0) continue;
+      for (uint32_t l = k; l < std::min(k + 3, sections - 1); ++l) {
+        for (uint32_t m = j > 2 ? j - 2 : 0; m < std::min(j + 3, across - 1); ++m) {
+          const int b = owner[size_t{l} * (across - 1) + m];
+          if (b >= 0 && b != a) {
+            return Status::error(text_format(
+                "procedural river: islands[%d] and islands[%d] come within two cells of each "
+                "other near z = %g: move them apart",
+                std::min(a, b), std::max(a, b), pos[k * across + j].z));
+          }
+        }
+      }
+    }
+  }
+  cut_grid_quads(
+      across, [&](uint32_t k, uint32_t j) { return owner[size_t{k} * (across - 1) + j] >= 0; },
+      &mesh->positions, &mesh->indices, &mesh->depth);
   return Status::success();
 }
 

@@ -229,6 +229,22 @@ Status parse_procedural(const Reader& r, const Json& v, const std::string& path,
     if (const Json* x = find(v, f.name))
       SIVIFLOW_TRY(r.uint32(*x, join(path, f.name), &(params.*f.member)));
   }
+  if (const Json* islands = find(v, "islands")) {
+    const std::string at = join(path, "islands");
+    SIVIFLOW_TRY(r.array(*islands, at, kMaxRiverIslands));
+    for (size_t i = 0; i < islands->size(); ++i) {
+      const Json& item = (*islands)[i];
+      const std::string item_path = element(at, i);
+      SIVIFLOW_TRY(r.object(item, item_path));
+      SIVIFLOW_TRY(r.keys(item, item_path, {"center_z", "offset", "length", "width"}));
+      ProceduralIsland island;
+      if (const Json* x = find(item, "center_z")) SIVIFLOW_TRY(r.real(*x, join(item_path, "center_z"), &island.center_z));
+      if (const Json* x = find(item, "offset")) SIVIFLOW_TRY(r.real(*x, join(item_path, "offset"), &island.offset));
+      if (const Json* x = find(item, "length")) SIVIFLOW_TRY(r.positive(*x, join(item_path, "length"), &island.length));
+      if (const Json* x = find(item, "width")) SIVIFLOW_TRY(r.positive(*x, join(item_path, "width"), &island.width));
+      params.islands.push_back(island);
+    }
+  }
   const Status valid = ProceduralRiver::validate(params);
   if (!valid.ok()) {
     std::string message = valid.message();
@@ -668,6 +684,7 @@ std::vector<std::string> procedural_river_keys() {
   std::vector<std::string> keys;
   for (const FloatField& f : kProceduralFloats) keys.emplace_back(f.name);
   for (const UintField& f : kProceduralUints) keys.emplace_back(f.name);
+  keys.emplace_back("islands");
   return keys;
 }
 

@@ -138,5 +138,62 @@ TEST(ExampleScenes, LookPresetColoursTheWater) {
   EXPECT_GT(muddy_ratio, 1.4 * clear_ratio) << muddy_ratio << " against " << clear_ratio;
 }
 
+// The island scene straightened and seen from 90 m above (screen right +X, down +Z, 2.14 px a
+// metre at 320x180): land where the island is, water flowing downstream in both its arms, and foam
+// in the island's wake (the water its tail leaves behind) beyond what mid-river carries above it.
+TEST(ExampleScenes, IslandPartsTheFlowAndLeavesAWake) {
+  const fs::path dir = fresh_test_dir("examples");
+  Json scene = read_json(kScenes / "island.json");
+  Json& procedural = scene["river"]["procedural"];
+  ASSERT_EQ(procedural["islands"].size(), 1u);
+  procedural["meander_amplitude"] = 0.0;
+  const Json island = procedural["islands"][0];
+  const double cz = island["center_z"], offset = island["offset"];
+  const double half_length = 0.5 * island["length"].get<double>();
+  scene["camera"] = {{"fov_y_deg", 50.0},
+                     {"keys", {{{"t", 0.0}, {"position", {0.0, 90.0, cz + 0.01}}, {"target", {0.0, 0.0, cz}}}}}};
+  std::ofstream(dir / "above.json") << scene.dump();
+  const RunResult run = run_siviflow("capture " + (dir / "above.json").string() +
+                                     " --range 150:151 --size 320x180 --aov flow,foam --validation --out " +
+                                     dir.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  ExrImage image;
+  ASSERT_TRUE(read_exr((dir / "frame_00150.exr").string(), &image).ok());
+  const std::vector<bool> water = water_of(image);
+  ASSERT_EQ(water.size(), 320u * 180u);
+  const double px_per_m = 90.0 / (90.0 * std::tan(25.0 * M_PI / 180.0));
+  const auto pixel = [&](double x, double z) {
+    const int u = int(std::lround(160.0 + x * px_per_m)), v = int(std::lround(90.0 + (z - cz) * px_per_m));
+    EXPECT_TRUE(u >= 0 && u < 320 && v >= 0 && v < 180) << "(" << x << ", " << z << ") is out of view";
+    return size_t(std::clamp(v, 0, 179)) * 320u + size_t(std::clamp(u, 0, 319));
+  };
+  const std::vector<float>& flow_z = *image.find("flow.Z");
+  const std::vector<float>& foam = *image.find("foam.Y");
+  EXPECT_FALSE(water[pixel(offset, cz)]) << "the island's middle is land";
+  for (const double x : {offset + 6.0, offset - 8.0}) {  // the narrow arm and the wide one
+    EXPECT_TRUE(water[pixel(x, cz)]) << "x = " << x;
+    EXPECT_GT(flow_z[pixel(x, cz)], 0.3f) << "x = " << x << ": downstream is +Z";
+  }
+  // Mean foam over 3 m across the island's line, 8 m long, just past its tail and above its head.
+  const auto mean_foam = [&](double z0, double z1) {
+    double sum = 0.0;
+    size_t n = 0;
+    for (double z = z0; z <= z1; z += 0.25) {
+      for (double x = offset - 1.5; x <= offset + 1.5; x += 0.25) {
+        if (!water[pixel(x, z)]) continue;
+        sum += foam[pixel(x, z)];
+        ++n;
+      }
+    }
+    EXPECT_GT(n, 0u);
+    return sum / double(std::max<size_t>(n, 1));
+  };
+  const double wake = mean_foam(cz + half_length + 1.0, cz + half_length + 9.0);
+  const double above = mean_foam(cz - half_length - 14.0, cz - half_length - 6.0);
+  RecordProperty("foam", std::to_string(wake) + " in the wake, " + std::to_string(above) + " above");
+  EXPECT_GT(wake, 0.1) << "above the island " << above;
+  EXPECT_GT(wake, 2.0 * above) << "wake " << wake << ", above the island " << above;
+}
+
 }  // namespace
 }  // namespace siviflow::testing

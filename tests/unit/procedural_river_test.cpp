@@ -67,6 +67,34 @@ TEST(ProceduralRiver, MeshFollowsCentrelineAndWidth) {
   EXPECT_GT(mesh.depth[4], mesh.depth[8]);
 }
 
+TEST(ProceduralRiver, AnIslandIsLandCutOutOfTheWater) {
+  ProceduralRiverParams params;
+  params.vertices_across = 25;
+  params.width = 20.0f;
+  params.width_variation = 0.0f;
+  params.islands = {{10.0f, 2.0f, 30.0f, 6.0f}};
+  const ProceduralRiver river(params);
+  RiverMesh mesh;
+  const Status generated = river.generate_mesh(&mesh);
+  ASSERT_TRUE(generated.ok()) << generated.message();
+  ASSERT_LT(mesh.positions.size(), size_t{mesh.section_count} * 25);
+  ASSERT_EQ(mesh.depth.size(), mesh.positions.size());
+  RiverSurface surface;
+  const Status status = RiverSurface::build(mesh.positions, mesh.indices, {}, &surface);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_EQ(surface.islands().size(), 1u);
+  // Land at its middle, a bank's height up; no water vertex inside it; shallow at its shore.
+  const float x = river.centreline_x(10.0f) + 2.0f;
+  EXPECT_NEAR(river.terrain_height(x, 10.0f), params.bank_height, 0.05f);
+  EXPECT_EQ(river.depth_at(x, 10.0f), 0.0f);
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    EXPECT_GE(river.island_radius(mesh.positions[v].x, mesh.positions[v].z), 0.8f) << "vertex " << v;
+  }
+  for (const uint32_t n : surface.island_nodes(0)) {
+    EXPECT_LT(mesh.depth[n], 0.35f * params.depth) << "shore vertex " << n;
+  }
+}
+
 TEST(ProceduralRiver, SeedChangesTheRiverDeterministically) {
   ProceduralRiverParams a;
   ProceduralRiverParams b = a;
@@ -89,6 +117,12 @@ TEST(ProceduralRiver, BadParametersNameTheParameter) {
       {[](ProceduralRiverParams& p) { p.vertices_across = 1; }, "vertices_across"},
       {[](ProceduralRiverParams& p) { p.valley_half_width = 5.0f; }, "valley_half_width"},
       {[](ProceduralRiverParams& p) { p.section_spacing = 1e-6f; }, "limit"},
+      {[](ProceduralRiverParams& p) { p.islands = {{0.0f, 0.0f, -3.0f, 2.0f}}; }, "islands[0].length"},
+      {[](ProceduralRiverParams& p) { p.islands = {{0.0f, 0.0f, 20.0f, 14.0f}}; }, "islands[0] comes within two cells of the bank"},
+      {[](ProceduralRiverParams& p) { p.islands = {{118.0f, 0.0f, 20.0f, 3.0f}}; }, "river's end"},
+      {[](ProceduralRiverParams& p) { p.islands = {{0.0f, 0.0f, 20.0f, 3.0f}, {16.0f, 0.0f, 20.0f, 3.0f}}; },
+       "islands[0] and islands[1]"},
+      {[](ProceduralRiverParams& p) { p.islands = {{0.0f, 40.0f, 20.0f, 3.0f}}; }, "covers no cell"},
       {[](ProceduralRiverParams& p) {
          p.meander_amplitude = 40.0f;
          p.meander_wavelength = 60.0f;

@@ -460,7 +460,7 @@ Json load_schema() {
 }
 
 TEST(SceneFileSchema, ProceduralPropertiesAndDefaultsMatchTheParser) {
-  EXPECT_EQ(sizeof(ProceduralRiverParams), 12 * sizeof(float))
+  EXPECT_EQ(sizeof(ProceduralRiverParams), 12 * sizeof(float) + sizeof(std::vector<ProceduralIsland>))
       << "ProceduralRiverParams changed: add the field to kProceduralFloats/kProceduralUints in "
          "engine/scene/scene_file.cpp and to engine/scene/scene.schema.json";
   const Json schema = load_schema();

@@ -11,6 +11,15 @@
 
 namespace siviflow {
 
+// An island in the procedural river: an ellipse in the river's own frame (along the flow and
+// across it), cut out of the water's mesh and raised as land in the terrain.
+struct ProceduralIsland {
+  float center_z = 0.0f;  // metres: where along +Z its middle lies
+  float offset = 0.0f;    // metres from the centreline across the flow, + towards the left bank
+  float length = 30.0f;   // metres along the flow
+  float width = 4.0f;     // metres across it
+};
+
 struct ProceduralRiverParams {
   float length = 240.0f;              // metres along +Z, centred on the origin
   float meander_amplitude = 14.0f;    // metres of lateral swing of the centreline
@@ -26,12 +35,16 @@ struct ProceduralRiverParams {
   // along the centreline, each with this many vertices from bank to bank.
   float section_spacing = 1.0f;  // metres
   uint32_t vertices_across = 13;
+  // Islands, each clear of the banks, the ends and the others by two cells of the mesh.
+  std::vector<ProceduralIsland> islands;
 };
 
 // The river's water surface as a strip, ready for RiverSurface::build. The river flows along +Z:
 // section 0 is at z = -length/2, vertex 0 is its left-bank corner (+X side).
 struct RiverMesh {
-  std::vector<glm::vec3> positions;  // vertex k * vertices_across + j: section k, j = 0 on the left
+  // Vertex k * vertices_across + j: section k, j = 0 on the left (in that order, less the
+  // vertices inside islands, where the river has any).
+  std::vector<glm::vec3> positions;
   std::vector<uint32_t> indices;     // triangles, counter-clockwise seen from +Y
   std::vector<float> depth;          // water depth under each vertex, metres, >= 0
   uint32_t section_count = 0;
@@ -56,11 +69,15 @@ class ProceduralRiver {
   float water_level() const { return 0.0f; }
   // Water depth at (x, z): water level minus the riverbed, 0 out of the river.
   float depth_at(float x, float z) const;
+  // How far (x, z) lies inside the nearest island's ellipse: < 1 inside, 1 on its shore (a large
+  // value without islands).
+  float island_radius(float x, float z) const;
 
   // Checks the parameters (ranges, sizes); the message names the parameter.
   static Status validate(const ProceduralRiverParams& params);
-  // Builds the water-surface strip following the centreline and width profile. Fails on bad
-  // parameters or when the meander is too tight for the width (sections would cross).
+  // Builds the water-surface strip following the centreline and width profile, its islands cut
+  // out. Fails on bad parameters, when the meander is too tight for the width (sections would
+  // cross), or when an island comes within two cells of a bank, an end or another island.
   Status generate_mesh(RiverMesh* out) const;
 
  private:
@@ -69,6 +86,9 @@ class ProceduralRiver {
   double centre_x(double z) const;
   double centre_slope(double z) const;  // dx/dz, analytic
   double width(double z) const;
+  // Cuts the islands' quads out of `mesh` (a full grid strip), naming an island too close to a
+  // bank, an end or another island.
+  Status cut_islands(RiverMesh* mesh) const;
 
   ProceduralRiverParams params_;
   float phase_a_ = 0.0f;  // seeded phases of the two meander harmonics
