@@ -53,67 +53,131 @@ std::vector<Cluster> clusters_of(const RiverSurface& surface) {
   return merged;
 }
 
-// One edge of a triangle with its half-cotangent weight, in unknowns (or fixed values).
-struct Edge {
-  int32_t du, dv;  // unknown of each end, or kFixed
-  double fu, fv;   // the fixed value of an end that has no unknown
-  double weight;
+// A x = b over a cluster's unknowns: A symmetric and positive definite, in rows (columns
+// ascending, the diagonal among them).
+struct System {
+  std::vector<uint32_t> start;  // row r's entries are [start[r], start[r + 1])
+  std::vector<uint32_t> column;
+  std::vector<double> value;
+  std::vector<double> rhs;
+  size_t size() const { return rhs.size(); }
 };
 
-// y = A x over the unknowns; with `fixed`, the fixed ends' values take part (K psi at x).
-void apply(const std::vector<Edge>& edges, const std::vector<double>& x, bool fixed,
-           std::vector<double>* y) {
-  std::fill(y->begin(), y->end(), 0.0);
-  for (const Edge& e : edges) {
-    const double u = e.du != kFixed ? x[size_t(e.du)] : (fixed ? e.fu : 0.0);
-    const double v = e.dv != kFixed ? x[size_t(e.dv)] : (fixed ? e.fv : 0.0);
-    const double flux = e.weight * (u - v);
-    if (e.du != kFixed) (*y)[size_t(e.du)] += flux;
-    if (e.dv != kFixed) (*y)[size_t(e.dv)] -= flux;
+void multiply(const System& a, const std::vector<double>& x, std::vector<double>* y) {
+  for (size_t r = 0; r < a.size(); ++r) {
+    double sum = 0.0;
+    for (uint32_t e = a.start[r]; e < a.start[r + 1]; ++e) sum += a.value[e] * x[a.column[e]];
+    (*y)[r] = sum;
   }
 }
 
-// Preconditioned conjugate gradients on A x = -K_fc psi_c; x holds the first guess.
-bool solve(const std::vector<Edge>& edges, std::vector<double>* x) {
-  const size_t n = x->size();
-  std::vector<double> diag(n, 0.0), r(n), z(n), p(n), ap(n);
-  for (const Edge& e : edges) {
-    if (e.du == e.dv) continue;  // both ends on one island's shore
-    if (e.du != kFixed) diag[size_t(e.du)] += e.weight;
-    if (e.dv != kFixed) diag[size_t(e.dv)] += e.weight;
+// Incomplete Cholesky without fill (IC(0)): L on A's lower pattern, L L^T ~ A. Fails (false)
+// where a pivot is not positive; the caller then falls back to the diagonal.
+struct IncompleteCholesky {
+  std::vector<uint32_t> start, column;  // lower rows, the diagonal last in each
+  std::vector<double> value;
+
+  bool factor(const System& a) {
+    const size_t n = a.size();
+    start.assign(n + 1, 0);
+    column.clear();
+    value.clear();
+    for (size_t r = 0; r < n; ++r) {
+      for (uint32_t e = a.start[r]; e < a.start[r + 1] && a.column[e] <= r; ++e) {
+        column.push_back(a.column[e]);
+        value.push_back(a.value[e]);
+      }
+      start[r + 1] = uint32_t(column.size());
+      if (column.empty() || column.back() != r) return false;  // no diagonal
+    }
+    for (size_t i = 0; i < n; ++i) {
+      for (uint32_t e = start[i]; e < start[i + 1]; ++e) {
+        const uint32_t k = column[e];
+        // L[i][k] -= sum over j < k of L[i][j] L[k][j] (both rows ascending: a merge).
+        double sum = 0.0;
+        uint32_t p = start[i], q = start[k];
+        while (p < e && q + 1 < start[k + 1]) {
+          if (column[p] == column[q]) {
+            sum += value[p++] * value[q++];
+          } else if (column[p] < column[q]) {
+            ++p;
+          } else {
+            ++q;
+          }
+        }
+        if (k < i) {
+          value[e] = (value[e] - sum) / value[start[k + 1] - 1];
+        } else {
+          const double pivot = value[e] - sum;
+          if (!(pivot > 0.0)) return false;
+          value[e] = std::sqrt(pivot);
+        }
+      }
+    }
+    return true;
   }
-  apply(edges, *x, true, &r);
-  std::vector<double> zero(n, 0.0), b(n);
-  apply(edges, zero, true, &b);  // K_fc psi_c
+
+  // z = (L L^T)^-1 r.
+  void apply(const std::vector<double>& r, std::vector<double>* z) const {
+    const size_t n = r.size();
+    for (size_t i = 0; i < n; ++i) {
+      double sum = r[i];
+      for (uint32_t e = start[i]; e + 1 < start[i + 1]; ++e) sum -= value[e] * (*z)[column[e]];
+      (*z)[i] = sum / value[start[i + 1] - 1];
+    }
+    for (size_t i = n; i-- > 0;) {
+      (*z)[i] /= value[start[i + 1] - 1];
+      for (uint32_t e = start[i]; e + 1 < start[i + 1]; ++e) (*z)[column[e]] -= value[e] * (*z)[i];
+    }
+  }
+};
+
+// Preconditioned conjugate gradients on A x = b; x holds the first guess.
+bool solve(const System& a, std::vector<double>* x) {
+  const size_t n = a.size();
+  IncompleteCholesky cholesky;
+  const bool factored = cholesky.factor(a);
+  std::vector<double> diag(n, 1.0);
+  for (size_t r = 0; r < n; ++r) {
+    for (uint32_t e = a.start[r]; e < a.start[r + 1]; ++e) {
+      if (a.column[e] == r && a.value[e] > 0.0) diag[r] = a.value[e];
+    }
+  }
+  const auto precondition = [&](const std::vector<double>& r, std::vector<double>* z) {
+    if (factored) {
+      cholesky.apply(r, z);
+    } else {
+      for (size_t i = 0; i < n; ++i) (*z)[i] = r[i] / diag[i];
+    }
+  };
+  std::vector<double> r(n), z(n), p(n), ap(n);
+  multiply(a, *x, &r);
   double b_norm = 0.0;
   for (size_t i = 0; i < n; ++i) {
-    r[i] = -r[i];
-    b_norm += b[i] * b[i];
-    if (!(diag[i] > 0.0)) diag[i] = 1.0;
+    r[i] = a.rhs[i] - r[i];
+    b_norm += a.rhs[i] * a.rhs[i];
   }
   b_norm = std::sqrt(b_norm);
+  precondition(r, &z);
+  p = z;
   double rz = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    z[i] = r[i] / diag[i];
-    p[i] = z[i];
-    rz += r[i] * z[i];
-  }
+  for (size_t i = 0; i < n; ++i) rz += r[i] * z[i];
   for (int iteration = 0; iteration < kIslandSolveMaxIterations; ++iteration) {
     double r_norm = 0.0;
     for (const double v : r) r_norm += v * v;
     if (std::sqrt(r_norm) <= kIslandSolveTolerance * b_norm) return true;
-    apply(edges, p, false, &ap);
+    multiply(a, p, &ap);
     double pap = 0.0;
     for (size_t i = 0; i < n; ++i) pap += p[i] * ap[i];
     if (!(pap > 0.0)) return false;
     const double alpha = rz / pap;
-    double rz_next = 0.0;
     for (size_t i = 0; i < n; ++i) {
       (*x)[i] += alpha * p[i];
       r[i] -= alpha * ap[i];
-      z[i] = r[i] / diag[i];
-      rz_next += r[i] * z[i];
     }
+    precondition(r, &z);
+    double rz_next = 0.0;
+    for (size_t i = 0; i < n; ++i) rz_next += r[i] * z[i];
     const double beta = rz_next / rz;
     rz = rz_next;
     for (size_t i = 0; i < n; ++i) p[i] = z[i] + beta * p[i];
@@ -169,26 +233,52 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
         }
       }
     }
-    std::vector<uint32_t> triangles;
+    // The rows: at each unknown node, sum over its triangles' two other corners m of
+    // w (psi_n - psi_m), w the half-cotangent of the angle opposite edge nm; an island's row is
+    // the sum of its shore's.
+    std::vector<std::vector<std::pair<uint32_t, double>>> rows(x.size());
+    System system;
+    system.rhs.assign(x.size(), 0.0);
+    const auto add = [&](uint32_t row, uint32_t col, double w) {
+      for (auto& [c, v] : rows[row]) {
+        if (c == col) {
+          v += w;
+          return;
+        }
+      }
+      rows[row].emplace_back(col, w);
+    };
     for (const uint32_t n : nodes) {
       if (unknown[n] == kFixed) continue;
-      for (const uint32_t t : surface.node_triangles(n)) triangles.push_back(t);
-    }
-    std::sort(triangles.begin(), triangles.end());
-    triangles.erase(std::unique(triangles.begin(), triangles.end()), triangles.end());
-    std::vector<Edge> edges;
-    edges.reserve(3 * triangles.size());
-    for (const uint32_t t : triangles) {
-      const uint32_t c[3] = {tris[3 * t], tris[3 * t + 1], tris[3 * t + 2]};
-      for (int i = 0; i < 3; ++i) {
-        const uint32_t a = c[i], b = c[(i + 1) % 3], o = c[(i + 2) % 3];
-        const double w =
-            0.5 * cotangent(glm::dvec3(pos[a]), glm::dvec3(pos[b]), glm::dvec3(pos[o]));
-        edges.push_back({unknown[a], unknown[b], fixed_value[a], fixed_value[b], w});
+      const auto u = static_cast<uint32_t>(unknown[n]);
+      for (const uint32_t t : surface.node_triangles(n)) {
+        const uint32_t* c = &tris[3 * size_t{t}];
+        const int i = c[0] == n ? 0 : c[1] == n ? 1 : 2;
+        const uint32_t a = c[(i + 1) % 3], b = c[(i + 2) % 3];
+        const glm::dvec3 pn(pos[n]), pa(pos[a]), pb(pos[b]);
+        for (const auto& [m, w] : {std::pair{a, 0.5 * cotangent(pn, pa, pb)},
+                                   std::pair{b, 0.5 * cotangent(pn, pb, pa)}}) {
+          if (unknown[m] == unknown[n]) continue;  // along one island's shore
+          add(u, u, w);
+          if (unknown[m] == kFixed) {
+            system.rhs[u] += w * fixed_value[m];
+          } else {
+            add(u, static_cast<uint32_t>(unknown[m]), -w);
+          }
+        }
       }
     }
+    system.start.assign(x.size() + 1, 0);
+    for (size_t r = 0; r < rows.size(); ++r) {
+      std::sort(rows[r].begin(), rows[r].end());
+      for (const auto& [c, v] : rows[r]) {
+        system.column.push_back(c);
+        system.value.push_back(v);
+      }
+      system.start[r + 1] = static_cast<uint32_t>(system.column.size());
+    }
     for (size_t i = 0; i < cluster.islands.size(); ++i) x[i] = 0.5 * discharge;  // first guess
-    const bool converged = solve(edges, &x);
+    const bool converged = solve(system, &x);
     for (const uint32_t n : nodes) {
       unknown[n] = kFixed;
       fixed_value[n] = 0.0;

@@ -7,8 +7,9 @@
 // elements' cotangent Laplacian on the river mesh), Q on the left bank and 0 on the right, each
 // island's shore one unknown. The equation of that unknown is the sum of its shore's rows, which
 // says the flux of grad psi out of the shore - the circulation of the velocity about the island -
-// is zero. Islands are solved in clusters, each on the sections within two river widths of them,
-// psi linear across the sections that close the cluster (the uniform flow far from an island).
+// is zero. Islands are solved in clusters, each on the sections within half a river width of
+// them, psi linear across the sections that close the cluster (the uniform flow away from an
+// island), by conjugate gradients preconditioned with an incomplete Cholesky factor.
 #pragma once
 
 #include <vector>

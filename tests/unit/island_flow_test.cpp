@@ -186,8 +186,7 @@ TEST(IslandFlow, AnOffCentreIslandSplitsTheDischargeAsLaplaceDoes) {
     const double right = flow.island_psi(0), right_oracle = oracle.island_psi();
     const double smaller = std::min(right_oracle, kQ - right_oracle);
     EXPECT_NEAR(right, right_oracle, 0.03 * smaller) << "island at x = " << x;
-    // Not the width's share: an island's arms carry less than their widths say where narrower.
-    RecordProperty("split",
+    RecordProperty("split_" + std::to_string(int(x * 10)),
                    std::to_string(right / kQ) + " vs " + std::to_string(right_oracle / kQ));
   }
 }

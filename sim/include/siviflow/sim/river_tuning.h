@@ -16,8 +16,8 @@ inline constexpr float kDefaultSearchRadiusFactor = 3.0f;
 
 // Islands' psi (island_circulation.h): each cluster of islands is solved on the sections within
 // this many widest-section widths of it, to this relative residual, in at most this many steps.
-inline constexpr double kIslandSolveMarginWidths = 1.0;
-inline constexpr double kIslandSolveTolerance = 1e-7;
+inline constexpr double kIslandSolveMarginWidths = 0.5;
+inline constexpr double kIslandSolveTolerance = 1e-6;
 inline constexpr int kIslandSolveMaxIterations = 20000;
 
 // --- Input limits (reliability.md §5 rows 8 and 17) -----------------------------------------
