@@ -284,5 +284,34 @@ TEST(IslandFlow, EveryArmOfEverySectionCarriesItsDischarge) {
   }
 }
 
+// A rock moved about an island's arm re-solves only near it, and the field is then the one a
+// fresh river with the rock where it now is gives, bit for bit; the island's shore keeps its psi.
+TEST(IslandFlow, ARockMovedInAnArmEqualsAFreshSolve) {
+  const TestMesh m =
+      test::channel_with_island(kWidth, kLength, kSections, kAcross, 1.5f, 30.0f, 1.5f, 12.0f);
+  StreamFunction moved = flow_around(m, 1.5f, 12.0f);
+  Obstacle rock;
+  rock.radius = 0.6f;
+  rock.centre = {-2.0f, 0.0f, 10.0f};
+  ASSERT_TRUE(moved.set_obstacles({rock}).ok());
+  for (const glm::vec3 centre : {glm::vec3(-2.0f, 0.0f, 28.0f), glm::vec3(4.2f, 0.0f, 33.0f),
+                                 glm::vec3(1.5f, 0.0f, 44.0f)}) {
+    ASSERT_TRUE(moved.move_obstacle(0, centre).ok());
+    EXPECT_LT(moved.last_update().nodes_resolved, moved.surface().node_count());  // not a full solve
+    StreamFunction fresh = flow_around(m, 1.5f, 12.0f);
+    rock.centre = centre;
+    ASSERT_TRUE(fresh.set_obstacles({rock}).ok());
+    size_t differ = 0;
+    for (size_t n = 0; n < moved.node_psi().size(); ++n) {
+      differ += moved.node_psi()[n] != fresh.node_psi()[n] ||
+                moved.node_velocity()[n] != fresh.node_velocity()[n];
+    }
+    EXPECT_EQ(differ, 0u) << "rock at z = " << centre.z;
+    for (const uint32_t n : moved.surface().island_nodes(0)) {
+      EXPECT_EQ(moved.node_psi()[n], moved.island_psi(0)) << "shore vertex " << n;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace siviflow
