@@ -1,14 +1,19 @@
-// `siviflow flow SCENE.json --out FILE.csv [--time T] [--river N]`: the solved flow field of one
-// of a scene's rivers.
+// `siviflow flow SCENE.json [--out FILE.csv] [--describe] [--time T] [--river N]`: the solved
+// flow field of one of a scene's rivers, and what the river surface generator found in it.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 #include <string>
+#include <utility>
 
 #include "cli.h"
 #include "commands.h"
 #include "siviflow/atomic_file.h"
 #include "siviflow/scene_river.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow {
 namespace {
@@ -17,11 +22,61 @@ constexpr const char* kCommand = "flow";
 
 void print_help() {
   std::printf(
-      "usage: siviflow flow SCENE.json --out FILE.csv [--time T] [--river N]\n"
+      "usage: siviflow flow SCENE.json [--out FILE.csv] [--describe] [--time T] [--river N]\n"
       "  Solves the stream-function flow of the scene's river N (default 0, the first), with\n"
-      "  its obstacles placed at time T (seconds, default 0), and writes one CSV row per river\n"
-      "  vertex in the file's accessor order:\n"
-      "  vertex,x,y,z,section,bank,width,d_left,d_right,psi,vx,vy,vz,wet\n");
+      "  its obstacles placed at time T (seconds, default 0).\n"
+      "  --out FILE.csv  writes one CSV row per river vertex in the file's accessor order:\n"
+      "                  vertex,x,y,z,section,bank,width,d_left,d_right,psi,vx,vy,vz,wet\n"
+      "  --describe      prints what the river's mesh was found to be: its ends, banks, arms\n"
+      "                  and islands, and the discharge each arm carries\n"
+      "  At least one of the two is required.\n");
+}
+
+// The river's ends, banks, arms (the water between two borders) and islands, with the
+// discharge of each.
+std::string describe(const StreamFunction& flow) {
+  const RiverSurface& s = flow.surface();
+  const auto sections = s.sections();
+  const auto end = [&](size_t k) {
+    return text_format("section %zu, %zu vertices, %.2f m wide", k, s.section_nodes(k).size(),
+                       double(sections[k].width));
+  };
+  std::set<std::pair<BorderId, BorderId>> arms;
+  for (uint32_t n = 0; n < s.node_count(); ++n) {
+    if (s.node_bank()[n] == Bank::kNone && !s.on_island(n)) {
+      arms.insert({s.node_left_border(n), s.node_right_border(n)});
+    }
+  }
+  std::string out = text_format(
+      "a strip of %zu sections, %.1f m along its middle, %zu vertices (%zu triangles)\n"
+      "1 inflow end (upstream): %s\n"
+      "1 outflow end (downstream): %s\n"
+      "2 banks: psi %.9g m^2/s on the left, 0 on the right\n"
+      "%zu island%s, %zu arms, 0 junctions\n",
+      sections.size(), double(sections.back().along), s.vertex_count(), s.triangle_count(),
+      end(0).c_str(), end(sections.size() - 1).c_str(), flow.border_psi(kLeftBankBorder),
+      s.islands().size(), s.islands().size() == 1 ? "" : "s", arms.size());
+  for (size_t i = 0; i < s.islands().size(); ++i) {
+    uint32_t first = UINT32_MAX, last = 0;
+    for (const uint32_t n : s.island_nodes(i)) {
+      first = std::min(first, s.node_section()[n]);
+      last = std::max(last, s.node_section()[n]);
+    }
+    out += text_format(
+        "island %zu: %zu shore vertices (vertex %u first), sections %u to %u (%.1f m), psi %.9g\n",
+        i, s.island_nodes(i).size(), s.vertex_of_node(s.island_nodes(i)[0]), first, last,
+        double(sections[last].along - sections[first].along), flow.island_psi(i));
+  }
+  for (const auto& [left, right] : arms) {
+    const auto name = [](BorderId b) {
+      return b == kLeftBankBorder    ? std::string("the left bank")
+             : b == kRightBankBorder ? std::string("the right bank")
+                                     : text_format("island %d", int(b - island_border(0)));
+    };
+    out += text_format("arm from %s to %s: %.9g m^2/s\n", name(left).c_str(), name(right).c_str(),
+                       flow.border_psi(left) - flow.border_psi(right));
+  }
+  return out;
 }
 
 Status parse_time(std::string_view text, double* out) {
@@ -43,6 +98,7 @@ int run_flow(int argc, char** argv) {
   std::string out_path;
   double time = 0.0;
   uint32_t river_index = 0;
+  bool describe_river = false;
   std::string_view value;
   while (!args.done()) {
     const std::string_view arg = args.next();
@@ -53,6 +109,8 @@ int run_flow(int argc, char** argv) {
     } else if (arg == "--out") {
       status = args.value(arg, &value);
       out_path = std::string(value);
+    } else if (arg == "--describe") {
+      describe_river = true;
     } else if (arg == "--time") {
       status = args.value(arg, &value);
       if (status.ok()) status = parse_time(value, &time);
@@ -69,8 +127,10 @@ int run_flow(int argc, char** argv) {
     if (!status.ok()) return cli::fail(kCommand, status.message());
   }
   if (scene_path.empty()) return cli::fail(kCommand, "a scene file is required (see --help)");
-  if (out_path.empty()) return cli::fail(kCommand, "--out FILE.csv is required");
-  Status status = check_output_path(out_path);
+  if (out_path.empty() && !describe_river) {
+    return cli::fail(kCommand, "--out FILE.csv or --describe is required");
+  }
+  Status status = out_path.empty() ? Status::success() : check_output_path(out_path);
   if (!status.ok()) return cli::fail(kCommand, status.message());
 
   SceneFile scene;
@@ -79,6 +139,8 @@ int run_flow(int argc, char** argv) {
   SceneRiverFlow river;
   status = build_scene_river_flow(scene, river_index, time, &river);
   if (!status.ok()) return cli::fail(kCommand, status.message());
+  if (describe_river) std::printf("%s", describe(river.flow).c_str());
+  if (out_path.empty()) return cli::kExitOk;
   const std::string csv = flow_field_csv(river);
   status = write_file_atomically(out_path, csv.data(), csv.size());
   if (!status.ok()) return cli::fail(kCommand, status.message());

@@ -85,6 +85,37 @@ TEST_F(FlowCliTest, StraightGltfChannelIsUniformAndInAccessorOrder) {
   }
 }
 
+// An island off the middle: --describe names it and its arms, which carry the discharge between
+// them, the narrower less; in the CSV its shore (d_left = d_right = 0 off the banks) holds one psi.
+TEST_F(FlowCliTest, ProceduralRiverWithAnIslandDescribesItsArms) {
+  write_text(dir_ / "scene.json",
+             R"({"version":1,"river":{"procedural":{"length":120.0,"width":20.0,"width_variation":0.0,)"
+             R"("meander_amplitude":0.0,"vertices_across":21,)"
+             R"("islands":[{"center_z":0.0,"offset":3.0,"length":40.0,"width":5.0}]}},"flow":{"discharge":20.0}})");
+  const RunResult r = run_siviflow("flow " + (dir_ / "scene.json").string() + " --describe --out " +
+                                   (dir_ / "flow.csv").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 island, 3 arms, 0 junctions"), std::string::npos) << r.output;
+  const auto discharge_of = [&](const std::string& arm) {
+    const size_t at = r.output.find(arm + ": ");
+    EXPECT_NE(at, std::string::npos) << arm << " in\n" << r.output;
+    return at == std::string::npos ? 0.0 : std::stod(r.output.substr(at + arm.size() + 2));
+  };
+  const double left = discharge_of("arm from the left bank to island 0");
+  const double right = discharge_of("arm from island 0 to the right bank");
+  EXPECT_NEAR(left + right, 20.0, 1e-6);
+  EXPECT_LT(left, 0.8 * right) << "the island lies towards the left bank (+X)";
+  std::string header;
+  const std::vector<Row> rows = read_csv(dir_ / "flow.csv", &header);
+  size_t shore = 0;
+  for (const Row& row : rows) {
+    if (row.v[5] != 0 || row.v[7] != 0 || row.v[8] != 0) continue;
+    EXPECT_NEAR(row.v[9], right, 1e-6) << "shore vertex " << row.v[0];
+    ++shore;
+  }
+  EXPECT_GT(shore, 20u);
+}
+
 TEST_F(FlowCliTest, ProceduralRiverWithAMovingObstacle) {
   ProceduralRiverParams params;
   params.length = 80.0f;
@@ -279,7 +310,7 @@ TEST_F(FlowCliTest, BadInputIsAnErrorAndWritesNothing) {
   expect_error(run_siviflow("flow " + (dir_ / "badgltf.json").string() + out), "nothere.glb");
   write_text(dir_ / "ok.json", R"({"version":1,"river":{"procedural":{"length":40.0}}})");
   expect_error(run_siviflow("flow " + (dir_ / "ok.json").string() + " --time nan" + out), "--time");
-  expect_error(run_siviflow("flow " + (dir_ / "ok.json").string()), "--out FILE.csv is required");
+  expect_error(run_siviflow("flow " + (dir_ / "ok.json").string()), "--out FILE.csv or --describe is required");
   expect_error(run_siviflow("flow " + (dir_ / "ok.json").string() + " --bogus" + out), "unknown option '--bogus'");
   // A one-section river is not a strip of sections: named, exit 1.
   write_channel_gltf(dir_ / "tiny.gltf", 1, 2, 4.0f, 1.0f);
