@@ -1,7 +1,6 @@
-// Islands in the stream function, against an independent oracle: a finite-difference solution of
-// Laplace's equation for psi on a fine grid over the same channel and island, the island's psi
-// set by zero circulation about it (superposition of two solves). The discharge split, the
-// velocity field and the flux through every arm.
+// Islands in the stream function, against an independent oracle (laplace_oracle.h: Laplace's
+// equation for psi on a fine grid over the same channel and island, zero circulation about it):
+// the discharge split, the velocity field and the flux through every arm.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +10,7 @@
 #include <vector>
 
 #include "siviflow/sim/stream_function.h"
+#include "laplace_oracle.h"
 #include "unit/river_test_meshes.h"
 
 namespace siviflow {
@@ -23,134 +23,9 @@ constexpr float kLength = 60.0f;  // z from 0 to 60, downstream
 constexpr uint32_t kSections = 61, kAcross = 21;  // quads 1 m along, 0.5 m across
 constexpr double kQ = 8.0;
 
-// The island as the mesh has it: the quads of the grid (k along, j across) it lacks.
-struct QuadIsland {
-  std::set<std::pair<int, int>> cut;
-  bool covers(double x, double z) const {  // inside or on the border of a cut quad
-    const double j = (0.5 * kWidth - x) / (kWidth / (kAcross - 1)), k = z;
-    for (const int dk : {0, -1}) {
-      for (const int dj : {0, -1}) {
-        const int qk = int(std::floor(k + 1e-9)) + dk, qj = int(std::floor(j + 1e-9)) + dj;
-        if (k - qk > 1 + 1e-9 || j - qj > 1 + 1e-9) continue;
-        if (cut.count({qk, qj})) return true;
-      }
-    }
-    return false;
-  }
-};
+const test::Channel kChannel{kWidth, 0.0, kLength, kWidth / (kAcross - 1), 1.0};
 
-QuadIsland island_of(const TestMesh& m) {
-  std::set<std::pair<int, int>> present;
-  for (size_t t = 0; t < m.indices.size(); t += 3) {
-    const glm::vec3 c = (m.positions[m.indices[t]] + m.positions[m.indices[t + 1]] +
-                         m.positions[m.indices[t + 2]]) /
-                        3.0f;
-    present.insert({int(std::floor(c.z)), int(std::floor((0.5f * kWidth - c.x) / 0.5f))});
-  }
-  QuadIsland island;
-  for (int k = 0; k + 1 < int(kSections); ++k) {
-    for (int j = 0; j + 1 < int(kAcross); ++j) {
-      if (!present.count({k, j})) island.cut.insert({k, j});
-    }
-  }
-  return island;
-}
-
-// psi on a grid of spacing h: Q on the left bank, 0 on the right, uniform flow at both ends, the
-// island's psi the value of zero circulation about it.
-class LaplaceOracle {
- public:
-  LaplaceOracle(const QuadIsland& island, double h) : h_(h) {
-    nx_ = int(std::lround(kWidth / h)) + 1;
-    nz_ = int(std::lround(kLength / h)) + 1;
-    island_.resize(size_t(nx_) * nz_);
-    for (int i = 0; i < nx_; ++i) {
-      for (int k = 0; k < nz_; ++k) island_[index(i, k)] = island.covers(x_of(i), k * h_);
-    }
-    const std::vector<double> base = relax(kQ, 0.0), unit = relax(0.0, 1.0);
-    island_psi_ = -circulation(base) / circulation(unit);
-    psi_.resize(base.size());
-    for (size_t n = 0; n < base.size(); ++n) psi_[n] = base[n] + island_psi_ * unit[n];
-  }
-
-  double island_psi() const { return island_psi_; }
-  // Velocity grad(psi) x +Y = (-dpsi/dz, 0, dpsi/dx), bilinear between central differences.
-  glm::dvec3 velocity(double x, double z) const {
-    const double fi = (0.5 * kWidth - x) / h_, fk = z / h_;
-    const int i = std::clamp(int(fi), 1, nx_ - 3), k = std::clamp(int(fk), 1, nz_ - 3);
-    const double u = fi - i, w = fk - k;
-    glm::dvec3 v(0.0);
-    for (const auto& [di, dk, weight] :
-         {std::tuple{0, 0, (1 - u) * (1 - w)}, std::tuple{1, 0, u * (1 - w)},
-          std::tuple{0, 1, (1 - u) * w}, std::tuple{1, 1, u * w}}) {
-      const int a = i + di, b = k + dk;
-      // x decreases with i.
-      const double dpsi_dx = -(psi_[index(a + 1, b)] - psi_[index(a - 1, b)]) / (2 * h_);
-      const double dpsi_dz = (psi_[index(a, b + 1)] - psi_[index(a, b - 1)]) / (2 * h_);
-      v += weight * glm::dvec3(-dpsi_dz, 0.0, dpsi_dx);
-    }
-    return v;
-  }
-
- private:
-  size_t index(int i, int k) const { return size_t(k) * nx_ + size_t(i); }
-  double x_of(int i) const { return 0.5 * kWidth - i * h_; }
-
-  // Successive over-relaxation to a fixed point.
-  std::vector<double> relax(double q, double island_value) const {
-    std::vector<double> psi(size_t(nx_) * nz_);
-    for (int k = 0; k < nz_; ++k) {
-      for (int i = 0; i < nx_; ++i) {
-        const double uniform = q * double(nx_ - 1 - i) / double(nx_ - 1);
-        psi[index(i, k)] = island_[index(i, k)] ? island_value : uniform;
-      }
-    }
-    const double omega = 2.0 / (1.0 + std::sin(M_PI * h_ / kWidth)) * 0.98;
-    for (int sweep = 0; sweep < 100000; ++sweep) {
-      double change = 0.0;
-      for (int k = 1; k + 1 < nz_; ++k) {
-        for (int i = 1; i + 1 < nx_; ++i) {
-          const size_t n = index(i, k);
-          if (island_[n]) continue;
-          const double target = 0.25 * (psi[n - 1] + psi[n + 1] + psi[n - nx_] + psi[n + nx_]);
-          change = std::max(change, std::abs(target - psi[n]));
-          psi[n] += omega * (target - psi[n]);
-        }
-      }
-      if (change < 1e-12 * std::max(1.0, q)) break;
-    }
-    return psi;
-  }
-
-  // Flux of grad(psi) out of a box of grid lines two steps outside the island.
-  double circulation(const std::vector<double>& psi) const {
-    int i0 = nx_, i1 = 0, k0 = nz_, k1 = 0;
-    for (int k = 0; k < nz_; ++k) {
-      for (int i = 0; i < nx_; ++i) {
-        if (!island_[index(i, k)]) continue;
-        i0 = std::min(i0, i - 2), i1 = std::max(i1, i + 2), k0 = std::min(k0, k - 2),
-        k1 = std::max(k1, k + 2);
-      }
-    }
-    const auto p = [&](int i, int k) { return psi[index(i, k)]; };
-    double flux = 0.0;
-    for (int i = i0; i < i1; ++i) {  // the upstream and downstream sides
-      flux += 0.5 * (p(i, k0 - 1) - p(i, k0) + p(i + 1, k0 - 1) - p(i + 1, k0));
-      flux += 0.5 * (p(i, k1 + 1) - p(i, k1) + p(i + 1, k1 + 1) - p(i + 1, k1));
-    }
-    for (int k = k0; k < k1; ++k) {  // the two sides
-      flux += 0.5 * (p(i0 - 1, k) - p(i0, k) + p(i0 - 1, k + 1) - p(i0, k + 1));
-      flux += 0.5 * (p(i1 + 1, k) - p(i1, k) + p(i1 + 1, k + 1) - p(i1, k + 1));
-    }
-    return flux;
-  }
-
-  double h_;
-  int nx_ = 0, nz_ = 0;
-  std::vector<uint8_t> island_;
-  std::vector<double> psi_;
-  double island_psi_ = 0.0;
-};
+test::QuadIsland island_of(const TestMesh& m) { return test::island_of(kChannel, m.positions, m.indices); }
 
 StreamFunction flow_around(const TestMesh& m, float p, float search_radius = 0.0f) {
   RiverSurface surface;
@@ -172,7 +47,7 @@ TEST(IslandFlow, ASymmetricIslandSplitsTheDischargeInHalves) {
   const StreamFunction flow = flow_around(m, 1.0f);
   ASSERT_EQ(flow.surface().islands().size(), 1u);
   EXPECT_NEAR(flow.island_psi(0) / kQ, 0.5, 0.01 * 0.5);
-  const LaplaceOracle oracle(island_of(m), 0.125);
+  const test::LaplaceOracle oracle(island_of(m), kQ, 0.125);
   EXPECT_NEAR(oracle.island_psi() / kQ, 0.5, 0.01 * 0.5);  // the oracle's own symmetry
 }
 
@@ -181,7 +56,7 @@ TEST(IslandFlow, AnOffCentreIslandSplitsTheDischargeAsLaplaceDoes) {
     const TestMesh m =
         test::channel_with_island(kWidth, kLength, kSections, kAcross, x, 30.0f, rx, rz);
     const StreamFunction flow = flow_around(m, 1.0f);
-    const LaplaceOracle oracle(island_of(m), 0.125);
+    const test::LaplaceOracle oracle(island_of(m), kQ, 0.125);
     // The right arm carries psi_island - 0, the left Q - psi_island: the smaller within 3 %.
     const double right = flow.island_psi(0), right_oracle = oracle.island_psi();
     const double smaller = std::min(right_oracle, kQ - right_oracle);
@@ -198,7 +73,7 @@ TEST(IslandFlow, VelocitiesAgreeWithLaplaceAwayFromTheEnds) {
   // is what potential flow gives in a straight arm (the default p = 1.5 slows the water at the
   // shores on purpose, and potential flow does not).
   const StreamFunction flow = flow_around(m, 1.0f, 1000.0f);
-  const LaplaceOracle oracle(island_of(m), 0.125);
+  const test::LaplaceOracle oracle(island_of(m), kQ, 0.125);
   std::vector<double> errors;
   const RiverSurface& s = flow.surface();
   for (uint32_t n = 0; n < s.node_count(); ++n) {
