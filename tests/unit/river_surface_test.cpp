@@ -391,6 +391,21 @@ TEST(RiverSurfaceBad, IslandTouchingABank) {
   expect_error(m, {"vertex 10", "an island and a bank"});
 }
 
+TEST(RiverSurfaceBad, ZeroWidthNeckBesideAnIsland) {
+  // The 5x5 grid missing quad (1, 1) (x in [0, 2], z in [2, 4]), its left bank pulled in to
+  // 5 micrometres from the island's shore beside it (vertices 5 and 10, at x = 4 before).
+  TestMesh m = test::straight_channel(8, 8, 5, 5);
+  std::vector<uint32_t> kept;
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    const std::array<uint32_t, 3> tri{m.indices[t], m.indices[t + 1], m.indices[t + 2]};
+    const auto has = [&](uint32_t v) { return std::find(tri.begin(), tri.end(), v) != tri.end(); };
+    if (!(has(7) && has(11))) kept.insert(kept.end(), tri.begin(), tri.end());
+  }
+  m.indices = kept;
+  m.positions[5].x = m.positions[10].x = 2.0f + 5e-6f;
+  expect_error(m, {"zero-width neck", "vertices 5 and 6"});
+}
+
 TEST(RiverSurfaceBad, NonManifoldEdge) {
   TestMesh m = test::straight_channel(4, 8, 5, 3);
   m.positions.push_back({0.5f, 3.0f, 3.0f});
