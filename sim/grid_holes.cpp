@@ -7,6 +7,7 @@ namespace siviflow {
 size_t cut_grid_quads(uint32_t across, const std::function<bool(uint32_t, uint32_t)>& cut,
                       std::vector<glm::vec3>* positions, std::vector<uint32_t>* indices,
                       std::vector<float>* depth) {
+  if (across < 2 || indices->size() % (6 * size_t{across - 1}) != 0) return 0;  // not a grid strip
   const size_t quads_across = across - 1;
   const size_t rows = indices->size() / 6 / quads_across;
   std::vector<uint8_t> gone(rows * quads_across, 0);

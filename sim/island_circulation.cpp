@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include <unordered_map>
 
 #include "siviflow/sim/river_tuning.h"
 #include "siviflow/text_format.h"
@@ -221,6 +222,12 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
         if (surface.on_island(n)) {
           const auto it = std::find(cluster.islands.begin(), cluster.islands.end(),
                                     static_cast<uint32_t>(surface.island_of(n)));
+          if (it == cluster.islands.end()) {  // a cluster holds every island its sections meet
+            return Status::error(text_format(
+                "the flow about the islands near river vertex %u could not be set up: island "
+                "%zu lies across the sections that close its neighbour's region",
+                surface.vertex_of_node(n), surface.island_of(n)));
+          }
           unknown[n] = static_cast<int32_t>(it - cluster.islands.begin());
         } else if (closing || bank[n] != Bank::kNone) {
           fixed_value[n] = closing ? discharge * (1.0 - water / width)
@@ -239,7 +246,15 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
     std::vector<std::vector<std::pair<uint32_t, double>>> rows(x.size());
     System system;
     system.rhs.assign(x.size(), 0.0);
+    // A node's row has a handful of entries; an island's, one per shore neighbour: looked up.
+    std::vector<std::unordered_map<uint32_t, uint32_t>> island_slot(cluster.islands.size());
     const auto add = [&](uint32_t row, uint32_t col, double w) {
+      if (row < island_slot.size()) {
+        const auto [it, added] = island_slot[row].try_emplace(col, uint32_t(rows[row].size()));
+        if (added) rows[row].emplace_back(col, 0.0);
+        rows[row][it->second].second += w;
+        return;
+      }
       for (auto& [c, v] : rows[row]) {
         if (c == col) {
           v += w;

@@ -144,9 +144,9 @@ Status ProceduralRiver::validate(const ProceduralRiverParams& p) {
         "procedural river: vertices_across = %u must be at least 2 (one per bank)",
         p.vertices_across));
   }
-  if (p.islands.size() > kMaxRiverIslands) {
+  if (p.islands.size() > kMaxProceduralIslands) {
     return Status::error(text_format("procedural river: %zu islands, more than the limit of %zu",
-                                     p.islands.size(), kMaxRiverIslands));
+                                     p.islands.size(), kMaxProceduralIslands));
   }
   for (size_t i = 0; i < p.islands.size(); ++i) {
     const ProceduralIsland& island = p.islands[i];
@@ -159,9 +159,11 @@ Status ProceduralRiver::validate(const ProceduralRiverParams& p) {
                   {"length", island.length, true},
                   {"width", island.width, true}};
     for (const auto& f : fields) {
-      if (!std::isfinite(f.value) || (f.positive && !(f.value > 0.0f))) {
-        return Status::error(text_format("procedural river: islands[%zu].%s = %g must be finite%s",
-                                         i, f.name, f.value, f.positive ? " and > 0" : ""));
+      if (!std::isfinite(f.value) || (f.positive && !(f.value >= kMinProceduralIslandSize))) {
+        return Status::error(text_format(
+            "procedural river: islands[%zu].%s = %g must be finite%s", i, f.name, f.value,
+            f.positive ? text_format(" and at least %g m", double(kMinProceduralIslandSize)).c_str()
+                       : ""));
       }
     }
   }

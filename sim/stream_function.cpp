@@ -91,9 +91,12 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
   for (size_t i = 0; i < s.islands().size(); ++i) {
     const auto shore = s.island_nodes(i);
     for (size_t j = 0; j < shore.size(); ++j) {
-      const glm::vec3 d = pos_of(s, shore[(j + 1) % shore.size()]) -
-                          pos_of(s, shore[(j + shore.size() - 1) % shore.size()]);
-      f.island_tangent_.push_back({shore[j], glm::normalize(d)});
+      // In double, as bank_tangent: a float difference of far coordinates may overflow.
+      const DVec3 d = DVec3(pos_of(s, shore[(j + 1) % shore.size()])) -
+                      DVec3(pos_of(s, shore[(j + shore.size() - 1) % shore.size()]));
+      const double length = glm::length(d);
+      f.island_tangent_.push_back(
+          {shore[j], length > 0.0 && std::isfinite(length) ? glm::vec3(d / length) : glm::vec3(0.0f)});
     }
   }
   std::sort(f.island_tangent_.begin(), f.island_tangent_.end(),
@@ -228,7 +231,7 @@ glm::vec3 StreamFunction::bank_tangent(uint32_t n) const {
   if (surface_.on_island(n)) {
     const auto it = std::lower_bound(island_tangent_.begin(), island_tangent_.end(), n,
                                      [](const auto& entry, uint32_t node) { return entry.first < node; });
-    return it->second;
+    return it != island_tangent_.end() && it->first == n ? it->second : glm::vec3(0.0f);
   }
   const Bank bank = surface_.node_bank()[n];
   if (bank == Bank::kNone) return glm::vec3(0.0f);

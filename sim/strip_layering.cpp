@@ -201,6 +201,7 @@ Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
     // island's far side where the chain ends on it.
     uint32_t prev = kNoNode;
     uint32_t cur = bank_1[k];
+    std::vector<uint32_t> crossed;  // the islands this section went across
     for (uint32_t steps = 0; cur != kNoNode; ++steps) {
       if (steps >= size) break;  // a cycle: reported below as an incomplete chain
       out->chain_nodes.push_back(cur);
@@ -223,6 +224,13 @@ Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
       prev = cur;
       if (next == kNoNode && has_islands && (*mesh.node_island)[cur] != kNoNode) {
         const uint32_t island = (*mesh.node_island)[cur];
+        if (std::find(crossed.begin(), crossed.end(), island) != crossed.end()) {
+          return Status::error(text_format(
+              "the river mesh is not a strip of sections: section %u meets the island at vertex "
+              "%s a second time (a bay?): each section must cross an island once",
+              k, vertex_name(mesh, cur).c_str()));
+        }
+        crossed.push_back(island);
         // The far side: the nearest of the island's other nodes in this section.
         uint32_t far_side = kNoNode;
         double nearest = 0.0;

@@ -231,7 +231,7 @@ Status parse_procedural(const Reader& r, const Json& v, const std::string& path,
   }
   if (const Json* islands = find(v, "islands")) {
     const std::string at = join(path, "islands");
-    SIVIFLOW_TRY(r.array(*islands, at, kMaxRiverIslands));
+    SIVIFLOW_TRY(r.array(*islands, at, kMaxProceduralIslands));
     for (size_t i = 0; i < islands->size(); ++i) {
       const Json& item = (*islands)[i];
       const std::string item_path = element(at, i);

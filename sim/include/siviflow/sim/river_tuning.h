@@ -26,6 +26,10 @@ inline constexpr size_t kMaxRiverVertices = size_t{1} << 27;
 inline constexpr size_t kMaxRiverTriangles = size_t{1} << 28;
 // Islands (holes in the river mesh) take a 16-bit border index beside the two banks.
 inline constexpr size_t kMaxRiverIslands = 65000;
+// The procedural generator's islands: every terrain sample asks each, so they are few; and none
+// so small that its half-size rounds to nothing.
+inline constexpr size_t kMaxProceduralIslands = 256;
+inline constexpr float kMinProceduralIslandSize = 0.01f;
 // Obstacles are few (objects touching the water); polygons are footprints, not meshes.
 inline constexpr size_t kMaxObstacles = 4096;
 inline constexpr size_t kMaxPolygonPoints = 4096;
