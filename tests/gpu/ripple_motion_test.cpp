@@ -3,39 +3,40 @@
 // phase correlation in a small window around each particle, and its motion compared with the
 // particle's flow projected to the screen, for both materials: Tiled Directional Flow and the
 // two-phase flow-map baseline. Floating bodies drifted by the gameplay queries (siviflow/drift.h)
-// move the way the ripples under them do.
+// move the way the ripples under them do. About an island, the ripples follow its two arms.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <glm/geometric.hpp>
 #include <map>
 #include <vector>
 
-#include <glm/geometric.hpp>
-#include <gtest/gtest.h>
-
 #include "phase_correlation.h"
 #include "renderer_inspect.h"
-#include "siviflow/drift.h"
 #include "shaders/shared.h"
 #include "sim/flow_textures.h"
+#include "siviflow/drift.h"
 #include "straight_channel.h"
 
 namespace siviflow::testing {
 namespace {
 
 constexpr VkExtent2D kView{640, 360};
-constexpr size_t kWindow = 32;     // pixels a side
-constexpr uint32_t kFirst = 12;    // frames: the particles have faded in
-constexpr uint32_t kApart = 3;     // frames between the two images compared: at most 6 px of
-                                   // motion at the boulder's shoulders, which the windows track
+constexpr size_t kWindow = 32;   // pixels a side
+constexpr uint32_t kFirst = 12;  // frames: the particles have faded in
+constexpr uint32_t kApart = 3;   // frames between the two images compared: at most 6 px of
+                                 // motion at the boulder's shoulders, which the windows track
 constexpr double kFps = 30.0;
 constexpr double kMinShift = 1.0;  // pixels: slower water is too still to measure a direction
 
 struct Motion {
-  glm::dvec2 measured;  // pixels over kApart frames
-  glm::dvec2 expected;  // the particle's flow over the same time, projected
+  glm::dvec2 measured;      // pixels over kApart frames
+  glm::dvec2 expected;      // the particle's flow over the same time, projected
   double boulder_distance;  // metres from the boulder's centre
+  glm::vec2 at;             // x and z of the particle
 };
 
 // A float's screen motion over kApart frames and the ripples' under it.
@@ -47,8 +48,8 @@ struct FloatMotion {
 
 struct Summary {
   size_t windows = 0;
-  double angle_deg = 0.0;   // median angular error
-  double speed_ratio = 0.0; // median |measured| / |expected|
+  double angle_deg = 0.0;    // median angular error
+  double speed_ratio = 0.0;  // median |measured| / |expected|
   size_t near_windows = 0;
   double near_angle_deg = 0.0;  // the same where the flow turns round the boulder
 };
@@ -107,8 +108,10 @@ class RippleMotionTest : public StraightChannelTest {
     for (uint32_t ty = 0; ty < layout.flow_extent.y; ++ty) {
       for (uint32_t tx = 0; tx < layout.flow_extent.x; ++tx) {
         gpu::FlowTexel texel{};
-        std::memcpy(&texel, a.flow_texture.data() + (size_t{ty} * layout.flow_extent.x + tx) * sizeof(texel),
-                    sizeof(texel));
+        std::memcpy(
+            &texel,
+            a.flow_texture.data() + (size_t{ty} * layout.flow_extent.x + tx) * sizeof(texel),
+            sizeof(texel));
         if (texel.id == SIVIFLOW_PARTICLE_NONE) continue;
         Cells& cells = particles[texel.id];
         cells.sum += (glm::dvec2(tx, ty) + 0.5) * double(layout.texel_px) - 0.5;
@@ -124,7 +127,8 @@ class RippleMotionTest : public StraightChannelTest {
       const glm::vec3 p(xz.x, 0.0f, xz.y);
       Motion motion;
       motion.expected = pixel_of(p + cells.flow * float(seconds)) - pixel_of(p);
-      motion.boulder_distance = glm::distance(xz, glm::vec2(kBoulder.x, kBoulder.z));
+      motion.boulder_distance = glm::distance(xz, glm::vec2(boulder_.x, boulder_.z));
+      motion.at = xz;
       if (glm::length(motion.expected) < kMinShift) continue;
       if (!track(a, b, centre, &motion.measured)) continue;
       out.push_back(motion);
@@ -132,11 +136,16 @@ class RippleMotionTest : public StraightChannelTest {
     return out;
   }
 
-  Summary measure(WaterMaterial material) {
+  // The motions of the ripples and of the particles' flow, between frames kFirst, kFirst +
+  // kApart and kFirst + 2 kApart of the channel with its boulder at `boulder` and `islands`.
+  std::vector<Motion> render_motions(WaterMaterial material, const glm::vec3& boulder,
+                                     const std::vector<ProceduralIsland>& islands = {}) {
     WaterLook look;
     look.material = material;
+    boulder_ = boulder;
     set_camera({0.0f, 9.0f, -4.5f}, {0.0f, 0.0f, 2.5f}, kView);
-    const Status status = create_channel(make_create_info(kView.width, kView.height), kBoulder, look);
+    const Status status =
+        create_channel(make_create_info(kView.width, kView.height), boulder, look, {}, islands);
     EXPECT_TRUE(status.ok()) << status.message();
     frames_ = render_still(0, kFirst + 2 * kApart + 1);
     const std::vector<Frame>& frames = frames_;
@@ -145,6 +154,11 @@ class RippleMotionTest : public StraightChannelTest {
     std::vector<Motion> all = motions(frames[kFirst], frames[kFirst + kApart]);
     const std::vector<Motion> later = motions(frames[kFirst + kApart], frames[kFirst + 2 * kApart]);
     all.insert(all.end(), later.begin(), later.end());
+    return all;
+  }
+
+  Summary measure(WaterMaterial material) {
+    const std::vector<Motion> all = render_motions(material, kBoulder);
     std::vector<double> angles, ratios, near;
     for (const Motion& m : all) {
       const double cosine = glm::dot(m.measured, m.expected) /
@@ -167,10 +181,10 @@ class RippleMotionTest : public StraightChannelTest {
       return renderer_->query_water(p, s);
     };
     std::vector<FloatMotion> out;
-    for (const glm::vec3 release : {glm::vec3(-1.5f, 0.0f, -2.0f), glm::vec3(1.5f, 0.0f, -2.0f),
-                                    glm::vec3(-2.2f, 0.0f, 0.5f), glm::vec3(2.2f, 0.0f, 0.5f),
-                                    glm::vec3(-3.0f, 0.0f, 2.0f), glm::vec3(3.0f, 0.0f, 2.0f),
-                                    glm::vec3(-1.5f, 0.0f, 3.0f), glm::vec3(1.5f, 0.0f, 3.0f)}) {
+    for (const glm::vec3 release :
+         {glm::vec3(-1.5f, 0.0f, -2.0f), glm::vec3(1.5f, 0.0f, -2.0f), glm::vec3(-2.2f, 0.0f, 0.5f),
+          glm::vec3(2.2f, 0.0f, 0.5f), glm::vec3(-3.0f, 0.0f, 2.0f), glm::vec3(3.0f, 0.0f, 2.0f),
+          glm::vec3(-1.5f, 0.0f, 3.0f), glm::vec3(1.5f, 0.0f, 3.0f)}) {
       std::vector<FloatingBody> body(1);
       body[0].position = release;
       body[0].radius = 0.1f;
@@ -181,7 +195,8 @@ class RippleMotionTest : public StraightChannelTest {
         EXPECT_TRUE(drift_bodies(body, float(1.0 / kFps), ask).ok());
         path.push_back(body[0].position);
       }
-      EXPECT_FALSE(body[0].stranded) << "a float released at x " << release.x << ", z " << release.z;
+      EXPECT_FALSE(body[0].stranded)
+          << "a float released at x " << release.x << ", z " << release.z;
       FloatMotion motion;
       motion.release = release;
       std::vector<double> xs, ys;
@@ -193,8 +208,8 @@ class RippleMotionTest : public StraightChannelTest {
         xs.push_back(shift.x);
         ys.push_back(shift.y);
       }
-      EXPECT_GE(xs.size(), kApart) << "no water round the float released at x " << release.x
-                                   << ", z " << release.z;
+      EXPECT_GE(xs.size(), kApart)
+          << "no water round the float released at x " << release.x << ", z " << release.z;
       if (xs.empty()) continue;
       motion.measured = {median(xs), median(ys)};
       out.push_back(motion);
@@ -209,12 +224,14 @@ class RippleMotionTest : public StraightChannelTest {
   }
 
   std::vector<Frame> frames_;  // measure()'s
+  glm::vec3 boulder_ = kBoulder;
 };
 
 void expect_moves_with_the_flow(const char* material, const Summary& s) {
-  std::printf("%s: %zu windows, median angular error %.1f deg, median speed ratio %.2f; "
-              "%zu windows round the boulder, median angular error %.1f deg\n",
-              material, s.windows, s.angle_deg, s.speed_ratio, s.near_windows, s.near_angle_deg);
+  std::printf(
+      "%s: %zu windows, median angular error %.1f deg, median speed ratio %.2f; "
+      "%zu windows round the boulder, median angular error %.1f deg\n",
+      material, s.windows, s.angle_deg, s.speed_ratio, s.near_windows, s.near_angle_deg);
   EXPECT_GT(s.windows, 100u) << material;
   EXPECT_GT(s.near_windows, 10u) << material;
   EXPECT_LE(s.angle_deg, 10.0) << material;
@@ -223,7 +240,8 @@ void expect_moves_with_the_flow(const char* material, const Summary& s) {
 }
 
 TEST_F(RippleMotionTest, TiledDirectionalFlowRipplesMoveWithTheFlow) {
-  expect_moves_with_the_flow("tiled directional flow", measure(WaterMaterial::kTiledDirectionalFlow));
+  expect_moves_with_the_flow("tiled directional flow",
+                             measure(WaterMaterial::kTiledDirectionalFlow));
   // The floats go where the ripples under them go.
   const std::vector<FloatMotion> floats = float_motions();
   EXPECT_EQ(floats.size(), 8u);
@@ -231,14 +249,15 @@ TEST_F(RippleMotionTest, TiledDirectionalFlowRipplesMoveWithTheFlow) {
     const double cosine = glm::dot(f.measured, f.drifted) /
                           std::max(glm::length(f.measured) * glm::length(f.drifted), 1e-9);
     const double angle = glm::degrees(std::acos(std::clamp(cosine, -1.0, 1.0)));
-    std::printf("float released at x %.1f, z %.1f: drifted (%.2f, %.2f) px, ripples (%.2f, %.2f) "
-                "px, %.1f deg apart\n",
-                double(f.release.x), double(f.release.z), f.drifted.x, f.drifted.y, f.measured.x,
-                f.measured.y, angle);
+    std::printf(
+        "float released at x %.1f, z %.1f: drifted (%.2f, %.2f) px, ripples (%.2f, %.2f) "
+        "px, %.1f deg apart\n",
+        double(f.release.x), double(f.release.z), f.drifted.x, f.drifted.y, f.measured.x,
+        f.measured.y, angle);
     // Where the flow turns round the boulder within a tile, the ripples' tolerance (as for the
     // particles above).
-    const bool near = glm::distance(glm::vec2(f.release.x, f.release.z), glm::vec2(kBoulder.x, kBoulder.z)) <
-                      2.5f * kBoulderRadius;
+    const bool near = glm::distance(glm::vec2(f.release.x, f.release.z),
+                                    glm::vec2(kBoulder.x, kBoulder.z)) < 2.5f * kBoulderRadius;
     EXPECT_LT(angle, near ? 15.0 : 10.0)
         << "the float released at x " << f.release.x << ", z " << f.release.z;
   }
@@ -246,6 +265,37 @@ TEST_F(RippleMotionTest, TiledDirectionalFlowRipplesMoveWithTheFlow) {
 
 TEST_F(RippleMotionTest, FlowMapRipplesMoveWithTheFlow) {
   expect_moves_with_the_flow("flow map", measure(WaterMaterial::kFlowMap));
+}
+
+// An island in mid-stream parts the flow (the boulder moved far downstream, out of view): the
+// ripples go where the flow goes in both its arms and where the flow turns at its head and tail.
+TEST_F(RippleMotionTest, RipplesFollowTheFlowAroundAnIsland) {
+  const ProceduralIsland island{3.0f, 0.0f, 10.0f, 3.0f};  // z from -2 to 8, x from -1.5 to 1.5
+  const std::vector<Motion> all =
+      render_motions(WaterMaterial::kTiledDirectionalFlow, {0.0f, 0.0f, 50.0f}, {island});
+  std::vector<double> angles, ratios, turning;
+  size_t left = 0, right = 0;
+  for (const Motion& m : all) {
+    const double cosine = glm::dot(m.measured, m.expected) /
+                          std::max(glm::length(m.measured) * glm::length(m.expected), 1e-9);
+    const double angle = glm::degrees(std::acos(std::clamp(cosine, -1.0, 1.0)));
+    angles.push_back(angle);
+    ratios.push_back(glm::length(m.measured) / glm::length(m.expected));
+    const bool beside = m.at.y > -2.0f && m.at.y < 8.0f;
+    left += beside && m.at.x > 1.5f ? 1 : 0;
+    right += beside && m.at.x < -1.5f ? 1 : 0;
+    if (std::abs(m.at.y + 2.0f) < 2.0f || std::abs(m.at.y - 8.0f) < 2.0f) turning.push_back(angle);
+  }
+  std::printf(
+      "around the island: %zu windows (%zu left of it, %zu right), median angular error "
+      "%.1f deg, median speed ratio %.2f; %zu at its head and tail, %.1f deg\n",
+      angles.size(), left, right, median(angles), median(ratios), turning.size(), median(turning));
+  EXPECT_GT(left, 10u);
+  EXPECT_GT(right, 10u);
+  EXPECT_GT(turning.size(), 10u);
+  EXPECT_LE(median(angles), 10.0);
+  EXPECT_NEAR(median(ratios), 1.0, 0.2);
+  EXPECT_LE(median(turning), 15.0);
 }
 
 }  // namespace

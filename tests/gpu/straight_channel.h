@@ -1,15 +1,15 @@
 // The view the tests of the flow's marks on the water measure: a still camera looking down on a
 // straight channel, flowing along +Z, with a boulder in mid-stream that the host can move (a
-// runtime obstacle of the renderer, drawn by the world's boulder of the same place).
+// runtime obstacle of the renderer, drawn by the world's boulder of the same place), and islands
+// where a test asks for them.
 #pragma once
 
 #include <cmath>
-#include <vector>
-
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <vector>
 
 #include "render_frames.h"
 #include "siviflow/scene_file.h"
@@ -22,7 +22,8 @@ class StraightChannelTest : public RenderTest {
   static constexpr float kBoulderRadius = 1.2f;
   static constexpr float kChannelWidth = 12.0f;
 
-  static SceneFile channel_scene(const glm::vec3& boulder) {
+  static SceneFile channel_scene(const glm::vec3& boulder,
+                                 const std::vector<ProceduralIsland>& islands = {}) {
     SceneFile scene;
     scene.path = "straight-channel.json";
     ProceduralRiverParams& river = scene.rivers[0].procedural;
@@ -30,6 +31,7 @@ class StraightChannelTest : public RenderTest {
     river.meander_amplitude = 0.0f;
     river.width = kChannelWidth;
     river.width_variation = 0.0f;
+    river.islands = islands;
     Obstacle obstacle;
     obstacle.centre = boulder;
     obstacle.radius = kBoulderRadius;
@@ -37,15 +39,16 @@ class StraightChannelTest : public RenderTest {
     return scene;
   }
 
-  // The world of the channel with its boulder at `boulder` and `objects`, and the water of the
-  // channel with the boulder as a runtime obstacle (so that move_boulder can move it), which
-  // reflects the world unless `info` names a reflection of its own; the world's ground and
-  // objects are its occluders.
+  // The world of the channel with its boulder at `boulder`, `objects` and `islands`, and the
+  // water of the channel with the boulder as a runtime obstacle (so that move_boulder can move
+  // it), which reflects the world unless `info` names a reflection of its own; the world's
+  // ground and objects are its occluders.
   Status create_channel(CreateInfo info, const glm::vec3& boulder, const WaterLook& look = {},
-                        const std::vector<SceneObject>& objects = {}) {
+                        const std::vector<SceneObject>& objects = {},
+                        const std::vector<ProceduralIsland>& islands = {}) {
     renderer_.reset();
     world_.reset();
-    scene_ = channel_scene(boulder);
+    scene_ = channel_scene(boulder, islands);
     scene_.look = look;
     scene_.objects = objects;
     WorldCreateInfo world_info = context_->world_create_info(info.color_format, info.depth_format);
@@ -85,14 +88,16 @@ class StraightChannelTest : public RenderTest {
   View view() const { return camera_view(camera_, extent_); }
 
   std::vector<Frame> render_still(uint32_t first, uint32_t end) {
-    return render_views(first, end, extent_.width, extent_.height, [this](double) { return view(); });
+    return render_views(first, end, extent_.width, extent_.height,
+                        [this](double) { return view(); });
   }
 
   // Where the centre of pixel (x, y) sees the water's level plane (y = 0), in x and z.
   glm::vec2 water_point(double x, double y) const {
     const View v = view();
     const glm::mat4 to_world = glm::inverse(v.projection * v.view);
-    const glm::vec2 ndc{(x + 0.5) / extent_.width * 2.0 - 1.0, (y + 0.5) / extent_.height * 2.0 - 1.0};
+    const glm::vec2 ndc{(x + 0.5) / extent_.width * 2.0 - 1.0,
+                        (y + 0.5) / extent_.height * 2.0 - 1.0};
     const glm::vec4 near = to_world * glm::vec4(ndc, 0.0f, 1.0f);
     const glm::vec4 far = to_world * glm::vec4(ndc, 1.0f, 1.0f);
     const glm::vec3 a = glm::vec3(near) / near.w, b = glm::vec3(far) / far.w;
