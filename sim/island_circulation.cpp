@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
-#include <unordered_map>
 
 #include "siviflow/sim/river_tuning.h"
 #include "siviflow/text_format.h"
@@ -246,13 +245,12 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
     std::vector<std::vector<std::pair<uint32_t, double>>> rows(x.size());
     System system;
     system.rhs.assign(x.size(), 0.0);
-    // A node's row has a handful of entries; an island's, one per shore neighbour: looked up.
-    std::vector<std::unordered_map<uint32_t, uint32_t>> island_slot(cluster.islands.size());
+    // A node's row has a handful of entries, merged as they come; an island's has one per shore
+    // neighbour, appended and merged once sorted.
+    const size_t island_rows = cluster.islands.size();
     const auto add = [&](uint32_t row, uint32_t col, double w) {
-      if (row < island_slot.size()) {
-        const auto [it, added] = island_slot[row].try_emplace(col, uint32_t(rows[row].size()));
-        if (added) rows[row].emplace_back(col, 0.0);
-        rows[row][it->second].second += w;
+      if (row < island_rows) {
+        rows[row].emplace_back(col, w);
         return;
       }
       for (auto& [c, v] : rows[row]) {
@@ -287,6 +285,11 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
     for (size_t r = 0; r < rows.size(); ++r) {
       std::sort(rows[r].begin(), rows[r].end());
       for (const auto& [c, v] : rows[r]) {
+        if (!system.column.empty() && system.column.size() > system.start[r] &&
+            system.column.back() == c) {
+          system.value.back() += v;  // an island's entries, appended apart
+          continue;
+        }
         system.column.push_back(c);
         system.value.push_back(v);
       }
