@@ -20,8 +20,6 @@
 namespace siviflow {
 namespace {
 
-constexpr uint32_t kUnset = std::numeric_limits<uint32_t>::max();
-
 using DVec3 = glm::dvec3;
 
 DVec3 to_d(const glm::vec3& v) { return DVec3(v); }
@@ -229,12 +227,12 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   pos.reserve(vertex_count);  // kept: grown by doubling, it held up to twice its size
   {
     const size_t table_size = std::bit_ceil(2 * vertex_count);
-    std::vector<uint32_t> table(table_size, kUnset);
+    std::vector<uint32_t> table(table_size, kNoNode);
     for (size_t v = 0; v < vertex_count; ++v) {
       const glm::vec3& p = positions[v];
       size_t slot = hash_position(p) & (table_size - 1);
-      while (table[slot] != kUnset && pos[table[slot]] != p) slot = (slot + 1) & (table_size - 1);
-      if (table[slot] == kUnset) {
+      while (table[slot] != kNoNode && pos[table[slot]] != p) slot = (slot + 1) & (table_size - 1);
+      if (table[slot] == kNoNode) {
         table[slot] = static_cast<uint32_t>(pos.size());
         pos.push_back(p);
         node_vertex.push_back(static_cast<uint32_t>(v));
@@ -298,7 +296,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   Csr adj;
   adj.start.assign(node_count + 1, 0);
   adj.list.reserve(tris.size());
-  std::vector<std::array<uint32_t, 2>> border_next(node_count, {kUnset, kUnset});
+  std::vector<std::array<uint32_t, 2>> border_next(node_count, {kNoNode, kNoNode});
   std::vector<uint8_t> on_border(node_count, 0);
   size_t edge_count = 0;
   {
@@ -330,9 +328,9 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
         if (shared == 1) {
           for (const auto& [x, y] : {std::pair{n, m}, std::pair{m, n}}) {
             auto& slots = border_next[x];
-            if (slots[0] == kUnset) {
+            if (slots[0] == kNoNode) {
               slots[0] = y;
-            } else if (slots[1] == kUnset) {
+            } else if (slots[1] == kNoNode) {
               slots[1] = y;
             } else {
               return Status::error(text_format(
@@ -350,12 +348,12 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
 
   // --- One piece.
   {
-    std::vector<uint32_t> piece(node_count, kUnset);
+    std::vector<uint32_t> piece(node_count, kNoNode);
     std::vector<uint32_t> stack;
     uint32_t pieces = 0;
-    uint32_t second_piece_node = kUnset;
+    uint32_t second_piece_node = kNoNode;
     for (uint32_t s = 0; s < node_count; ++s) {
-      if (piece[s] != kUnset) continue;
+      if (piece[s] != kNoNode) continue;
       if (pieces == 1) second_piece_node = s;
       piece[s] = pieces;
       stack.push_back(s);
@@ -363,7 +361,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
         const uint32_t n = stack.back();
         stack.pop_back();
         for (const uint32_t m : adj.of(n)) {
-          if (piece[m] == kUnset) {
+          if (piece[m] == kNoNode) {
             piece[m] = pieces;
             stack.push_back(m);
           }
@@ -396,20 +394,20 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     std::vector<uint8_t> seen(node_count, 0);
     for (uint32_t s = 0; s < node_count; ++s) {
       if (!on_border[s] || seen[s]) continue;
-      if (border_next[s][1] == kUnset) {
+      if (border_next[s][1] == kNoNode) {
         return Status::error(text_format(
             "the river mesh is non-manifold at vertex %u: a single border edge ends there",
             node_vertex[s]));
       }
       std::vector<uint32_t> walked;
-      uint32_t prev = kUnset, cur = s;
+      uint32_t prev = kNoNode, cur = s;
       do {
         walked.push_back(cur);
         seen[cur] = 1;
         const uint32_t next = border_next[cur][0] != prev ? border_next[cur][0] : border_next[cur][1];
         prev = cur;
         cur = next;
-      } while (cur != s && cur != kUnset && !seen[cur]);
+      } while (cur != s && cur != kNoNode && !seen[cur]);
       if (std::find(walked.begin(), walked.end(), upstream_node) != walked.end()) {
         loop = std::move(walked);
       } else {

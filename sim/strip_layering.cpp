@@ -184,7 +184,7 @@ Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
 
   std::vector<uint32_t> layer_size(section_count, 0);
   for (const uint32_t l : layer) ++layer_size[l];
-  const IslandRows island_rows(mesh, has_islands ? layer : std::vector<uint32_t>{});
+  const IslandRows island_rows(mesh, layer);  // empty without islands
   std::vector<uint32_t> walked_in(has_islands ? node_count : 0, kNoNode);
 
   out->chain_start.assign(section_count + 1, 0);

@@ -54,6 +54,12 @@ struct Summary {
   double near_angle_deg = 0.0;  // the same where the flow turns round the boulder
 };
 
+// The angle between two screen motions, in degrees.
+double degrees_apart(const glm::dvec2& a, const glm::dvec2& b) {
+  const double cosine = glm::dot(a, b) / std::max(glm::length(a) * glm::length(b), 1e-9);
+  return glm::degrees(std::acos(std::clamp(cosine, -1.0, 1.0)));
+}
+
 double median(std::vector<double> values) {
   if (values.empty()) return NAN;
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
@@ -161,9 +167,7 @@ class RippleMotionTest : public StraightChannelTest {
     const std::vector<Motion> all = render_motions(material, kBoulder);
     std::vector<double> angles, ratios, near;
     for (const Motion& m : all) {
-      const double cosine = glm::dot(m.measured, m.expected) /
-                            std::max(glm::length(m.measured) * glm::length(m.expected), 1e-9);
-      const double angle = glm::degrees(std::acos(std::clamp(cosine, -1.0, 1.0)));
+      const double angle = degrees_apart(m.measured, m.expected);
       angles.push_back(angle);
       ratios.push_back(glm::length(m.measured) / glm::length(m.expected));
       if (m.boulder_distance < 2.5 * kBoulderRadius) near.push_back(angle);
@@ -246,9 +250,7 @@ TEST_F(RippleMotionTest, TiledDirectionalFlowRipplesMoveWithTheFlow) {
   const std::vector<FloatMotion> floats = float_motions();
   EXPECT_EQ(floats.size(), 8u);
   for (const FloatMotion& f : floats) {
-    const double cosine = glm::dot(f.measured, f.drifted) /
-                          std::max(glm::length(f.measured) * glm::length(f.drifted), 1e-9);
-    const double angle = glm::degrees(std::acos(std::clamp(cosine, -1.0, 1.0)));
+    const double angle = degrees_apart(f.measured, f.drifted);
     std::printf(
         "float released at x %.1f, z %.1f: drifted (%.2f, %.2f) px, ripples (%.2f, %.2f) "
         "px, %.1f deg apart\n",
@@ -276,9 +278,7 @@ TEST_F(RippleMotionTest, RipplesFollowTheFlowAroundAnIsland) {
   std::vector<double> angles, ratios, turning;
   size_t left = 0, right = 0;
   for (const Motion& m : all) {
-    const double cosine = glm::dot(m.measured, m.expected) /
-                          std::max(glm::length(m.measured) * glm::length(m.expected), 1e-9);
-    const double angle = glm::degrees(std::acos(std::clamp(cosine, -1.0, 1.0)));
+    const double angle = degrees_apart(m.measured, m.expected);
     angles.push_back(angle);
     ratios.push_back(glm::length(m.measured) / glm::length(m.expected));
     const bool beside = m.at.y > -2.0f && m.at.y < 8.0f;
