@@ -193,7 +193,7 @@ double cotangent(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) 
 
 }  // namespace
 
-Status island_stream_values(const RiverSurface& surface, double discharge,
+Status island_stream_values(const RiverSurface& surface, const std::vector<double>& border_psi,
                             std::vector<double>* out) {
   const size_t island_count = surface.islands().size();
   std::vector<double> values(island_count, 0.0);
@@ -202,6 +202,15 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
   const auto bank = surface.node_bank();
   std::vector<int32_t> unknown(surface.node_count(), kFixed);
   std::vector<double> fixed_value(surface.node_count(), 0.0);
+  // A first guess for an island's psi: halfway between the banks.
+  const double middle = 0.5 * (border_psi[kLeftBankBorder] + border_psi[kRightBankBorder]);
+  auto known_psi = [&](BorderId b) { return surface.is_island_border(b) ? middle : border_psi[b]; };
+  // psi of uniform flow across a node's arm: linear between the borders either side.
+  auto uniform = [&](uint32_t n) {
+    const RiverVertex v = surface.node(n);
+    const double right = known_psi(v.right_border);
+    return right + (known_psi(v.left_border) - right) * v.d_right / (v.d_left + v.d_right);
+  };
 
   for (const Cluster& cluster : clusters_of(surface)) {
     // Unknowns: the islands first, then every other node strictly inside the cluster that is
@@ -210,13 +219,9 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
     std::vector<double> x(cluster.islands.size(), 0.0);
     for (uint32_t k = cluster.first_section; k <= cluster.last_section; ++k) {
       const auto chain = surface.section_nodes(k);
-      const double width = surface.sections()[k].width;
       const bool closing = k == cluster.first_section || k == cluster.last_section;
-      double water = 0.0;  // arc over water from the left bank (no island on a closing section)
       for (size_t i = 0; i < chain.size(); ++i) {
         const uint32_t n = chain[i];
-        if (i > 0 && closing)
-          water += glm::distance(glm::dvec3(pos[chain[i - 1]]), glm::dvec3(pos[n]));
         nodes.push_back(n);
         if (surface.on_island(n)) {
           const auto it = std::find(cluster.islands.begin(), cluster.islands.end(),
@@ -228,14 +233,15 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
                 surface.vertex_of_node(n), surface.island_of(n)));
           }
           unknown[n] = static_cast<int32_t>(it - cluster.islands.begin());
-        } else if (closing || bank[n] != Bank::kNone) {
-          fixed_value[n] = closing ? discharge * (1.0 - water / width)
-                                   : (bank[n] == Bank::kLeft ? discharge : 0.0);
+        } else if (bank[n] != Bank::kNone) {
+          fixed_value[n] = border_psi[bank[n] == Bank::kLeft ? kLeftBankBorder : kRightBankBorder];
+        } else if (surface.on_tongue(n)) {
+          fixed_value[n] = border_psi[surface.node_left_border(n)];
+        } else if (closing) {
+          fixed_value[n] = uniform(n);
         } else {
           unknown[n] = static_cast<int32_t>(x.size());
-          // First guess: uniform flow between the banks' own borders.
-          const RiverVertex v = surface.node(n);
-          x.push_back(discharge * v.d_right / (v.d_left + v.d_right));
+          x.push_back(uniform(n));
         }
       }
     }
@@ -295,7 +301,7 @@ Status island_stream_values(const RiverSurface& surface, double discharge,
       }
       system.start[r + 1] = static_cast<uint32_t>(system.column.size());
     }
-    for (size_t i = 0; i < cluster.islands.size(); ++i) x[i] = 0.5 * discharge;  // first guess
+    for (size_t i = 0; i < cluster.islands.size(); ++i) x[i] = middle;  // first guess
     const bool converged = solve(system, &x);
     for (const uint32_t n : nodes) {
       unknown[n] = kFixed;

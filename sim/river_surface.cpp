@@ -14,6 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "siviflow/sim/river_tuning.h"
+#include "river_welded.h"
 #include "strip_layering.h"
 #include "siviflow/text_format.h"
 
@@ -86,7 +87,8 @@ size_t RiverSurface::memory_bytes() const {
          bytes(node_section_) + bytes(node_bank_) + bytes(node_d_left_) + bytes(node_d_right_) +
          bytes(triangles_) + bytes(node_tri_start_) + bytes(node_tri_list_) + bytes(sections_) +
          bytes(section_nodes_) + bytes(node_left_border_) + bytes(node_right_border_) +
-         bytes(islands_) + bytes(island_nodes_);
+         bytes(islands_) + bytes(island_nodes_) + bytes(ends_) + bytes(end_nodes_) +
+         bytes(banks_) + bytes(bank_nodes_);
 }
 
 Status RiverSurface::share_mesh(std::span<const glm::vec3> positions,
@@ -215,9 +217,30 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
           index_at(i), vertex_count));
     }
   }
-  if (options.upstream_vertex >= vertex_count) {
+  // The upstream end: the named inflow of a strip's two named ends, else upstream_vertex (which
+  // a network with named ends does not read).
+  uint32_t upstream_vertex = options.upstream_vertex;
+  if (options.ends.size() == 1) {
+    return Status::error("ends: a single end is named, where a river has at least two");
+  }
+  for (size_t m = 0; m < options.ends.size(); ++m) {
+    if (options.ends[m].vertex >= vertex_count) {
+      return Status::error(text_format("ends[%zu]: vertex %u is not in the river mesh (%zu vertices)",
+                                       m, options.ends[m].vertex, vertex_count));
+    }
+  }
+  if (options.ends.size() == 2) {
+    if (options.ends[0].inflow == options.ends[1].inflow) {
+      return Status::error(text_format(
+          "ends: both named ends are %s, where a strip has one inflow and one outflow",
+          options.ends[0].inflow ? "inflows" : "outflows"));
+    }
+    upstream_vertex = options.ends[options.ends[0].inflow ? 0 : 1].vertex;
+  }
+  const bool read_upstream = options.ends.size() <= 2;
+  if (read_upstream && upstream_vertex >= vertex_count) {
     return Status::error(text_format("the upstream vertex %u is not in the river mesh (%zu vertices)",
-                                     options.upstream_vertex, vertex_count));
+                                     upstream_vertex, vertex_count));
   }
 
   // --- Weld vertices at exactly the same position (open addressing on the position bits).
@@ -381,16 +404,21 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   if (std::find(on_border.begin(), on_border.end(), 1) == on_border.end()) {
     return Status::error("the river mesh is closed (it has no border): a river is an open strip");
   }
-  const uint32_t upstream_node = node_of_vertex[options.upstream_vertex];
-  if (!on_border[upstream_node]) {
+  const uint32_t upstream_node = read_upstream ? node_of_vertex[upstream_vertex] : kNoNode;
+  if (read_upstream && !on_border[upstream_node]) {
     return Status::error(text_format(
         "river vertex %u marks the upstream end but is not on the border of the mesh: the "
         "upstream end is the end section holding it (a corner, in the paper's meshes)",
-        options.upstream_vertex));
+        upstream_vertex));
   }
   std::vector<uint32_t> loop;
   std::vector<std::vector<uint32_t>> island_loops;
   {
+    // With named ends: the outer border is the one that holds the first.
+    const uint32_t first_end_node = read_upstream ? kNoNode : node_of_vertex[options.ends[0].vertex];
+    auto is_outer_loop = [&](const std::vector<uint32_t>& walked) {
+      return std::find(walked.begin(), walked.end(), first_end_node) != walked.end();
+    };
     std::vector<uint8_t> seen(node_count, 0);
     for (uint32_t s = 0; s < node_count; ++s) {
       if (!on_border[s] || seen[s]) continue;
@@ -408,11 +436,17 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
         prev = cur;
         cur = next;
       } while (cur != s && cur != kNoNode && !seen[cur]);
-      if (std::find(walked.begin(), walked.end(), upstream_node) != walked.end()) {
+      if (read_upstream ? std::find(walked.begin(), walked.end(), upstream_node) != walked.end()
+                        : is_outer_loop(walked)) {
         loop = std::move(walked);
       } else {
         island_loops.push_back(std::move(walked));
       }
+    }
+    if (loop.empty()) {
+      return Status::error(text_format(
+          "ends[0]: vertex %u is not on the border of the river mesh, so not on an end",
+          options.ends[0].vertex));
     }
     if (island_loops.size() > kMaxRiverIslands) {
       return Status::error(text_format(
@@ -442,9 +476,13 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     }
   }
 
+  const std::vector<double> angles = angle_sums(pos, tris, on_border);
+  Welded welded{pos,         tris,         node_tris, adj,  node_vertex, node_of_vertex,
+                island_loops, node_island, loop,      angles, vertex_count};
+  if (options.ends.size() > 2) return build_network(welded, options, out);
+
   // --- Corners: the four sharpest border vertices (about 90 degrees; banks and ends are about
   // 180). Ties go to the lower node, so the choice is deterministic.
-  const std::vector<double> angles = angle_sums(pos, tris, on_border);
   std::vector<uint32_t> corner_at(loop.size());  // positions in the loop
   std::iota(corner_at.begin(), corner_at.end(), 0u);
   std::partial_sort(corner_at.begin(), corner_at.begin() + 4, corner_at.end(),
@@ -497,11 +535,22 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     if (first_error.ok()) first_error = std::move(status);
   }
   if (!found) {
+    // More corners than a strip's four, and no ends named: a network whose ends are found.
+    const size_t sharp = static_cast<size_t>(std::count_if(loop.begin(), loop.end(), [&](uint32_t n) {
+      return angles[n] < kNetworkCornerMaxAngle;
+    }));
     std::string corners;
     for (const uint32_t c : corner_at) {
       corners += (corners.empty() ? "" : ", ") + vertex_name(view_for_names, loop[c]);
     }
-    return Status::error(first_error.message() + " (corners taken at vertices " + corners + ")");
+    const std::string as_strip = first_error.message() + " (corners taken at vertices " + corners + ")";
+    if (options.ends.empty() && sharp >= 6) {
+      const Status network = build_network(welded, options, out);
+      if (network.ok()) return network;
+      return Status::error(as_strip + "; nor is it a network of " + std::to_string(sharp / 2) +
+                           " ends: " + network.message());
+    }
+    return Status::error(as_strip);
   }
   const size_t section_count = layering.chain_start.size() - 1;
 
@@ -625,6 +674,31 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     const DVec3 a = to_d(pos[tri[0]]);
     const DVec3 normal = glm::cross(to_d(pos[tri[1]]) - a, to_d(pos[tri[2]]) - a);
     if (glm::dot(normal, up) < 0.0) std::swap(tri[1], tri[2]);
+  }
+
+  // --- The two ends; a named outflow must lie on the downstream one.
+  for (const size_t k : {size_t{0}, section_count - 1}) {
+    const RiverSection& sec = s.sections_[k];
+    RiverEnd end;
+    end.first_node = static_cast<uint32_t>(s.end_nodes_.size());
+    end.node_count = sec.node_count;
+    end.inflow = k == 0;
+    end.section = static_cast<uint32_t>(k);
+    end.width = sec.width;
+    for (size_t m = 0; m < options.ends.size(); ++m) {
+      if (options.ends[m].inflow == end.inflow) end.mark = static_cast<uint32_t>(m);
+    }
+    s.end_nodes_.insert(s.end_nodes_.end(), s.section_nodes_.begin() + sec.first_node,
+                        s.section_nodes_.begin() + sec.first_node + sec.node_count);
+    s.ends_.push_back(end);
+  }
+  for (size_t m = 0; m < options.ends.size(); ++m) {
+    if (!options.ends[m].inflow && s.node_section_[node_of_vertex[options.ends[m].vertex]] != section_count - 1) {
+      return Status::error(text_format(
+          "ends[%zu]: vertex %u is not on the downstream end of the river (the end across from "
+          "the inflow at vertex %u)",
+          m, options.ends[m].vertex, upstream_vertex));
+    }
   }
 
   if (node_count != vertex_count) {  // else both maps are the identity: not worth 8 bytes a vertex

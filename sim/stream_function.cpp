@@ -8,6 +8,7 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "end_discharges.h"
 #include "island_circulation.h"
 #include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
@@ -87,19 +88,30 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
     }
   }
 
-  SIVIFLOW_TRY(island_stream_values(s, params.discharge, &f.island_psi_));
-  for (size_t i = 0; i < s.islands().size(); ++i) {
-    const auto shore = s.island_nodes(i);
-    for (size_t j = 0; j < shore.size(); ++j) {
+  // psi on the borders: the banks from the ends' discharges, the islands from their circulation.
+  SIVIFLOW_TRY(end_discharges(s, params.discharge, params.end_discharges, &f.end_discharge_));
+  SIVIFLOW_TRY(bank_stream_values(s, f.end_discharge_, &f.border_psi_));
+  std::vector<double> island_psi;
+  SIVIFLOW_TRY(island_stream_values(s, f.border_psi_, &island_psi));
+  for (size_t i = 0; i < island_psi.size(); ++i) f.border_psi_[island_border(i)] = island_psi[i];
+  // A shore's tangent from its neighbours along it; a network bank's ends (its corners) take
+  // the one neighbour they have along the bank.
+  auto add_tangents = [&](std::span<const uint32_t> border, bool closed) {
+    const size_t size = border.size();
+    for (size_t j = 0; j < size; ++j) {
+      const uint32_t prev = closed ? border[(j + size - 1) % size] : border[j == 0 ? 0 : j - 1];
+      const uint32_t next = closed ? border[(j + 1) % size] : border[std::min(j + 1, size - 1)];
       // In double, as bank_tangent: a float difference of far coordinates may overflow.
-      const DVec3 d = DVec3(pos_of(s, shore[(j + 1) % shore.size()])) -
-                      DVec3(pos_of(s, shore[(j + shore.size() - 1) % shore.size()]));
+      const DVec3 d = DVec3(pos_of(s, next)) - DVec3(pos_of(s, prev));
       const double length = glm::length(d);
-      f.island_tangent_.push_back(
-          {shore[j], length > 0.0 && std::isfinite(length) ? glm::vec3(d / length) : glm::vec3(0.0f)});
+      f.shore_tangent_.push_back(
+          {border[j], length > 0.0 && std::isfinite(length) ? glm::vec3(d / length) : glm::vec3(0.0f)});
     }
-  }
-  std::sort(f.island_tangent_.begin(), f.island_tangent_.end(),
+  };
+  for (size_t i = 0; i < s.islands().size(); ++i) add_tangents(s.island_nodes(i), true);
+  for (size_t b = 0; b < s.banks().size(); ++b) add_tangents(s.bank_nodes(b), false);
+  f.find_tips();
+  std::sort(f.shore_tangent_.begin(), f.shore_tangent_.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
 
   // No obstacles yet: the field is the obstacle-free one.
@@ -157,35 +169,97 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
       }
     }
   }
-  if (dl < s) nearest = std::min(nearest, dl);
-  if (dr < s) nearest = std::min(nearest, dr);
-  if (dl <= 0.0) return psi_left;
-  if (dr <= 0.0) return psi_right;
-  if (on_obstacle != nullptr) return *on_obstacle;
-
-  // Pass 2: w_i scaled by nearest^p, which is the product form of algorithms.md §1.1 divided by
-  // a common factor: finite and exact on a boundary, no overflow however many boundaries.
+  const double nearest_obstacle = nearest;
   const double p = params_.p;
-  double num = 0.0, den = 0.0;
-  auto add = [&](double d, double value) {
-    const double w = blend(1.0 - d / s) * ratio_pow(nearest / d, p);
-    num += w * value;
-    den += w;
-  };
-  if (dl < s) add(dl, psi_left);
-  if (dr < s) add(dr, psi_right);
-  if (reached <= kKept) {
-    for (size_t i = 0; i < reached; ++i) add(kept_d[i], kept_psi[i]);
-  } else {
-    const glm::dvec2 pn = xz(surface_.node_positions()[n]);
-    for (const uint32_t j : active_) {
-      const ObstacleState& st = state_[j];
-      if (st.merged != Bank::kNone || !influences(st, j, n)) continue;
-      add(footprint_distance(obstacles_[j], xz(st.centre), pn), st.psi);
+  // Pass 2, between the borders either side and the obstacles: w_i
+  // scaled by nearest^p, which is the product form of algorithms.md §1.1 divided by a common
+  // factor: finite and exact on a boundary, no overflow however many boundaries.
+  auto interpolate = [&](double to_left, double left_psi, double to_right, double right_psi) {
+    double closest = nearest_obstacle;
+    if (to_left < s) closest = std::min(closest, to_left);
+    if (to_right < s) closest = std::min(closest, to_right);
+    if (to_left <= 0.0) return left_psi;
+    if (to_right <= 0.0) return right_psi;
+    if (on_obstacle != nullptr) return *on_obstacle;
+    double num = 0.0, den = 0.0;
+    auto add = [&](double d, double value) {
+      const double w = blend(1.0 - d / s) * ratio_pow(closest / d, p);
+      num += w * value;
+      den += w;
+    };
+    if (to_left < s) add(to_left, left_psi);
+    if (to_right < s) add(to_right, right_psi);
+    if (reached <= kKept) {
+      for (size_t i = 0; i < reached; ++i) add(kept_d[i], kept_psi[i]);
+    } else {
+      const glm::dvec2 pn = xz(surface_.node_positions()[n]);
+      for (const uint32_t j : active_) {
+        const ObstacleState& st = state_[j];
+        if (st.merged != Bank::kNone || !influences(st, j, n)) continue;
+        add(footprint_distance(obstacles_[j], xz(st.centre), pn), st.psi);
+      }
     }
+    if (den > 0.0) return num / den;
+    return use_obstacles ? node_psi_free(n) : 0.0;  // every weight underflowed
+  };
+  const double psi = interpolate(dl, psi_left, dr, psi_right);
+
+  // Beyond a tongue's tip the streamline parting its arms leaves from the tip: the field as if
+  // the tongue went on (a divider where the tip is across the river, at the tongue's psi),
+  // giving way to the plain one with the distance from the tip (river_tuning.h).
+  for (const Tip& tip : tips_) {
+    if (tip.left != left || tip.right != right) continue;
+    const double x = std::abs(double{surface_.sections()[surface_.node_section()[n]].along} - tip.along);
+    const double width = double{surface_.node_d_left()[n]} + surface_.node_d_right()[n];
+    const double g = std::exp(-kTipRelaxationRoot * std::sqrt(x / width) - kTipRelaxationLinear * x / width) *
+                     blend(1.0 - x / (kTipReachWidths * width));
+    if (g <= 0.0) continue;
+    const double arc = surface_.node_d_left()[n], divider = tip.fraction * width;
+    const double parted = arc < divider ? interpolate(dl, psi_left, divider - arc, tip.psi)
+                                        : interpolate(arc - divider, tip.psi, dr, psi_right);
+    return psi + g * (parted - psi);
   }
-  if (den > 0.0) return num / den;
-  return use_obstacles ? node_psi_free(n) : 0.0;  // every weight underflowed
+  return psi;
+}
+
+void StreamFunction::find_tips() {
+  const RiverSurface& s = surface_;
+  if (!s.network()) return;
+  // The tip lies nearest the root end: the last section of a confluence, the first of a fork.
+  const bool confluence = !s.ends()[0].inflow;
+  const auto section = s.node_section();
+  for (size_t b = 0; b < s.banks().size(); ++b) {
+    const BorderId tongue = s.banks()[b].border;
+    if (tongue < island_border(s.islands().size())) continue;  // a bank of the root end
+    const auto path = s.bank_nodes(b);
+    uint32_t tip = path[0];
+    for (const uint32_t n : path) {
+      if (confluence ? section[n] > section[tip] : section[n] < section[tip]) tip = n;
+    }
+    // The arms either side: the water next to the tip, its outer borders and widths.
+    Tip t;
+    t.along = s.sections()[section[tip]].along;
+    t.psi = border_psi_[tongue];
+    double left_width = 0.0, right_width = 0.0;
+    for (const uint32_t tri : s.node_triangles(tip)) {
+      for (int i = 0; i < 3; ++i) {
+        const uint32_t m = s.triangles()[3 * size_t{tri} + i];
+        if (section[m] != section[tip]) continue;
+        const double width = double{s.node_d_left()[m]} + s.node_d_right()[m];
+        if (s.node_right_border(m) == tongue && s.node_left_border(m) != tongue) {
+          t.left = s.node_left_border(m);
+          left_width = width;
+        }
+        if (s.node_left_border(m) == tongue && s.node_right_border(m) != tongue) {
+          t.right = s.node_right_border(m);
+          right_width = width;
+        }
+      }
+    }
+    const bool left = left_width > 0.0, right = right_width > 0.0;
+    t.fraction = left && right ? left_width / (left_width + right_width) : 0.5;
+    if (left && right) tips_.push_back(t);
+  }
 }
 
 double StreamFunction::node_psi_free(uint32_t n) const {
@@ -221,17 +295,11 @@ StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t) const {
 
 glm::vec3 StreamFunction::triangle_velocity(uint32_t t) const { return triangle_flow(t).velocity; }
 
-double StreamFunction::border_psi(BorderId border) const {
-  if (border == kLeftBankBorder) return params_.discharge;
-  if (border == kRightBankBorder) return 0.0;
-  return island_psi_[border - island_border(0)];
-}
-
 glm::vec3 StreamFunction::bank_tangent(uint32_t n) const {
-  if (surface_.on_island(n)) {
-    const auto it = std::lower_bound(island_tangent_.begin(), island_tangent_.end(), n,
+  if (surface_.on_island(n) || surface_.network()) {
+    const auto it = std::lower_bound(shore_tangent_.begin(), shore_tangent_.end(), n,
                                      [](const auto& entry, uint32_t node) { return entry.first < node; });
-    return it != island_tangent_.end() && it->first == n ? it->second : glm::vec3(0.0f);
+    return it != shore_tangent_.end() && it->first == n ? it->second : glm::vec3(0.0f);
   }
   const Bank bank = surface_.node_bank()[n];
   if (bank == Bank::kNone) return glm::vec3(0.0f);
@@ -268,7 +336,7 @@ void StreamFunction::update_node_velocity(uint32_t n) {
 size_t StreamFunction::memory_bytes() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return surface_.memory_bytes() + bytes(psi_) + bytes(wet_) + bytes(node_velocity_) +
-         bytes(island_psi_) + bytes(island_tangent_) +
+         bytes(tips_) + bytes(border_psi_) + bytes(end_discharge_) + bytes(shore_tangent_) +
          bytes(obstacles_) + bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
          triangle_grid_.memory_bytes() + bytes(node_stamp_) + bytes(triangle_stamp_) +
          bytes(scratch_nodes_) + bytes(scratch_triangles_);
@@ -391,7 +459,7 @@ StreamFunction::ObstacleState StreamFunction::place(size_t obstacle, const glm::
   // dams the river; it stays a boundary of its own (the flow there is moot, but finite).
   if (crosses_left != crosses_right) {
     st.merged = crosses_left ? Bank::kLeft : Bank::kRight;
-    st.psi = crosses_left ? double{params_.discharge} : 0.0;
+    st.psi = border_psi(crosses_left ? kLeftBankBorder : kRightBankBorder);
   }
   return st;
 }

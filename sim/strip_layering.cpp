@@ -12,27 +12,6 @@
 namespace siviflow {
 namespace {
 
-// Hop distance of every node from `sources` (the mesh is connected: every node is reached).
-std::vector<uint32_t> hops_from(const Csr& adj, const std::vector<uint32_t>& sources) {
-  std::vector<uint32_t> hops(adj.start.size() - 1, kNoNode);
-  std::vector<uint32_t> queue;
-  queue.reserve(hops.size());
-  for (const uint32_t n : sources) {
-    hops[n] = 0;
-    queue.push_back(n);
-  }
-  for (size_t head = 0; head < queue.size(); ++head) {
-    const uint32_t n = queue[head];
-    for (const uint32_t m : adj.of(n)) {
-      if (hops[m] == kNoNode) {
-        hops[m] = hops[n] + 1;
-        queue.push_back(m);
-      }
-    }
-  }
-  return hops;
-}
-
 // The island border edges that run across the flow (more across it than along it), as each
 // island node's (at most two) neighbours over such an edge. The flow's direction near a node
 // is that of the bank midpoints about the section its hop count from the upstream end names
@@ -64,35 +43,6 @@ std::vector<std::array<uint32_t, 2>> across_island_edges(const MeshView& mesh,
   return across;
 }
 
-// Hops from `sources` where the island edges across the flow cost nothing (0-1 breadth first).
-std::vector<uint32_t> layers_around_islands(const MeshView& mesh,
-                                            const std::vector<uint32_t>& sources,
-                                            const std::vector<std::array<uint32_t, 2>>& across) {
-  const Csr& adj = *mesh.adjacency;
-  std::vector<uint32_t> layer(adj.start.size() - 1, kNoNode);
-  std::deque<uint32_t> queue;
-  for (const uint32_t n : sources) {
-    layer[n] = 0;
-    queue.push_back(n);
-  }
-  while (!queue.empty()) {
-    const uint32_t n = queue.front();
-    queue.pop_front();
-    for (const uint32_t m : adj.of(n)) {
-      const bool free = across[n][0] == m || across[n][1] == m;
-      const uint32_t d = layer[n] + (free ? 0 : 1);
-      if (d >= layer[m]) continue;
-      layer[m] = d;
-      if (free) {
-        queue.push_front(m);
-      } else {
-        queue.push_back(m);
-      }
-    }
-  }
-  return layer;
-}
-
 // Island nodes by (island, layer): where a section that meets an island goes on.
 struct IslandRows {
   std::vector<std::tuple<uint32_t, uint32_t, uint32_t>> sorted;  // island, layer, node
@@ -113,6 +63,52 @@ struct IslandRows {
 };
 
 }  // namespace
+
+std::vector<uint32_t> hops_from(const Csr& adj, const std::vector<uint32_t>& sources) {
+  std::vector<uint32_t> hops(adj.start.size() - 1, kNoNode);
+  std::vector<uint32_t> queue;
+  queue.reserve(hops.size());
+  for (const uint32_t n : sources) {
+    hops[n] = 0;
+    queue.push_back(n);
+  }
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const uint32_t n = queue[head];
+    for (const uint32_t m : adj.of(n)) {
+      if (hops[m] == kNoNode) {
+        hops[m] = hops[n] + 1;
+        queue.push_back(m);
+      }
+    }
+  }
+  return hops;
+}
+
+std::vector<uint32_t> layers_with_free_edges(const Csr& adj, const std::vector<uint32_t>& sources,
+                                             const std::vector<std::array<uint32_t, 2>>& free_edges) {
+  std::vector<uint32_t> layer(adj.start.size() - 1, kNoNode);
+  std::deque<uint32_t> queue;
+  for (const uint32_t n : sources) {
+    layer[n] = 0;
+    queue.push_back(n);
+  }
+  while (!queue.empty()) {
+    const uint32_t n = queue.front();
+    queue.pop_front();
+    for (const uint32_t m : adj.of(n)) {
+      const bool free = free_edges[n][0] == m || free_edges[n][1] == m;
+      const uint32_t d = layer[n] + (free ? 0 : 1);
+      if (d >= layer[m]) continue;
+      layer[m] = d;
+      if (free) {
+        queue.push_front(m);
+      } else {
+        queue.push_back(m);
+      }
+    }
+  }
+  return layer;
+}
 
 std::string vertex_name(const MeshView& mesh, uint32_t node) {
   return std::to_string((*mesh.node_vertex)[node]);
@@ -137,7 +133,7 @@ Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
 
   std::vector<uint32_t> layer = hops_from(adj, end_a);
   if (has_islands) {
-    layer = layers_around_islands(mesh, end_a, across_island_edges(mesh, layer, bank_1, bank_2));
+    layer = layers_with_free_edges(adj, end_a, across_island_edges(mesh, layer, bank_1, bank_2));
   }
   uint32_t max_layer = 0;
   for (const uint32_t l : layer) max_layer = std::max(max_layer, l);  // connected: all set

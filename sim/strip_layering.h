@@ -4,6 +4,7 @@
 // island's shore edges across the flow join nodes of one row.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <glm/vec3.hpp>
 #include <span>
@@ -49,6 +50,14 @@ struct MeshView {
 };
 
 std::string vertex_name(const MeshView& mesh, uint32_t node);
+
+// Hop distance of every node from `sources` (the mesh is connected: every node is reached).
+std::vector<uint32_t> hops_from(const Csr& adj, const std::vector<uint32_t>& sources);
+
+// Hops from `sources` where the edges in `free_edges` (each node's at most two) cost nothing:
+// a 0-1 breadth-first pass, so a shore's edges across the flow join nodes of one section.
+std::vector<uint32_t> layers_with_free_edges(const Csr& adj, const std::vector<uint32_t>& sources,
+                                             const std::vector<std::array<uint32_t, 2>>& free_edges);
 
 // Splits the mesh into sections by hop distance from the upstream end `end_a` (a border path),
 // then checks that the result is a strip: every triangle joins two neighbouring sections, every

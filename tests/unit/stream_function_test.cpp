@@ -160,7 +160,7 @@ TEST(StreamFunction, TooSmallSearchRadiusNamesSectionAndVertex) {
 
 TEST(StreamFunction, BadParameters) {
   const TestMesh m = test::straight_channel(10.0f, 10.0f, 3, 5);
-  for (const FlowParams params : {FlowParams{NAN, 1.5f, 0.0f}, FlowParams{1.0f, 0.0f, 0.0f},
+  for (const FlowParams& params : {FlowParams{NAN, 1.5f, 0.0f}, FlowParams{1.0f, 0.0f, 0.0f},
                                   FlowParams{1.0f, -1.0f, 0.0f}, FlowParams{1.0f, 1.5f, -3.0f},
                                   FlowParams{1.0f, 1.5f, INFINITY}}) {
     RiverSurface surface;

@@ -28,9 +28,20 @@ namespace siviflow {
 // Which margin a vertex lies on. The values are those of the `bank` column of `siviflow flow`.
 enum class Bank : int8_t { kLeft = -1, kNone = 0, kRight = 1 };
 
+// One end of the river named by the caller: a vertex on it, and which way the water crosses it.
+struct RiverEndMark {
+  uint32_t vertex = 0;
+  bool inflow = true;
+};
+
 struct RiverSurfaceOptions {
   // An input vertex on the upstream end section (a corner, in the paper's meshes).
   uint32_t upstream_vertex = 0;
+  // Every end of the river, each named once by one of its vertices, in any order. Empty: the end
+  // holding upstream_vertex is the only inflow and every other end an outflow (a fork, or a
+  // strip). Given, upstream_vertex is not read. A network takes a single inflow or a single
+  // outflow.
+  std::vector<RiverEndMark> ends;
 };
 
 // One cross-section of the river, from the left shore to the right shore.
@@ -43,9 +54,10 @@ struct RiverSection {
   glm::vec3 flow_direction{0.0f};  // unit, horizontal, downstream (paper §2.1)
 };
 
-// The borders of the water: the two banks and the islands' shores. Every vertex lies between a
-// border on its left and one on its right along its section (the two banks, where no island
-// parts the river).
+// The borders of the water: the two banks beside the upstream end (a network's root end), the
+// islands' shores, then a network's other banks (the tongues between its arms). Every vertex
+// lies between a border on its left and one on its right along its section (the two banks,
+// where no island parts the river).
 using BorderId = uint16_t;
 inline constexpr BorderId kLeftBankBorder = 0;
 inline constexpr BorderId kRightBankBorder = 1;
@@ -55,6 +67,28 @@ inline constexpr BorderId island_border(size_t island) { return static_cast<Bord
 struct RiverIsland {
   uint32_t first_node = 0;  // offset into RiverSurface::island_nodes()
   uint32_t node_count = 0;  // the shore's nodes in border order
+};
+
+inline constexpr uint32_t kNoEndMark = 0xffffffffu;
+
+// An open end of the river, where water enters or leaves: one section's water between the two
+// borders at its corners.
+struct RiverEnd {
+  uint32_t first_node = 0;  // offset into RiverSurface::end_nodes(), left to right downstream
+  uint32_t node_count = 0;
+  bool inflow = true;
+  uint32_t section = 0;
+  BorderId left_border = kLeftBankBorder;  // looking downstream
+  BorderId right_border = kRightBankBorder;
+  float width = 0.0f;
+  uint32_t mark = kNoEndMark;  // the index in RiverSurfaceOptions::ends that named it
+};
+
+// A bank of a river network: a border between two ends, its nodes in border order.
+struct RiverBank {
+  BorderId border = kLeftBankBorder;
+  uint32_t first_node = 0;  // offset into RiverSurface::bank_nodes()
+  uint32_t node_count = 0;
 };
 
 // What Algorithm 1 stores per vertex.
@@ -108,9 +142,18 @@ class RiverSurface {
   }
   // Whether node n lies on an island's shore, and which.
   bool on_island(uint32_t n) const {
-    return !node_left_border_.empty() && node_left_border_[n] >= island_border(0) &&
+    return !node_left_border_.empty() && is_island_border(node_left_border_[n]) &&
            node_d_left_[n] == 0.0f && node_d_right_[n] == 0.0f;
   }
+  bool is_island_border(BorderId b) const {
+    return b >= island_border(0) && b < island_border(islands_.size());
+  }
+  // Whether node n lies on a network's bank that is not one of the root end's two (a tongue).
+  bool on_tongue(uint32_t n) const {
+    return !node_left_border_.empty() && node_left_border_[n] >= island_border(islands_.size()) &&
+           node_d_left_[n] == 0.0f && node_d_right_[n] == 0.0f;
+  }
+  size_t border_count() const { return 2 + islands_.size() + (banks_.empty() ? 0 : banks_.size() - 2); }
   size_t island_of(uint32_t n) const { return node_left_border_[n] - island_border(0); }
 
   std::span<const RiverIsland> islands() const { return islands_; }
@@ -135,6 +178,19 @@ class RiverSurface {
   std::span<const uint32_t> node_triangle_start() const { return node_tri_start_; }
   std::span<const uint32_t> node_triangle_list() const { return node_tri_list_; }
 
+  // The ends: the upstream end first, then the rest in border order (a strip's second is its
+  // downstream end). A network has more than two.
+  std::span<const RiverEnd> ends() const { return ends_; }
+  std::span<const uint32_t> end_nodes(size_t e) const {
+    return {end_nodes_.data() + ends_[e].first_node, ends_[e].node_count};
+  }
+  bool network() const { return ends_.size() > 2; }
+  // A network's banks (empty for a strip, whose banks are its sections' shores).
+  std::span<const RiverBank> banks() const { return banks_; }
+  std::span<const uint32_t> bank_nodes(size_t b) const {
+    return {bank_nodes_.data() + banks_[b].first_node, banks_[b].node_count};
+  }
+
   std::span<const RiverSection> sections() const { return sections_; }
   // Nodes of section k, from the left shore to the right shore.
   std::span<const uint32_t> section_nodes(size_t k) const {
@@ -153,6 +209,11 @@ class RiverSurface {
   Status share_mesh(std::span<const glm::vec3> positions, std::span<const uint32_t> triangles);
 
  private:
+  // Everything past the welded mesh's checks for a mesh with more than two ends: its corners,
+  // ends, layers, arms and borders (river_network.cpp).
+  struct Welded;
+  static Status build_network(const Welded& mesh, const RiverSurfaceOptions& options,
+                              RiverSurface* out);
   // With islands: the distances, borders and arms of section `section` (`chain`, left to right);
   // its width, the sum of its arms, in `width`. Fails on an arm narrower than `min_arm`.
   Status measure_arms(std::span<const uint32_t> chain, std::span<const glm::vec3> pos,
@@ -177,6 +238,10 @@ class RiverSurface {
   std::vector<BorderId> node_right_border_;
   std::vector<RiverIsland> islands_;
   std::vector<uint32_t> island_nodes_;
+  std::vector<RiverEnd> ends_;
+  std::vector<uint32_t> end_nodes_;
+  std::vector<RiverBank> banks_;  // only in a network
+  std::vector<uint32_t> bank_nodes_;
   // After share_mesh: where the positions and triangles are read instead of the vectors above.
   std::span<const glm::vec3> shared_positions_;
   std::span<const uint32_t> shared_triangles_;

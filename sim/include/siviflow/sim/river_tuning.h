@@ -14,6 +14,15 @@ inline constexpr float kDefaultShepardPower = 1.5f;
 // close to the pure power law (algorithms.md §6.2 shows how s near W sharpens it).
 inline constexpr float kDefaultSearchRadiusFactor = 3.0f;
 
+// Beyond a tongue's tip (where two arms meet), the streamline parting them relaxes from the tip
+// to where the plain field puts it as exp(-a sqrt(x / W) - b x / W), x the distance from the tip
+// and W the river's width there, and not past kTipReachWidths W: fitted to a fine-grid Laplace
+// solution of a Y (river_network_test). The square root is the tip's corner singularity, the
+// linear term the channel's decay.
+inline constexpr double kTipRelaxationRoot = 1.5;
+inline constexpr double kTipRelaxationLinear = 1.0;
+inline constexpr double kTipReachWidths = 1.5;
+
 // Islands' psi (island_circulation.h): each cluster of islands is solved on the sections within
 // this many widest-section widths of it, to this relative residual, in at most this many steps.
 inline constexpr double kIslandSolveMarginWidths = 0.5;
@@ -44,6 +53,9 @@ inline constexpr double kMinSectionWidthRelative = 1e-6;
 // A section whose shore chord is within this fraction of vertical has no horizontal flow
 // direction (the plane through the shores and the raised midpoint degenerates).
 inline constexpr double kMinHorizontalChordRelative = 1e-6;
+// A river network's corners (where an end meets a bank) are border vertices where the water's
+// angle is below this; along a bank or an end it is about 180 degrees, at a corner about 90.
+inline constexpr double kNetworkCornerMaxAngle = 0.75 * 3.14159265358979323846;
 
 // --- Spatial grids (obstacle queries) ---------------------------------------------------------
 // Grid cells in the XZ plane: about this many river vertices per cell on average, and never

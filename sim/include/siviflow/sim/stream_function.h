@@ -36,6 +36,10 @@ struct FlowParams {
   float discharge = 1.0f;              // Q = psi_left - psi_right, m^2/s (speed Q/W when uniform)
   float p = kDefaultShepardPower;      // Shepard power, in (0, 16]
   float search_radius = 0.0f;          // s in metres; 0: kDefaultSearchRadiusFactor x widest section
+  // Per end of the river (RiverSurface::ends() order), m^2/s in or out: the ends must balance and
+  // bring in `discharge`. Empty: the upstream end carries `discharge` and the ends of the other
+  // kind share it by width (end_discharges.h).
+  std::vector<float> end_discharges;
 };
 
 // What the last update re-solved (a full solve counts everything).
@@ -102,9 +106,12 @@ class StreamFunction {
 
   // --- Per island: psi on its shore. The discharge passing on its left is psi_left_border -
   // island_psi, on its right island_psi - psi_right_border.
-  double island_psi(size_t i) const { return island_psi_[i]; }
-  // Q on the left bank, 0 on the right, island_psi on an island's shore.
-  double border_psi(BorderId border) const;
+  double island_psi(size_t i) const { return border_psi_[island_border(i)]; }
+  // Q on the left bank, 0 on the right, island_psi on an island's shore; a network's other banks
+  // as its ends' discharges set them.
+  double border_psi(BorderId border) const { return border_psi_[border]; }
+  // The discharge through end e (RiverSurface::ends() order), m^2/s.
+  double end_discharge(size_t e) const { return end_discharge_[e]; }
 
   // --- Per obstacle.
   glm::vec3 obstacle_centre(size_t i) const { return state_[i].centre; }
@@ -148,9 +155,22 @@ class StreamFunction {
   std::vector<double> psi_;
   std::vector<uint8_t> wet_;
   std::vector<glm::vec3> node_velocity_;
-  std::vector<double> island_psi_;
-  // Every island shore node's tangent (a shore is a streamline, as a bank is), by node.
-  std::vector<std::pair<uint32_t, glm::vec3>> island_tangent_;
+  // Where two arms of a network meet, the tip of the tongue between them. Beyond it the
+  // streamline parting the arms leaves from the tip (evaluate()), where the water's fraction
+  // `fraction` of the way across from the left lies at the tip's section.
+  struct Tip {
+    double along = 0.0;     // the tip's section's
+    double fraction = 0.5;  // the left arm's share of the width at the tip
+    double psi = 0.0;       // the tongue's
+    BorderId left = 0, right = 0;  // the outer borders of the water beyond the tip
+  };
+  void find_tips();
+  std::vector<Tip> tips_;
+  std::vector<double> border_psi_;  // by BorderId
+  std::vector<double> end_discharge_;
+  // Every island shore node's tangent, and in a network every bank node's (a shore is a
+  // streamline, as a bank is), by node.
+  std::vector<std::pair<uint32_t, glm::vec3>> shore_tangent_;
   std::vector<Obstacle> obstacles_;
   std::vector<ObstacleState> state_;
   std::vector<uint32_t> active_;             // obstacles in the water, ascending
