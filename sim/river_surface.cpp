@@ -550,6 +550,11 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
       return Status::error(as_strip + "; nor is it a network of " + std::to_string(sharp / 2) +
                            " ends: " + network.message());
     }
+    if (sharp >= 6) {
+      return Status::error(text_format(
+          "%s; it has %zu corners, as a network of %zu ends has: name every end, or none",
+          as_strip.c_str(), sharp, sharp / 2));
+    }
     return Status::error(as_strip);
   }
   const size_t section_count = layering.chain_start.size() - 1;

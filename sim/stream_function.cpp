@@ -102,10 +102,15 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
       const uint32_t prev = closed ? border[(j + size - 1) % size] : border[j == 0 ? 0 : j - 1];
       const uint32_t next = closed ? border[(j + 1) % size] : border[std::min(j + 1, size - 1)];
       // In double, as bank_tangent: a float difference of far coordinates may overflow.
+      const DVec3 here(pos_of(s, border[j]));
       const DVec3 d = DVec3(pos_of(s, next)) - DVec3(pos_of(s, prev));
       const double length = glm::length(d);
-      f.shore_tangent_.push_back(
-          {border[j], length > 0.0 && std::isfinite(length) ? glm::vec3(d / length) : glm::vec3(0.0f)});
+      // A tongue's tip, where the border turns back on itself, has no tangent: its velocity is
+      // its triangles' as they are.
+      const bool tip = glm::dot(here - DVec3(pos_of(s, prev)), DVec3(pos_of(s, next)) - here) < 0.0;
+      f.shore_tangent_.push_back({border[j], length > 0.0 && std::isfinite(length) && !tip
+                                                 ? glm::vec3(d / length)
+                                                 : glm::vec3(0.0f)});
     }
   };
   for (size_t i = 0; i < s.islands().size(); ++i) add_tangents(s.island_nodes(i), true);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace siviflow::test {
@@ -87,21 +88,25 @@ class YLaplaceOracle {
     return x > -off ? psi_tongue_ : lerp(0.0, psi_tongue_, (x + off + w) / w);
   }
 
-  // Successive over-relaxation of the five-point Laplacian on the water's nodes.
+  // Successive over-relaxation of the five-point Laplacian on the water's nodes (those off the
+  // ends, listed once: most of the grid's box is land).
   void solve() {
-    const double omega = 1.95;
+    std::vector<std::pair<int, int>> free;
+    for (int k = 1; k + 1 < nz_; ++k) {
+      for (int i = 1; i + 1 < nx_; ++i) {
+        if (inside_[index(i, k)] && !on_end(z_of(k), x_of(i))) free.emplace_back(i, k);
+      }
+    }
+    const double omega = 1.985;  // near the optimum for the grid's longest run of nodes
     for (int sweep = 0; sweep < 100000; ++sweep) {
       double change = 0.0;
-      for (int k = 1; k + 1 < nz_; ++k) {
-        for (int i = 1; i + 1 < nx_; ++i) {
-          if (!inside_[index(i, k)] || on_end(z_of(k), x_of(i))) continue;
-          const double mean = 0.25 * (at(i - 1, k) + at(i + 1, k) + at(i, k - 1) + at(i, k + 1));
-          const double delta = omega * (mean - at(i, k));
-          psi_[index(i, k)] += delta;
-          change = std::max(change, std::abs(delta));
-        }
+      for (const auto& [i, k] : free) {
+        const double mean = 0.25 * (at(i - 1, k) + at(i + 1, k) + at(i, k - 1) + at(i, k + 1));
+        const double delta = omega * (mean - at(i, k));
+        psi_[index(i, k)] += delta;
+        change = std::max(change, std::abs(delta));
       }
-      if (change < 1e-10 * psi_left_) return;
+      if (change < 1e-9 * psi_left_) return;
     }
   }
 

@@ -15,6 +15,7 @@
 namespace siviflow {
 namespace {
 
+using test::triangle_on_edge;
 using test::YMesh;
 
 const test::YShape kShape;  // arms 4 m wide, main 24 m, left arm 16 m, right 10 m, spread 0.25
@@ -144,6 +145,150 @@ TEST(RiverNetwork, TheStreamlineBetweenTheArmsLeavesTheTipAsLaplaceSays) {
                   "oracle's\n", shape.spread, left_q, right_q, worst);
     }
   }
+}
+
+// Every arm of every section carries the difference of psi between its borders: exactly by the
+// triangles' velocities (P1), within 1 % by the vertex velocities away from the tip (where the
+// parting streamline bends), within 3 % beside it; the outflow carries both inflows.
+TEST(RiverNetwork, EveryArmOfEverySectionCarriesItsDischarge) {
+  for (const float p : {1.0f, 1.5f}) {
+    const StreamFunction flow = confluence_flow(p, 0.0f);
+    const RiverSurface& s = flow.surface();
+    const auto pos = s.node_positions();
+    const auto vel = flow.node_velocity();
+    size_t arms = 0;
+    for (size_t k = 0; k < s.sections().size(); ++k) {
+      const auto nodes = s.section_nodes(k);
+      size_t first = 0;
+      for (size_t i = 1; i <= nodes.size(); ++i) {
+        const bool arm_ends = i == nodes.size() || triangle_on_edge(s, nodes[i - 1], nodes[i]) == UINT32_MAX;
+        if (!arm_ends) continue;
+        const double expected = flow.node_psi()[nodes[first]] - flow.node_psi()[nodes[i - 1]];
+        double by_vertices = 0.0;
+        const double by_triangles = test::triangle_flux(flow, k, first, i - 1);
+        for (size_t j = first; j + 1 < i; ++j) {
+          const glm::vec3 &u = pos[nodes[j]], &w = pos[nodes[j + 1]];
+          const glm::dvec3 v = 0.5 * (glm::dvec3(vel[nodes[j]]) + glm::dvec3(vel[nodes[j + 1]]));
+          by_vertices += glm::dot(v, test::segment_normal(u, w)) * glm::distance(glm::dvec3(u), glm::dvec3(w));
+        }
+        const float z = pos[nodes[first]].z;
+        EXPECT_GT(expected, 0.0) << "section " << k;
+        EXPECT_NEAR(by_triangles, expected, 1e-6 * (kLeftQ + kRightQ)) << "section " << k;
+        const bool beside_tip = z > -1.0f && z < 12.0f;
+        EXPECT_NEAR(by_vertices, expected, (beside_tip ? 0.03 : 0.01) * expected)
+            << "p " << p << ", section " << k << " at z = " << z;
+        ++arms;
+        first = i;
+      }
+    }
+    EXPECT_GT(arms, s.sections().size());  // the tributaries' sections have two
+    const RiverEnd& out = s.ends()[0];
+    EXPECT_NEAR(test::vertex_flux(flow, out.section), kLeftQ + kRightQ, 0.01 * (kLeftQ + kRightQ));
+  }
+}
+
+// Without named ends the end holding the upstream vertex is the only inflow: the Y read from its
+// wide end is a fork, its outflows sharing the discharge by width (here equal).
+TEST(RiverNetwork, AForkSharesTheDischargeByTheWidthOfItsOutflows) {
+  const YMesh y = y_mesh();
+  RiverSurfaceOptions options;
+  options.upstream_vertex = y.main_end;
+  RiverSurface s = surface_of(y, options);
+  ASSERT_EQ(s.ends().size(), 3u);
+  EXPECT_TRUE(s.ends()[0].inflow);
+  EXPECT_FALSE(s.ends()[1].inflow);
+  EXPECT_FALSE(s.ends()[2].inflow);
+  EXPECT_EQ(s.ends()[0].section, 0u);
+  FlowParams params;
+  params.discharge = 6.0f;
+  StreamFunction flow;
+  ASSERT_TRUE(StreamFunction::create(std::move(s), params, &flow).ok());
+  EXPECT_NEAR(flow.end_discharge(1), 3.0, 1e-6);
+  EXPECT_NEAR(flow.end_discharge(2), 3.0, 1e-6);
+  EXPECT_NEAR(flow.border_psi(island_border(0)), 3.0, 1e-6);
+  // The water flows away from the wide end: down the main channel towards -Z.
+  for (uint32_t n = 0; n < flow.surface().node_count(); ++n) {
+    if (flow.surface().node_positions()[n].z > 1.0f) {
+      EXPECT_LT(flow.node_velocity()[n].z, 0.0f) << n;
+    }
+  }
+}
+
+// A rock moved about the junction re-solves only near it, and the field then equals a fresh
+// river's with the rock where it now is, bit for bit.
+TEST(RiverNetwork, ARockMovedAboutTheJunctionEqualsAFreshSolve) {
+  StreamFunction moved = confluence_flow(1.5f, 9.0f);
+  Obstacle rock;
+  rock.radius = 0.5f;
+  rock.centre = {2.0f, 0.0f, -6.0f};
+  ASSERT_TRUE(moved.set_obstacles({rock}).ok());
+  for (const glm::vec3 centre : {glm::vec3(-2.0f, 0.0f, -3.0f), glm::vec3(0.5f, 0.0f, 1.5f),
+                                 glm::vec3(-1.0f, 0.0f, 9.0f)}) {
+    ASSERT_TRUE(moved.move_obstacle(0, centre).ok());
+    EXPECT_LT(moved.last_update().nodes_resolved, moved.surface().node_count());
+    StreamFunction fresh = confluence_flow(1.5f, 9.0f);
+    rock.centre = centre;
+    ASSERT_TRUE(fresh.set_obstacles({rock}).ok());
+    size_t differ = 0;
+    for (size_t n = 0; n < moved.node_psi().size(); ++n) {
+      differ += moved.node_psi()[n] != fresh.node_psi()[n] ||
+                moved.node_velocity()[n] != fresh.node_velocity()[n];
+    }
+    EXPECT_EQ(differ, 0u) << "rock at z = " << centre.z;
+  }
+}
+
+void expect_flow_error(const std::vector<float>& discharges, float total,
+                       std::initializer_list<const char*> parts) {
+  const YMesh y = y_mesh();
+  RiverSurface s = surface_of(y, confluence_ends(y));
+  FlowParams params;
+  params.discharge = total;
+  params.end_discharges = by_end(s, discharges);
+  StreamFunction flow;
+  const Status status = StreamFunction::create(std::move(s), params, &flow);
+  ASSERT_FALSE(status.ok());
+  for (const char* part : parts) {
+    EXPECT_NE(status.message().find(part), std::string::npos) << status.message() << " lacks " << part;
+  }
+}
+
+TEST(RiverNetwork, DischargesThatDoNotBalanceAreRefused) {
+  expect_flow_error({2.0f, 1.0f, 2.5f}, 3.0f, {"do not balance", "3 m^2/s flows in", "2.5 m^2/s out"});
+  expect_flow_error({2.0f, -1.0f, 1.0f}, 1.0f, {"-1", "inflow", "0 or more"});
+  expect_flow_error({2.0f, 1.0f, 3.0f}, 4.0f, {"bring in 3", "discharge is 4"});
+}
+
+void expect_surface_error(const RiverSurfaceOptions& options, std::initializer_list<const char*> parts) {
+  const YMesh y = y_mesh();
+  RiverSurface s;
+  const Status status = RiverSurface::build(y.mesh.positions, y.mesh.indices, options, &s);
+  ASSERT_FALSE(status.ok());
+  for (const char* part : parts) {
+    EXPECT_NE(status.message().find(part), std::string::npos) << status.message() << " lacks " << part;
+  }
+}
+
+TEST(RiverNetwork, EndsNamedWronglyAreRefused) {
+  const YMesh y = y_mesh();
+  RiverSurfaceOptions options = confluence_ends(y);
+  options.ends[1].vertex = 5;  // on the tip's row, in mid-river
+  expect_surface_error(options, {"ends[1]", "vertex 5", "not on an end"});
+  options = confluence_ends(y);
+  options.ends.pop_back();
+  options.ends[1].inflow = false;  // two ends named of three
+  expect_surface_error(options, {"not a strip", "6 corners", "name every end"});
+  options.ends[1].inflow = true;
+  expect_surface_error(options, {"both named ends are inflows"});
+  options = confluence_ends(y);
+  options.ends.push_back({y.main_end, false});
+  expect_surface_error(options, {"4 ends are named", "has 3"});
+  options = confluence_ends(y);
+  options.ends[2].inflow = true;
+  expect_surface_error(options, {"3 inflows and 0 outflows"});
+  options = confluence_ends(y);
+  options.ends[2].vertex = 100000;
+  expect_surface_error(options, {"ends[2]", "vertex 100000", "not in the river mesh"});
 }
 
 }  // namespace
