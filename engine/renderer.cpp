@@ -229,7 +229,14 @@ Status Renderer::Impl::create_river() {
       obstacles.push_back(flow_obstacle(info.river->obstacles[i]));
     }
   }
-  const FlowParams params{flow.discharge, flow.shepard_power, flow.search_radius};
+  FlowParams params{flow.discharge, flow.shepard_power, flow.search_radius};
+  params.end_discharges = std::move(input.end_discharges);
+  if (!params.end_discharges.empty()) {  // named ends bring the discharge in
+    params.discharge = 0.0f;
+    for (size_t e = 0; e < params.end_discharges.size(); ++e) {
+      if (input.surface.ends()[e].inflow) params.discharge += params.end_discharges[e];
+    }
+  }
   return SharedRiver::create(table, info.allocation_callbacks, std::move(input), params,
                              std::move(obstacles), &river);
 }

@@ -44,17 +44,42 @@ bool surface_is_mesh(const RiverSurface& surface, std::span<const uint32_t> indi
 
 }  // namespace
 
+std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float discharge) {
+  std::vector<WaterRiverEnd> ends;
+  float inflow_width = 0.0f;
+  for (const RiverMeshEnd& end : mesh.ends) inflow_width += end.inflow ? end.width : 0.0f;
+  for (const RiverMeshEnd& end : mesh.ends) {
+    ends.push_back({end.vertex, end.inflow, end.inflow ? discharge * end.width / inflow_width : discharge});
+  }
+  return ends;
+}
+
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   RiverInput input;
   SIVIFLOW_TRY(procedural_river_mesh(river, &input.mesh, &input.slope));
-  SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, RiverSurfaceOptions{},
-                                   &input.surface));
+  RiverSurfaceOptions options;
+  for (const RiverMeshEnd& end : input.mesh.ends) options.ends.push_back({end.vertex, end.inflow});
+  SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, options, &input.surface));
   if (surface_is_mesh(input.surface, input.mesh.indices)) {
     input.mesh.positions = {};
     input.mesh.indices = {};
   }
   *out = std::move(input);
   return Status::success();
+}
+
+RiverSurfaceOptions river_surface_options(std::span<const WaterRiverEnd> ends) {
+  RiverSurfaceOptions options;
+  for (const WaterRiverEnd& end : ends) options.ends.push_back({end.vertex, end.inflow});
+  return options;
+}
+
+std::vector<float> surface_end_discharges(const RiverSurface& surface,
+                                          std::span<const WaterRiverEnd> ends) {
+  std::vector<float> q;
+  if (ends.empty()) return q;
+  for (const RiverEnd& end : surface.ends()) q.push_back(ends[end.mark].discharge);
+  return q;
 }
 
 Status river_input_from(const WaterRiver& river, RiverInput* out) {
@@ -80,10 +105,18 @@ Status river_input_from(const WaterRiver& river, RiverInput* out) {
                                        v, double(river.slope[v])));
     }
   }
+  for (size_t e = 0; e < river.ends.size(); ++e) {
+    const float q = river.ends[e].discharge;
+    if (!(q >= 0.0f) || !std::isfinite(q)) {
+      return Status::error(text_format("CreateInfo::river->ends[%zu].discharge %g is not a finite "
+                                       "discharge >= 0", e, double(q)));
+    }
+  }
   RiverInput input;
-  const Status built =
-      RiverSurface::build(river.positions, river.indices, RiverSurfaceOptions{}, &input.surface);
+  const Status built = RiverSurface::build(river.positions, river.indices,
+                                           river_surface_options(river.ends), &input.surface);
   if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
+  input.end_discharges = surface_end_discharges(input.surface, river.ends);
   if (!surface_is_mesh(input.surface, river.indices)) {
     input.mesh.positions.assign(river.positions.begin(), river.positions.end());
     input.mesh.indices.assign(river.indices.begin(), river.indices.end());

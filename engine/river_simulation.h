@@ -14,6 +14,8 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "siviflow/sim/river_surface.h"
+#include "siviflow/water_river.h"
 #include "sim/flow_textures.h"
 #include "sim/foam.h"
 #include "sim/particles.h"
@@ -36,11 +38,21 @@ struct RiverInput {
   RiverMesh mesh;
   std::vector<float> slope;
   RiverSurface surface;
+  std::vector<float> end_discharges;  // FlowParams::end_discharges: per surface end, or none
 };
+
+// The surface options that name a river's ends (none: vertex 0's end is the upstream one).
+RiverSurfaceOptions river_surface_options(std::span<const WaterRiverEnd> ends);
+// Their discharges in the order of `surface`'s ends (built with those options), or none.
+std::vector<float> surface_end_discharges(const RiverSurface& surface,
+                                          std::span<const WaterRiverEnd> ends);
 
 // The procedural river's mesh, with the slope of the terrain under each vertex.
 Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh,
                              std::vector<float>* slope);
+// The generated river's ends (a confluence's), the outflow carrying `discharge` and the
+// tributaries sharing it by width; none for a strip.
+std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float discharge);
 // procedural_river_mesh with its surface built.
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
 // A host's river (CreateInfo::river): its arrays checked (sizes, finite, non-negative depth and

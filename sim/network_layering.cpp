@@ -80,19 +80,38 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
   }
 
   // --- Layers: hops from the root end, where the edges of a shore or a tongue that run across
-  // the flow (the layers' gradient) cost nothing, so a row stays one row around an island's
-  // head or a tongue's tip. The banks beside the root end never take such an edge.
+  // the flow cost nothing, so a row stays one row around an island's head or a tongue's tip.
+  // The flow's direction at a hop count is that of the midpoints of the root end's two banks
+  // there (the river's middle; a tongue or an island bends the hop count's own fronts).
   const std::vector<uint32_t>& root = sides.sides[sides.root];
   const std::vector<uint32_t> hops = hops_from(adj, root);
-  const std::vector<glm::dvec2> hop_grad = layer_gradients(mesh, hops);
+  uint32_t max_hops = 0;
+  for (const uint32_t h : hops) max_hops = std::max(max_hops, h);
   const uint32_t root_left_bank = net.side_bank[(sides.root + side_count - 1) % side_count];
   const uint32_t root_right_bank = net.side_bank[(sides.root + 1) % side_count];
+  std::vector<uint32_t> left_at(max_hops + 1, kNoNode), right_at(max_hops + 1, kNoNode);
+  for (const size_t side : {(sides.root + side_count - 1) % side_count, (sides.root + 1) % side_count}) {
+    std::vector<uint32_t>& at = net.side_bank[side] == root_left_bank ? left_at : right_at;
+    for (const uint32_t n : sides.sides[side]) {
+      if (at[hops[n]] == kNoNode) at[hops[n]] = n;
+    }
+  }
+  for (std::vector<uint32_t>* at : {&left_at, &right_at}) {  // a bank that ends holds its last
+    uint32_t last = kNoNode;
+    for (uint32_t& n : *at) last = n = n == kNoNode ? last : n;
+    for (size_t k = at->size(); k-- > 0;) last = (*at)[k] = (*at)[k] == kNoNode ? last : (*at)[k];
+  }
+  auto middle = [&](size_t k) {
+    return 0.5 * (xz(pos[left_at[std::min<size_t>(k, max_hops)]]) +
+                  xz(pos[right_at[std::min<size_t>(k, max_hops)]]));
+  };
   std::vector<std::array<uint32_t, 2>> across(node_count, {kNoNode, kNoNode});
   for (uint32_t a = 0; a < node_count; ++a) {
     for (const uint32_t b : along_border.of[a]) {
       if (b == kNoNode || b < a) continue;
       if (net.border[a] == root_left_bank || net.border[a] == root_right_bank) continue;
-      const glm::dvec2 g = hop_grad[a] + hop_grad[b];
+      const size_t k = hops[a];
+      const glm::dvec2 g = middle(k + 1) - middle(k == 0 ? 0 : k - 1);
       const glm::dvec2 e = xz(pos[b]) - xz(pos[a]);
       if (!(std::abs(e.x * g.y - e.y * g.x) > std::abs(glm::dot(e, g)))) continue;
       for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}}) {

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -24,6 +25,22 @@ ProceduralRiver::ProceduralRiver(const ProceduralRiverParams& params) : params_(
   phase_a_ = static_cast<float>(rng() % 100000u) / 100000.0f * two_pi;
   phase_b_ = static_cast<float>(rng() % 100000u) / 100000.0f * two_pi;
   phase_w_ = static_cast<float>(rng() % 100000u) / 100000.0f * two_pi;
+  if (params.confluence && params.vertices_across >= 2) {
+    const uint32_t j = tongue_vertex(params, 0.5 * width(params.confluence->tip_z));
+    tongue_fraction_ = 1.0 - 2.0 * double(j) / double(params.vertices_across - 1);
+  }
+}
+
+uint32_t ProceduralRiver::tongue_vertex(const ProceduralRiverParams& params, double half_width_at_tip) {
+  const double across = double(params.vertices_across - 1);
+  const double j = std::round(across * (0.5 - 0.5 * double(params.confluence->offset) / half_width_at_tip));
+  return static_cast<uint32_t>(std::clamp(j, 0.0, across));
+}
+
+double ProceduralRiver::tongue_half_width(double z) const {
+  const ProceduralConfluence& c = *params_.confluence;
+  const double above = double(c.tip_z) - z;
+  return above > 0.0 ? above * std::tan(0.5 * double(c.angle_deg) * glm::pi<double>() / 180.0) : 0.0;
 }
 
 double ProceduralRiver::centre_x(double z) const {
@@ -56,12 +73,29 @@ float ProceduralRiver::lateral_distance(float x, float z) const {
 }
 
 float ProceduralRiver::terrain_height(float x, float z) const {
-  const float d = std::abs(lateral_distance(x, z));
+  float lateral = lateral_distance(x, z);
   const float half_width = 0.5f * width_at(z);
+  const float bank_run = 3.0f;
+  // A confluence's tongue: land between the tributaries, the bed rising to it under the water
+  // (and to its tip below it); out of it the tributaries' banks lie further out by its width.
+  float tongue_shelf = -std::numeric_limits<float>::max();
+  if (params_.confluence) {
+    const float middle = half_width * static_cast<float>(tongue_fraction_);
+    const float half = static_cast<float>(tongue_half_width(z));
+    const float from_middle = lateral - middle;
+    const float beyond_tip = std::max(0.0f, z - params_.confluence->tip_z);
+    const float outside = std::hypot(std::abs(from_middle) - half, beyond_tip);
+    if (beyond_tip == 0.0f && std::abs(from_middle) < half) {
+      return params_.bank_height * glm::smoothstep(0.0f, bank_run, half - std::abs(from_middle));
+    }
+    tongue_shelf = -kConfluenceShelfSlope * outside;
+    lateral -= from_middle > 0.0f ? half : -half;
+  }
+  const float d = std::abs(lateral);
   if (d < half_width) {
     // Riverbed: a smooth bowl from -depth at the centre up to the waterline at the bank.
     const float t = d / half_width;
-    const float bed = -params_.depth * (1.0f - t * t);
+    const float bed = std::max(-params_.depth * (1.0f - t * t), tongue_shelf);
     if (params_.islands.empty()) return bed;
     // An island: a dome rising to the banks' height, its shore at the waterline, its shelf
     // sloping under the water into the bed.
@@ -69,7 +103,6 @@ float ProceduralRiver::terrain_height(float x, float z) const {
     return std::max(bed, params_.bank_height * (1.0f - r * r));
   }
   // Bank: rises to bank_height over a few metres, then the valley floor climbs to the walls.
-  const float bank_run = 3.0f;
   const float bank = params_.bank_height * glm::smoothstep(0.0f, 1.0f, (d - half_width) / bank_run);
   const float s = std::max(0.0f, (d - half_width - bank_run) /
                                      (params_.valley_half_width - half_width - bank_run));
@@ -167,6 +200,30 @@ Status ProceduralRiver::validate(const ProceduralRiverParams& p) {
       }
     }
   }
+  if (p.confluence) {
+    const ProceduralConfluence& c = *p.confluence;
+    for (const auto& [name, value] : {std::pair{"tip_z", c.tip_z}, std::pair{"offset", c.offset}}) {
+      if (!std::isfinite(value)) {
+        return Status::error(text_format("procedural river: confluence.%s = %g must be finite", name, value));
+      }
+    }
+    if (!(c.angle_deg > 0.0f && c.angle_deg <= 120.0f)) {
+      return Status::error(text_format(
+          "procedural river: confluence.angle_deg = %g must be in (0, 120]", c.angle_deg));
+    }
+    if (!(std::abs(c.tip_z) < 0.5f * p.length)) {
+      return Status::error(text_format(
+          "procedural river: confluence.tip_z = %g lies outside the river (z in (%g, %g))",
+          c.tip_z, -0.5 * p.length, 0.5 * p.length));
+    }
+    const uint32_t j = tongue_vertex(p, 0.5 * p.width * (1.0 - p.width_variation));
+    if (p.vertices_across < 5 || j < 2 || j + 3 > p.vertices_across) {
+      return Status::error(text_format(
+          "procedural river: confluence.offset = %g leaves a tributary under two cells of the %u "
+          "vertices across: move it towards the centreline or raise vertices_across",
+          c.offset, p.vertices_across));
+    }
+  }
   // Bound the mesh size before allocating: the centreline's slope is at most 1.26 A k.
   const double k = glm::two_pi<double>() / p.meander_wavelength;
   const double max_slope = 1.26 * p.meander_amplitude * k;
@@ -201,13 +258,13 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
       std::max<uint32_t>(2, static_cast<uint32_t>(std::lround(total / params_.section_spacing)) + 1);
   const uint32_t across = params_.vertices_across;
 
-  RiverMesh mesh;
-  mesh.section_count = section_count;
-  mesh.vertices_across = across;
-  const size_t vertex_count = size_t{section_count} * across;
-  mesh.positions.reserve(vertex_count);
-  mesh.depth.reserve(vertex_count);
-  const float y = water_level();
+  // Every section's frame: where it crosses the centreline, its left (+Y x downstream, in x/z)
+  // and its half-width. Sections are perpendicular to the centreline.
+  struct Frame {
+    double x, z, half_width;
+    glm::dvec2 left;
+  };
+  std::vector<Frame> frames(section_count);
   size_t seg = 1;
   for (uint32_t k = 0; k < section_count; ++k) {
     // The z where the centreline has run k / (S - 1) of its length.
@@ -217,28 +274,41 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
                          ? std::clamp((target - arc[seg - 1]) / (arc[seg] - arc[seg - 1]), 0.0, 1.0)
                          : 0.0;
     const double z = z_of(seg - 1) + u * (z_of(seg) - z_of(seg - 1));
-    const double x = centre_x(z);
-    // Sections are perpendicular to the centreline; left = +Y x downstream.
     const double slope = centre_slope(z);
     const double norm = std::sqrt(1.0 + slope * slope);
-    const glm::dvec2 left(1.0 / norm, -slope / norm);  // (x, z)
-    const double half_width = 0.5 * width(z);
-    for (uint32_t j = 0; j < across; ++j) {
-      const double t = double(j) / double(across - 1);
-      const double offset = half_width * (1.0 - 2.0 * t);
-      const glm::vec3 p(float(x + offset * left.x), y, float(z + offset * left.y));
-      mesh.positions.push_back(p);
-      mesh.depth.push_back(depth_at(p.x, p.z));
+    frames[k] = {centre_x(z), z, 0.5 * width(z), glm::dvec2(1.0 / norm, -slope / norm)};
+  }
+  // With a confluence the grid starts at the tongue's tip; the sections above it are split.
+  uint32_t tip = 0;
+  if (params_.confluence) {
+    while (tip < section_count && frames[tip].z < double(params_.confluence->tip_z)) ++tip;
+    if (tip < 1 || tip + 3 > section_count) {
+      return Status::error(text_format(
+          "procedural river: confluence.tip_z = %g leaves no room for the tributaries above it or "
+          "the river below it (it needs a section above and three below)",
+          double(params_.confluence->tip_z)));
     }
   }
 
-  // Two triangles per quad, counter-clockwise from +Y; a quad that turns over means two
-  // neighbouring sections cross, on the inside of a bend tighter than the half-width.
-  mesh.indices.reserve(size_t{section_count - 1} * (across - 1) * 6);
-  for (uint32_t k = 0; k + 1 < section_count; ++k) {
-    for (uint32_t j = 0; j + 1 < across; ++j) {
-      const uint32_t a = k * across + j, b = a + 1, c = a + across, d = c + 1;
-      for (const auto& [p, q, r] : {std::array{a, b, c}, std::array{b, d, c}}) {
+  RiverMesh mesh;
+  mesh.section_count = section_count - tip;  // the grid's, while islands are cut
+  mesh.vertices_across = across;
+  const size_t vertex_count = size_t{section_count} * (across + (params_.confluence ? 1 : 0));
+  mesh.positions.reserve(vertex_count);
+  mesh.depth.reserve(vertex_count);
+  const float y = water_level();
+  auto place = [&](const Frame& f, double offset) {
+    const glm::vec3 p(float(f.x + offset * f.left.x), y, float(f.z + offset * f.left.y));
+    mesh.positions.push_back(p);
+    mesh.depth.push_back(depth_at(p.x, p.z));
+    return static_cast<uint32_t>(mesh.positions.size() - 1);
+  };
+  // Two triangles per quad between a section (a, left to right) and the next downstream (c),
+  // counter-clockwise from +Y; a quad that turns over means the two sections cross, on the
+  // inside of a bend tighter than the half-width.
+  auto zip = [&](const std::vector<uint32_t>& a, const std::vector<uint32_t>& c, uint32_t k) {
+    for (size_t j = 0; j + 1 < a.size(); ++j) {
+      for (const auto& [p, q, r] : {std::array{a[j], a[j + 1], c[j]}, std::array{a[j + 1], c[j + 1], c[j]}}) {
         const glm::vec3 e1 = mesh.positions[q] - mesh.positions[p];
         const glm::vec3 e2 = mesh.positions[r] - mesh.positions[p];
         if (!(e1.z * e2.x - e1.x * e2.z > 0.0f)) {
@@ -246,13 +316,60 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
               "procedural river: sections %u and %u cross near z = %g (the meander is too tight "
               "for the width: raise meander_wavelength or section_spacing, or lower "
               "meander_amplitude or width)",
-              k, k + 1, mesh.positions[a].z));
+              k, k + 1, mesh.positions[a[j]].z));
         }
         mesh.indices.insert(mesh.indices.end(), {p, q, r});
       }
     }
+    return Status::success();
+  };
+
+  std::vector<uint32_t> prev, row;
+  for (uint32_t k = tip; k < section_count; ++k) {
+    row.clear();
+    for (uint32_t j = 0; j < across; ++j) {
+      row.push_back(place(frames[k], frames[k].half_width * (1.0 - 2.0 * double(j) / double(across - 1))));
+    }
+    if (k > tip) SIVIFLOW_TRY(zip(prev, row, k - 1));
+    prev = row;
   }
+  const glm::vec3 outflow_middle = mesh.positions[prev[across / 2]];
   if (!params_.islands.empty()) SIVIFLOW_TRY(cut_islands(&mesh));
+  mesh.section_count = section_count;
+
+  if (params_.confluence) {
+    // Above the tip each section has two arms: from the left bank to the tongue, and from the
+    // tongue to the right bank, the banks and the tongue's shores parted by its half-width.
+    const uint32_t j_tip = tongue_vertex(params_, frames[tip].half_width);
+    std::vector<uint32_t> prev_left(across), prev_right;
+    std::iota(prev_left.begin(), prev_left.end(), 0u);  // the tip's section, first in the grid
+    prev_right.assign(prev_left.begin() + j_tip, prev_left.end());
+    prev_left.resize(j_tip + 1);
+    std::vector<uint32_t> left, right;
+    for (uint32_t k = tip; k-- > 0;) {
+      const Frame& f = frames[k];
+      const double half = tongue_half_width(f.z), middle = f.half_width * tongue_fraction_;
+      left.clear();
+      right.clear();
+      for (uint32_t j = 0; j <= j_tip; ++j) {
+        left.push_back(place(f, f.half_width + half - double(j) * (f.half_width - middle) / double(j_tip)));
+      }
+      const uint32_t right_cells = across - 1 - j_tip;
+      for (uint32_t j = 0; j <= right_cells; ++j) {
+        right.push_back(place(f, middle - half - double(j) * (middle + f.half_width) / double(right_cells)));
+      }
+      SIVIFLOW_TRY(zip(left, prev_left, k));
+      SIVIFLOW_TRY(zip(right, prev_right, k));
+      prev_left = left;
+      prev_right = right;
+    }
+    const uint32_t outflow = static_cast<uint32_t>(
+        std::find(mesh.positions.begin(), mesh.positions.end(), outflow_middle) - mesh.positions.begin());
+    const Frame& top = frames[0];
+    mesh.ends = {{outflow, false, float(2.0 * frames.back().half_width)},
+                 {left[j_tip / 2], true, float(top.half_width * (1.0 - tongue_fraction_))},
+                 {right[right.size() / 2], true, float(top.half_width * (1.0 + tongue_fraction_))}};
+  }
   *out = std::move(mesh);
   return Status::success();
 }

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 namespace siviflow::test {
 
 struct YShape {
@@ -52,6 +54,22 @@ class YLaplaceOracle {
       }
     }
     return NAN;
+  }
+
+  // Velocity grad(psi) x +Y = (-dpsi/dz, 0, dpsi/dx), by central differences of the bilinear psi.
+  glm::dvec3 velocity(double x, double z) const {
+    return {-(psi(x, z + h_) - psi(x, z - h_)) / (2 * h_), 0.0,
+            (psi(x + h_, z) - psi(x - h_, z)) / (2 * h_)};
+  }
+
+  // Whether (x, z) lies in the water at least `margin` from every border and end.
+  bool inside(double x, double z, double margin) const {
+    for (const double dx : {-margin, 0.0, margin}) {
+      for (const double dz : {-margin, 0.0, margin}) {
+        if (!water(x + dx, z + dz)) return false;
+      }
+    }
+    return true;
   }
 
   double psi(double x, double z) const {

@@ -27,8 +27,9 @@ void print_help() {
       "  its obstacles placed at time T (seconds, default 0).\n"
       "  --out FILE.csv  writes one CSV row per river vertex in the file's accessor order:\n"
       "                  vertex,x,y,z,section,bank,width,d_left,d_right,psi,vx,vy,vz,wet\n"
-      "  --describe      prints what the river's mesh was found to be: its ends, banks, arms\n"
-      "                  and islands, and the discharge each arm carries\n"
+      "  --describe      prints what the river's mesh was found to be: a strip or a network,\n"
+      "                  its ends, banks, tongues, arms and islands, and the discharge each\n"
+      "                  end and arm carries\n"
       "  At least one of the two is required.\n");
 }
 
@@ -37,25 +38,42 @@ void print_help() {
 std::string describe(const StreamFunction& flow) {
   const RiverSurface& s = flow.surface();
   const auto sections = s.sections();
-  const auto end = [&](size_t k) {
-    return text_format("section %zu, %zu vertices, %.2f m wide", k, s.section_nodes(k).size(),
-                       double(sections[k].width));
+  const size_t tongues = s.network() ? s.banks().size() - 2 : 0;
+  const auto name = [&](BorderId b) {
+    if (b == kLeftBankBorder) return std::string("the left bank");
+    if (b == kRightBankBorder) return std::string("the right bank");
+    if (s.is_island_border(b)) return text_format("island %d", int(b - island_border(0)));
+    return text_format("tongue %d", int(b - island_border(s.islands().size())));
   };
   std::set<std::pair<BorderId, BorderId>> arms;
   for (uint32_t n = 0; n < s.node_count(); ++n) {
-    if (s.node_bank()[n] == Bank::kNone && !s.on_island(n)) {
+    if (s.node_bank()[n] == Bank::kNone && !s.on_island(n) && !s.on_tongue(n)) {
       arms.insert({s.node_left_border(n), s.node_right_border(n)});
     }
   }
-  std::string out = text_format(
-      "a strip of %zu sections, %.1f m along its middle, %zu vertices (%zu triangles)\n"
-      "1 inflow end (upstream): %s\n"
-      "1 outflow end (downstream): %s\n"
-      "2 banks: psi %.9g m^2/s on the left, 0 on the right\n"
-      "%zu island%s, %zu arms, 0 junctions\n",
-      sections.size(), double(sections.back().along), s.vertex_count(), s.triangle_count(),
-      end(0).c_str(), end(sections.size() - 1).c_str(), flow.border_psi(kLeftBankBorder),
-      s.islands().size(), s.islands().size() == 1 ? "" : "s", arms.size());
+  std::string out = text_format("a %s of %zu sections, %.1f m along its middle, %zu vertices (%zu triangles)\n",
+                                s.network() ? "network" : "strip", sections.size(),
+                                double(sections.back().along), s.vertex_count(), s.triangle_count());
+  for (size_t e = 0; e < s.ends().size(); ++e) {
+    const RiverEnd& end = s.ends()[e];
+    const char* kind = end.inflow ? "inflow" : "outflow";
+    const std::string where =
+        s.network() ? text_format("end %zu, %s", e, kind)
+                    : text_format("1 %s end (%s)", kind, end.inflow ? "upstream" : "downstream");
+    out += text_format("%s: section %u, %u vertices (vertex %u first), %.2f m wide, %.9g m^2/s\n",
+                       where.c_str(), end.section, end.node_count,
+                       s.vertex_of_node(s.end_nodes(e)[0]), double(end.width), flow.end_discharge(e));
+  }
+  if (s.network()) {
+    for (const RiverBank& bank : s.banks()) {
+      out += text_format("%s: psi %.9g m^2/s\n", name(bank.border).c_str(), flow.border_psi(bank.border));
+    }
+  } else {
+    out += text_format("2 banks: psi %.9g m^2/s on the left, 0 on the right\n",
+                       flow.border_psi(kLeftBankBorder));
+  }
+  out += text_format("%zu island%s, %zu arms, %zu junction%s\n", s.islands().size(),
+                     s.islands().size() == 1 ? "" : "s", arms.size(), tongues, tongues == 1 ? "" : "s");
   for (size_t i = 0; i < s.islands().size(); ++i) {
     uint32_t first = UINT32_MAX, last = 0;
     for (const uint32_t n : s.island_nodes(i)) {
@@ -68,11 +86,6 @@ std::string describe(const StreamFunction& flow) {
         double(sections[last].along - sections[first].along), flow.island_psi(i));
   }
   for (const auto& [left, right] : arms) {
-    const auto name = [](BorderId b) {
-      return b == kLeftBankBorder    ? std::string("the left bank")
-             : b == kRightBankBorder ? std::string("the right bank")
-                                     : text_format("island %d", int(b - island_border(0)));
-    };
     out += text_format("arm from %s to %s: %.9g m^2/s\n", name(left).c_str(), name(right).c_str(),
                        flow.border_psi(left) - flow.border_psi(right));
   }

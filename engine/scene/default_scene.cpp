@@ -162,17 +162,30 @@ SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vect
   SceneGeometry geometry;
   add_terrain(river, &geometry);
   // Boulders on both banks, and trees: a piece each.
+  // Each where the river leaves land for it, a metre from the water (a wider river, a
+  // confluence's, may cover the spot).
+  const auto dry = [&](float x, float z) {
+    for (const glm::vec2 d : {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(-1, 0), glm::vec2(0, 1), glm::vec2(0, -1)}) {
+      if (river.depth_at(x + d.x, z + d.y) > 0.0f) return false;
+    }
+    return true;
+  };
   auto first = static_cast<uint32_t>(geometry.indices.size());
-  add_boulder(on_ground(river, -10.0f, -20.0f) + glm::vec3(0, 0.6f, 0), {2.2f, 1.6f, 1.9f}, kGranite, 1.0f, &geometry);
-  add_object_piece(first, &geometry);
+  if (dry(-10.0f, -20.0f)) {
+    add_boulder(on_ground(river, -10.0f, -20.0f) + glm::vec3(0, 0.6f, 0), {2.2f, 1.6f, 1.9f}, kGranite, 1.0f, &geometry);
+    add_object_piece(first, &geometry);
+  }
   first = static_cast<uint32_t>(geometry.indices.size());
-  add_boulder(on_ground(river, 11.0f, 12.0f) + glm::vec3(0, 0.5f, 0), {1.6f, 1.2f, 1.5f}, kSandstone, 2.0f, &geometry);
-  add_object_piece(first, &geometry);
+  if (dry(11.0f, 12.0f)) {
+    add_boulder(on_ground(river, 11.0f, 12.0f) + glm::vec3(0, 0.5f, 0), {1.6f, 1.2f, 1.5f}, kSandstone, 2.0f, &geometry);
+    add_object_piece(first, &geometry);
+  }
   for (int i = 0; i < 6; ++i) {
     const float z = -60.0f + 22.0f * static_cast<float>(i);
-    const float side = (i % 2 == 0) ? -1.0f : 1.0f;
+    const float x = ((i % 2 == 0) ? -1.0f : 1.0f) * (13.0f + 3.0f * static_cast<float>(i % 3));
+    if (!dry(x, z)) continue;
     first = static_cast<uint32_t>(geometry.indices.size());
-    add_tree(on_ground(river, side * (13.0f + 3.0f * static_cast<float>(i % 3)), z), 7.0f + static_cast<float>(i % 3), &geometry);
+    add_tree(on_ground(river, x, z), 7.0f + static_cast<float>(i % 3), &geometry);
     add_object_piece(first, &geometry);
   }
   add_obstacle_boulders(obstacles, &geometry);

@@ -245,6 +245,16 @@ Status parse_procedural(const Reader& r, const Json& v, const std::string& path,
       params.islands.push_back(island);
     }
   }
+  if (const Json* c = find(v, "confluence")) {
+    const std::string at = join(path, "confluence");
+    SIVIFLOW_TRY(r.object(*c, at));
+    SIVIFLOW_TRY(r.keys(*c, at, {"tip_z", "offset", "angle_deg"}));
+    ProceduralConfluence confluence;
+    if (const Json* x = find(*c, "tip_z")) SIVIFLOW_TRY(r.real(*x, join(at, "tip_z"), &confluence.tip_z));
+    if (const Json* x = find(*c, "offset")) SIVIFLOW_TRY(r.real(*x, join(at, "offset"), &confluence.offset));
+    if (const Json* x = find(*c, "angle_deg")) SIVIFLOW_TRY(r.positive(*x, join(at, "angle_deg"), &confluence.angle_deg));
+    params.confluence = confluence;
+  }
   const Status valid = ProceduralRiver::validate(params);
   if (!valid.ok()) {
     std::string message = valid.message();
@@ -272,6 +282,56 @@ Status parse_flow(const Reader& r, const Json& v, const std::string& path, FlowP
   return Status::success();
 }
 
+// A river's "ends": each a vertex or a point near it, and an inflow or an outflow of a discharge
+// >= 0; together they balance.
+Status parse_ends(const Reader& r, const Json& v, const std::string& path,
+                  std::vector<SceneRiverEnd>* out) {
+  SIVIFLOW_TRY(r.array(v, path, kMaxSceneRiverEnds));
+  if (v.size() < 2) return r.fail(path, text_format("%zu ends given: a river has at least two", v.size()));
+  std::vector<SceneRiverEnd> ends;
+  double in = 0.0, out_sum = 0.0;
+  std::string in_list, out_list;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const Json& item = v[i];
+    const std::string at = element(path, i);
+    SIVIFLOW_TRY(r.object(item, at));
+    SIVIFLOW_TRY(r.keys(item, at, {"vertex", "near", "inflow", "outflow"}));
+    SceneRiverEnd end;
+    const Json* vertex = find(item, "vertex");
+    const Json* near = find(item, "near");
+    if ((vertex != nullptr) == (near != nullptr)) {
+      return r.fail(at, "needs either 'vertex' (a vertex on the end) or 'near' (a point by it)");
+    }
+    end.by_vertex = vertex != nullptr;
+    if (vertex) SIVIFLOW_TRY(r.uint32(*vertex, join(at, "vertex"), &end.vertex));
+    if (near) SIVIFLOW_TRY(r.vec3(*near, join(at, "near"), &end.near));
+    const Json* inflow = find(item, "inflow");
+    const Json* outflow = find(item, "outflow");
+    if ((inflow != nullptr) == (outflow != nullptr)) {
+      return r.fail(at, "needs either 'inflow' or 'outflow' (the discharge through it, m^2/s)");
+    }
+    end.inflow = inflow != nullptr;
+    const std::string key = join(at, end.inflow ? "inflow" : "outflow");
+    SIVIFLOW_TRY(r.real(end.inflow ? *inflow : *outflow, key, &end.discharge));
+    if (end.discharge < 0.0f) {
+      return r.fail(key, text_format("%g is negative: a discharge is 0 or more", double(end.discharge)));
+    }
+    (end.inflow ? in : out_sum) += end.discharge;
+    std::string& list = end.inflow ? in_list : out_list;
+    list += text_format("%s%g", list.empty() ? "" : " + ", double(end.discharge));
+    ends.push_back(end);
+  }
+  if (std::abs(in - out_sum) > 1e-5 * std::max({in, out_sum, 1e-30})) {
+    return r.fail(path, text_format("the ends do not balance: %g m^2/s flows in (%s) and %g "
+                                    "m^2/s out (%s)",
+                                    in, in_list.empty() ? "none" : in_list.c_str(), out_sum,
+                                    out_list.empty() ? "none" : out_list.c_str()));
+  }
+  if (!(in > 0.0)) return r.fail(path, "no water flows in: the inflows' discharges are all 0");
+  *out = std::move(ends);
+  return Status::success();
+}
+
 // One river at `path`: "river" (its flow from the top-level "flow") or an element of "rivers"
 // (which may carry a "flow" of its own, else the top-level one's).
 Status parse_river(const Reader& r, const Json& v, const std::string& path,
@@ -279,9 +339,9 @@ Status parse_river(const Reader& r, const Json& v, const std::string& path,
                    SceneRiver* out) {
   SIVIFLOW_TRY(r.object(v, path));
   if (own_flow) {
-    SIVIFLOW_TRY(r.keys(v, path, {"gltf", "mesh", "procedural", "flow"}));
+    SIVIFLOW_TRY(r.keys(v, path, {"gltf", "mesh", "procedural", "flow", "ends"}));
   } else {
-    SIVIFLOW_TRY(r.keys(v, path, {"gltf", "mesh", "procedural"}));
+    SIVIFLOW_TRY(r.keys(v, path, {"gltf", "mesh", "procedural", "ends"}));
   }
   const Json* gltf = find(v, "gltf");
   const Json* mesh = find(v, "mesh");
@@ -290,6 +350,7 @@ Status parse_river(const Reader& r, const Json& v, const std::string& path,
   if (!gltf && !procedural) return r.fail(path, "needs 'gltf' (a river mesh file) or 'procedural'");
   SceneRiver river;
   river.flow = flow;
+  river.key = path;
   if (gltf) {
     river.source = SceneRiver::Source::kGltf;
     SIVIFLOW_TRY(r.string(*gltf, join(path, "gltf"), &river.gltf));
@@ -302,6 +363,11 @@ Status parse_river(const Reader& r, const Json& v, const std::string& path,
   }
   if (const Json* x = own_flow ? find(v, "flow") : nullptr) {
     SIVIFLOW_TRY(parse_flow(r, *x, join(path, "flow"), &river.flow));
+  }
+  if (const Json* x = find(v, "ends")) {
+    SIVIFLOW_TRY(parse_ends(r, *x, join(path, "ends"), &river.ends));
+    river.flow.discharge = 0.0f;  // the inflows bring it
+    for (const SceneRiverEnd& end : river.ends) river.flow.discharge += end.inflow ? end.discharge : 0.0f;
   }
   *out = std::move(river);
   return Status::success();
@@ -685,6 +751,7 @@ std::vector<std::string> procedural_river_keys() {
   for (const FloatField& f : kProceduralFloats) keys.emplace_back(f.name);
   for (const UintField& f : kProceduralUints) keys.emplace_back(f.name);
   keys.emplace_back("islands");
+  keys.emplace_back("confluence");
   return keys;
 }
 

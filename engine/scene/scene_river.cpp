@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <memory>
 #include <utility>
@@ -208,6 +209,7 @@ WaterRiver SceneRiverData::river() const {
   river.slope = slope;
   river.flow = flow;
   river.obstacles = obstacles;
+  river.ends = ends;
   return river;
 }
 
@@ -224,10 +226,37 @@ WaterObstacle water_obstacle(const Obstacle& obstacle) {
   return out;
 }
 
+// The scene's ends of a river on its mesh: a point's end is the one holding the vertex nearest
+// it. Errors name the key.
+Status resolve_ends(const SceneRiver& river, std::span<const glm::vec3> positions,
+                    std::vector<WaterRiverEnd>* out) {
+  out->clear();
+  for (size_t i = 0; i < river.ends.size(); ++i) {
+    const SceneRiverEnd& end = river.ends[i];
+    WaterRiverEnd placed{end.vertex, end.inflow, end.discharge};
+    if (end.by_vertex && end.vertex >= positions.size()) {
+      return Status::error(text_format("%s.ends[%zu].vertex: %u is not in the river mesh (%zu vertices)",
+                                       river.key.c_str(), i, end.vertex, positions.size()));
+    }
+    if (!end.by_vertex) {
+      double nearest = std::numeric_limits<double>::max();
+      for (uint32_t v = 0; v < positions.size(); ++v) {
+        const double d = glm::distance(glm::dvec3(positions[v]), glm::dvec3(end.near));
+        if (d < nearest) {
+          nearest = d;
+          placed.vertex = v;
+        }
+      }
+    }
+    out->push_back(placed);
+  }
+  return Status::success();
+}
+
 // A glTF river's depth (the profile of kGltfRiverDepth) and the slope of that bed across.
 Status gltf_river_data(TriangleMesh gltf, SceneRiverData* out) {
   RiverSurface surface;
-  SIVIFLOW_TRY(RiverSurface::build(gltf.positions, gltf.indices, RiverSurfaceOptions{}, &surface));
+  SIVIFLOW_TRY(RiverSurface::build(gltf.positions, gltf.indices, river_surface_options(out->ends), &surface));
   out->mesh.positions = std::move(gltf.positions);
   out->mesh.indices = std::move(gltf.indices);
   const size_t count = out->mesh.positions.size();
@@ -262,6 +291,7 @@ Status scene_river_shape(const SceneFile* scene, size_t river_index, SceneRiverD
     if (river.source == SceneRiver::Source::kGltf) {
       TriangleMesh gltf;
       Status status = load_river_mesh(river.gltf, river.mesh, &gltf);
+      if (status.ok()) status = resolve_ends(river, gltf.positions, &data.ends);
       if (status.ok()) status = gltf_river_data(std::move(gltf), &data);
       if (!status.ok()) return in_scene(*scene, status);
     } else {
@@ -278,7 +308,13 @@ Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverDa
   SceneRiverData data;
   SIVIFLOW_TRY(scene_river_shape(scene, river_index, &data));
   if (data.procedural) {
-    const Status status = procedural_river_mesh(*data.procedural, &data.mesh, &data.slope);
+    Status status = procedural_river_mesh(*data.procedural, &data.mesh, &data.slope);
+    if (status.ok() && scene != nullptr) {
+      status = resolve_ends(scene->rivers[river_index], data.mesh.positions, &data.ends);
+    }
+    if (status.ok() && data.ends.empty()) {
+      data.ends = procedural_river_ends(data.mesh, data.flow.discharge);
+    }
     if (!status.ok()) return scene == nullptr ? status : in_scene(*scene, status);
   }
   std::vector<Obstacle> obstacles;
@@ -301,9 +337,11 @@ Status build_scene_river_flow(const SceneFile& scene, size_t river_index, double
   SIVIFLOW_TRY(scene_river_data(&scene, river_index, &data));
   out->positions = std::move(data.mesh.positions);
   RiverSurface surface;
-  Status status = RiverSurface::build(out->positions, data.mesh.indices, RiverSurfaceOptions{}, &surface);
+  Status status = RiverSurface::build(out->positions, data.mesh.indices,
+                                      river_surface_options(data.ends), &surface);
   if (!status.ok()) return in_scene(scene, status);
-  const FlowParams flow{data.flow.discharge, data.flow.shepard_power, data.flow.search_radius};
+  FlowParams flow{data.flow.discharge, data.flow.shepard_power, data.flow.search_radius};
+  flow.end_discharges = surface_end_discharges(surface, data.ends);
   status = StreamFunction::create(std::move(surface), flow, &out->flow);
   if (!status.ok()) return in_scene(scene, status);
   std::vector<Obstacle> obstacles;

@@ -195,5 +195,47 @@ TEST(ExampleScenes, IslandPartsTheFlowAndLeavesAWake) {
   EXPECT_GT(wake, 2.0 * above) << "wake " << wake << ", above the island " << above;
 }
 
+// The confluence scene straightened and seen from 90 m above its tongue's tip (screen right +X,
+// down +Z, 2.14 px a metre at 320x180): land on the tongue, water flowing downstream in both
+// tributaries and in the river they make, the wider tributary bringing the more.
+TEST(ExampleScenes, ConfluenceJoinsTwoTributaries) {
+  const fs::path dir = fresh_test_dir("examples");
+  Json scene = read_json(kScenes / "confluence.json");
+  Json& procedural = scene["river"]["procedural"];
+  procedural["meander_amplitude"] = 0.0;
+  const double tip = procedural["confluence"]["tip_z"], offset = procedural["confluence"]["offset"];
+  scene["camera"] = {{"fov_y_deg", 50.0},
+                     {"keys", {{{"t", 0.0}, {"position", {0.0, 90.0, tip + 0.01}}, {"target", {0.0, 0.0, tip}}}}}};
+  std::ofstream(dir / "junction.json") << scene.dump();
+  const RunResult run = run_siviflow("capture " + (dir / "junction.json").string() +
+                                     " --range 150:151 --size 320x180 --aov flow,foam --validation --out " +
+                                     dir.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  ExrImage image;
+  ASSERT_TRUE(read_exr((dir / "frame_00150.exr").string(), &image).ok());
+  const std::vector<bool> water = water_of(image);
+  ASSERT_EQ(water.size(), 320u * 180u);
+  const double px_per_m = 90.0 / (90.0 * std::tan(25.0 * M_PI / 180.0));
+  const auto pixel = [&](double x, double z) {
+    const int u = int(std::lround(160.0 + x * px_per_m)), v = int(std::lround(90.0 + (z - tip) * px_per_m));
+    EXPECT_TRUE(u >= 0 && u < 320 && v >= 0 && v < 180) << "(" << x << ", " << z << ") is out of view";
+    return size_t(std::clamp(v, 0, 179)) * 320u + size_t(std::clamp(u, 0, 319));
+  };
+  const std::vector<float>& flow_x = *image.find("flow.X");
+  const std::vector<float>& flow_z = *image.find("flow.Z");
+  // 12 m above the tip the tongue (30 degrees) is 6.4 m wide about the offset; each tributary
+  // lies beyond it, the left (+X) one width / 2 - offset = 9 m wide, the right 15 m.
+  EXPECT_FALSE(water[pixel(offset, tip - 12.0)]) << "the tongue is land";
+  const double half = 12.0 * std::tan(15.0 * M_PI / 180.0);
+  for (const auto& [x, z] : {std::pair{offset + half + 4.5, tip - 12.0}, std::pair{offset - half - 7.5, tip - 12.0},
+                             std::pair{0.0, tip + 12.0}}) {
+    EXPECT_TRUE(water[pixel(x, z)]) << "(" << x << ", " << z << ")";
+    EXPECT_GT(flow_z[pixel(x, z)], 0.3f) << "(" << x << ", " << z << "): downstream is +Z";
+  }
+  // Each tributary runs towards the junction: the left one (+X) towards -X, the right towards +X.
+  EXPECT_LT(flow_x[pixel(offset + half + 4.5, tip - 12.0)], 0.0f);
+  EXPECT_GT(flow_x[pixel(offset - half - 7.5, tip - 12.0)], 0.0f);
+}
+
 }  // namespace
 }  // namespace siviflow::testing

@@ -460,7 +460,8 @@ Json load_schema() {
 }
 
 TEST(SceneFileSchema, ProceduralPropertiesAndDefaultsMatchTheParser) {
-  EXPECT_EQ(sizeof(ProceduralRiverParams), 12 * sizeof(float) + sizeof(std::vector<ProceduralIsland>))
+  EXPECT_EQ(sizeof(ProceduralRiverParams), 12 * sizeof(float) + sizeof(std::vector<ProceduralIsland>) +
+                                               sizeof(std::optional<ProceduralConfluence>))
       << "ProceduralRiverParams changed: add the field to kProceduralFloats/kProceduralUints in "
          "engine/scene/scene_file.cpp and to engine/scene/scene.schema.json";
   const Json schema = load_schema();
@@ -469,9 +470,12 @@ TEST(SceneFileSchema, ProceduralPropertiesAndDefaultsMatchTheParser) {
   for (const auto& item : props.items()) schema_keys.insert(item.key());
   const std::vector<std::string> parser_keys = procedural_river_keys();
   EXPECT_EQ(schema_keys, std::set<std::string>(parser_keys.begin(), parser_keys.end()));
-  // Every schema default, written out, parses to the struct's default.
+  // Every schema default, written out, parses to the struct's default (a confluence, absent by
+  // default, has its own defaults below).
   Json procedural = Json::object();
-  for (const auto& item : props.items()) procedural[item.key()] = item.value()["default"];
+  for (const auto& item : props.items()) {
+    if (item.value().contains("default")) procedural[item.key()] = item.value()["default"];
+  }
   SceneFile from_defaults;
   const Status status = parse(with({{"river", {{"procedural", procedural}}}}), &from_defaults);
   ASSERT_TRUE(status.ok()) << status.message();
@@ -489,6 +493,54 @@ TEST(SceneFileSchema, ProceduralPropertiesAndDefaultsMatchTheParser) {
   EXPECT_EQ(p.seed, d.seed);
   EXPECT_EQ(p.section_spacing, d.section_spacing);
   EXPECT_EQ(p.vertices_across, d.vertices_across);
+  EXPECT_FALSE(p.confluence.has_value());
+  // The confluence's own defaults, written out, parse to ProceduralConfluence's.
+  const Json& confluence_props = props["confluence"]["properties"];
+  Json confluence = Json::object();
+  for (const auto& item : confluence_props.items()) confluence[item.key()] = item.value()["default"];
+  SceneFile with_confluence;
+  ASSERT_TRUE(parse(with({{"river", {{"procedural", {{"confluence", confluence}}}}}}), &with_confluence).ok());
+  const ProceduralConfluence dc;
+  ASSERT_TRUE(with_confluence.rivers[0].procedural.confluence.has_value());
+  EXPECT_EQ(with_confluence.rivers[0].procedural.confluence->tip_z, dc.tip_z);
+  EXPECT_EQ(with_confluence.rivers[0].procedural.confluence->offset, dc.offset);
+  EXPECT_EQ(with_confluence.rivers[0].procedural.confluence->angle_deg, dc.angle_deg);
+}
+
+// A river's ends: each a vertex or a point and an inflow or an outflow; their inflows make the
+// discharge; bad ones named by key and value.
+TEST(SceneFile, RiverEndsCarryTheirDischarges) {
+  SceneFile scene;
+  const Json ends = {{{"vertex", 3}, {"inflow", 2.0}},
+                     {{"near", {1.0, 0.0, -40.0}}, {"inflow", 1.5}},
+                     {{"vertex", 9}, {"outflow", 3.5}}};
+  const Status parsed = parse(with({{"river", {{"procedural", nullptr}, {"gltf", "y.glb"}, {"ends", ends}}}}), &scene);
+  ASSERT_TRUE(parsed.ok()) << parsed.message();
+  const std::vector<SceneRiverEnd>& e = scene.rivers[0].ends;
+  ASSERT_EQ(e.size(), 3u);
+  EXPECT_TRUE(e[0].by_vertex);
+  EXPECT_EQ(e[0].vertex, 3u);
+  EXPECT_FALSE(e[1].by_vertex);
+  EXPECT_EQ(e[1].near, glm::vec3(1.0f, 0.0f, -40.0f));
+  EXPECT_FALSE(e[2].inflow);
+  EXPECT_EQ(e[2].discharge, 3.5f);
+  EXPECT_EQ(scene.rivers[0].flow.discharge, 3.5f);
+
+  auto refused = [&](const Json& bad, std::initializer_list<const char*> parts) {
+    const Status status = parse(with({{"river", {{"procedural", nullptr}, {"gltf", "y.glb"}, {"ends", bad}}}}), &scene);
+    ASSERT_FALSE(status.ok());
+    for (const char* part : parts) {
+      EXPECT_NE(status.message().find(part), std::string::npos) << status.message() << " lacks " << part;
+    }
+  };
+  refused({{{"vertex", 3}, {"inflow", 2.0}}, {{"vertex", 9}, {"outflow", 2.5}}},
+          {"river.ends", "do not balance", "2 m^2/s flows in (2)", "2.5 m^2/s out (2.5)"});
+  refused({{{"vertex", 3}, {"inflow", -2.0}}, {{"vertex", 9}, {"outflow", -2.0}}},
+          {"river.ends[0].inflow", "-2 is negative"});
+  refused({{{"vertex", 3}, {"inflow", 2.0}, {"outflow", 2.0}}, {{"vertex", 9}, {"outflow", 2.0}}},
+          {"river.ends[0]", "either 'inflow' or 'outflow'"});
+  refused({{{"inflow", 2.0}}, {{"vertex", 9}, {"outflow", 2.0}}}, {"river.ends[0]", "'vertex'", "'near'"});
+  refused({{{"vertex", 3}, {"inflow", 2.0}}}, {"river.ends", "at least two"});
 }
 
 TEST(SceneFile, SeveralRiversEachWithTheirOwnFlow) {

@@ -91,6 +91,17 @@ inline constexpr uint32_t kDefaultRenderHeight = 720;
 inline constexpr double kDefaultRenderFps = 30.0;
 inline constexpr uint32_t kDefaultRenderSeed = 1;
 
+// One end of a scene's river: a vertex on it, or the point it is nearest, and the discharge
+// through it.
+struct SceneRiverEnd {
+  bool by_vertex = true;
+  uint32_t vertex = 0;      // by_vertex: the river mesh's vertex
+  glm::vec3 near{0.0f};     // else: the end holding the mesh vertex nearest this point
+  bool inflow = true;
+  float discharge = 0.0f;   // m^2/s, >= 0
+};
+inline constexpr size_t kMaxSceneRiverEnds = 256;
+
 struct SceneRiver {
   enum class Source : uint8_t { kProcedural, kGltf };
   Source source = Source::kProcedural;
@@ -98,6 +109,9 @@ struct SceneRiver {
   std::string mesh;                  // kGltf: mesh name; empty: the first mesh
   ProceduralRiverParams procedural;  // kProcedural: the generator's parameters
   FlowParams flow{kDefaultSceneDischarge, kDefaultShepardPower, 0.0f};  // its own flow
+  // Every end with its discharge (flow.discharge is then their inflows' sum), or none.
+  std::vector<SceneRiverEnd> ends;
+  std::string key = "river";  // where the file gives it: "river" or "rivers[i]", for messages
 };
 
 struct SceneObject {

@@ -31,6 +31,7 @@ struct SceneRiverData {
   std::vector<float> slope;              // the bed's slope under each vertex
   std::vector<WaterObstacle> obstacles;  // the scene's, then those of objects marked obstacle
   RiverFlowParams flow;
+  std::vector<WaterRiverEnd> ends;            // the scene's (or the generator's), or none
   std::optional<ProceduralRiver> procedural;  // the generator it came from, if it did
   WaterRiver river() const;
 };

@@ -43,16 +43,29 @@ struct RiverFlowParams {
   float search_radius = 0.0f; // s in metres; 0: 3 x the widest section
 };
 
+// One open end of a river (where water enters or leaves), named by any vertex on it.
+struct WaterRiverEnd {
+  uint32_t vertex = 0;
+  bool inflow = true;
+  float discharge = 0.0f;  // m^2/s through it, >= 0; the ends balance (in = out)
+};
+
 struct WaterRiver {
   // The water surface: a strip of quads from bank to bank, one row of vertices per
-  // cross-section (sections may differ in width and vertex count), triangles as index triples.
-  // The upstream end is the section holding vertex 0; world metres, +Y up.
+  // cross-section (sections may differ in width and vertex count), triangles as index triples;
+  // it may have holes (islands) and, as a network, more than two ends (a confluence, a fork).
+  // The upstream end is the section holding vertex 0, unless `ends` names them; world metres,
+  // +Y up.
   std::span<const glm::vec3> positions;
   std::span<const uint32_t> indices;
   std::span<const float> depth;  // per vertex: water depth under it, metres, >= 0
   std::span<const float> slope;  // per vertex: the bed's slope under it (rise over run), >= 0
   RiverFlowParams flow;
   std::span<const WaterObstacle> obstacles;
+  // Every end, each once, with its discharge (their inflows then make flow.discharge), or none:
+  // then the end holding vertex 0 is the only inflow and the other ends (a strip has one) share
+  // flow.discharge by their widths. A network takes a single inflow or a single outflow.
+  std::span<const WaterRiverEnd> ends;
 };
 
 }  // namespace siviflow

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -20,6 +21,17 @@ struct ProceduralIsland {
   float width = 4.0f;     // metres across it
 };
 
+// A confluence in the procedural river: two tributaries joining into it, the tongue of land
+// between them a wedge from the river's upstream end to its tip. Each tributary keeps its width
+// (the river's, split where the tongue lies); above the tip the banks part as the tongue widens.
+struct ProceduralConfluence {
+  float tip_z = 0.0f;       // metres: where along +Z the tongue ends (the tributaries meet)
+  float offset = 0.0f;      // metres from the centreline across the flow, + towards the left bank
+                            // (snapped to the mesh's nearest vertex): the left tributary is
+                            // width / 2 - offset wide, the right width / 2 + offset
+  float angle_deg = 30.0f;  // between the two tributaries, degrees in (0, 120]
+};
+
 struct ProceduralRiverParams {
   float length = 240.0f;              // metres along +Z, centred on the origin
   float meander_amplitude = 14.0f;    // metres of lateral swing of the centreline
@@ -35,20 +47,35 @@ struct ProceduralRiverParams {
   // along the centreline, each with this many vertices from bank to bank.
   float section_spacing = 1.0f;  // metres
   uint32_t vertices_across = 13;
-  // Islands, each clear of the banks, the ends and the others by two cells of the mesh.
+  // Islands, each clear of the banks, the ends and the others by two cells of the mesh (and
+  // below the confluence's tip, where there is one).
   std::vector<ProceduralIsland> islands;
+  std::optional<ProceduralConfluence> confluence;
+};
+
+// An end of the generated river: a vertex in its middle, which way the water crosses it, and
+// its width (the rule that shares a discharge among ends of one kind).
+struct RiverMeshEnd {
+  uint32_t vertex = 0;
+  bool inflow = true;
+  float width = 0.0f;
 };
 
 // The river's water surface as a strip, ready for RiverSurface::build. The river flows along +Z:
 // section 0 is at z = -length/2, vertex 0 is its left-bank corner (+X side).
 struct RiverMesh {
   // Vertex k * vertices_across + j: section k, j = 0 on the left (in that order, less the
-  // vertices inside islands, where the river has any).
+  // vertices inside islands, where the river has any). With a confluence the sections from its
+  // tip down come first, then each section above it, its left tributary's vertices before its
+  // right's (vertices_across + 1 a section, the tongue's two shores among them).
   std::vector<glm::vec3> positions;
   std::vector<uint32_t> indices;     // triangles, counter-clockwise seen from +Y
   std::vector<float> depth;          // water depth under each vertex, metres, >= 0
   uint32_t section_count = 0;
   uint32_t vertices_across = 0;
+  // With a confluence, its three ends (the outflow first), for RiverSurfaceOptions::ends; else
+  // none (the strip's upstream end holds vertex 0).
+  std::vector<RiverMeshEnd> ends;
 };
 
 class ProceduralRiver {
@@ -90,7 +117,14 @@ class ProceduralRiver {
   // bank, an end or another island.
   Status cut_islands(RiverMesh* mesh) const;
 
+  // With a confluence: the tongue's half-width at z (0 from its tip on), and where its middle
+  // lies as a fraction of the half-width from the centreline (+ left).
+  double tongue_half_width(double z) const;
+  // The tongue's vertex at the tip in a section of `across` vertices.
+  static uint32_t tongue_vertex(const ProceduralRiverParams& params, double half_width_at_tip);
+
   ProceduralRiverParams params_;
+  double tongue_fraction_ = 0.0;
   float phase_a_ = 0.0f;  // seeded phases of the two meander harmonics
   float phase_b_ = 0.0f;
   float phase_w_ = 0.0f;  // seeded phase of the width profile

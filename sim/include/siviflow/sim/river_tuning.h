@@ -39,6 +39,8 @@ inline constexpr size_t kMaxRiverIslands = 65000;
 // so small that its half-size rounds to nothing.
 inline constexpr size_t kMaxProceduralIslands = 256;
 inline constexpr float kMinProceduralIslandSize = 0.01f;
+// The procedural confluence's bed rises to its tongue (and past its tip) at this slope, m/m.
+inline constexpr float kConfluenceShelfSlope = 0.8f;
 // Obstacles are few (objects touching the water); polygons are footprints, not meshes.
 inline constexpr size_t kMaxObstacles = 4096;
 inline constexpr size_t kMaxPolygonPoints = 4096;
