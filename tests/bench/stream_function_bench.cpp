@@ -15,6 +15,7 @@
 #include "sim/grid_holes.h"
 #include "sim/triangle_bvh.h"
 #include "unit/foam_inputs.h"
+#include "unit/river_network_meshes.h"
 
 namespace siviflow {
 namespace {
@@ -69,21 +70,54 @@ const RiverMesh& river_with_islands(int64_t vertices) {
   return *slot;
 }
 
+// A network of about 100k vertices with four ends: three arms of 13 quads across (240 m)
+// joining into a channel of 40 (525 m), 0.3 m rows, ten islands cut from the channel as above.
+struct Network {
+  test::FanMesh fan;
+  RiverSurfaceOptions options;
+};
+const Network& river_network() {
+  static const Network network = [] {
+    Network n;
+    const uint32_t rows = 1750;
+    n.fan = test::fan_channel(4.0f, 0.3f * rows, {240.0f, 240.0f, 240.0f}, 0.05f, 0.3f, 13,
+                              [&](uint32_t k, uint32_t j) {
+                                const int island = int(double(k) * 10.0 / rows);
+                                const double dk = (double(k) + 0.5 - (island + 0.5) * rows / 10.0) / 40.0;
+                                const double dj = (double(j) + 0.5 - (island % 2 == 0 ? 16.0 : 24.0)) / 4.5;
+                                return dk * dk + dj * dj < 1.0;
+                              });
+    n.options.ends.push_back({n.fan.main_end, false});
+    for (const uint32_t end : n.fan.arm_ends) n.options.ends.push_back({end, true});
+    return n;
+  }();
+  return network;
+}
+
 // The surface and the obstacle-free solve, as a river is loaded: a strip against the same river
-// with ten islands (issue 29: at most 2x).
+// with ten islands, and against a network of four ends with ten islands (issue 29: at most 2x).
 void BM_LoadFlow(benchmark::State& state) {
-  const RiverMesh& mesh = state.range(1) != 0 ? river_with_islands(state.range(0)) : river_mesh(state.range(0));
+  const int kind = int(state.range(1));  // 0: strip, 1: ten islands, 2: the network
+  const std::vector<glm::vec3>& positions = kind == 2 ? river_network().fan.mesh.positions
+                                            : kind == 1 ? river_with_islands(state.range(0)).positions
+                                                        : river_mesh(state.range(0)).positions;
+  const std::vector<uint32_t>& indices = kind == 2 ? river_network().fan.mesh.indices
+                                         : kind == 1 ? river_with_islands(state.range(0)).indices
+                                                     : river_mesh(state.range(0)).indices;
+  const RiverSurfaceOptions options = kind == 2 ? river_network().options : RiverSurfaceOptions{};
   for (auto _ : state) {
     RiverSurface surface;
     StreamFunction flow;
-    if (!RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok() ||
-        !StreamFunction::create(std::move(surface), {20.0f, 1.5f, 0.0f}, &flow).ok()) {
-      state.SkipWithError("the river did not load");
+    const Status built = RiverSurface::build(positions, indices, options, &surface);
+    if (!built.ok() || !StreamFunction::create(std::move(surface), {20.0f, 1.5f, 0.0f}, &flow).ok()) {
+      state.SkipWithError(("the river did not load: " + built.message()).c_str());
       return;
     }
     benchmark::DoNotOptimize(flow.node_psi().data());
   }
-  state.counters["islands"] = double(state.range(1) != 0 ? 10 : 0);
+  state.counters["islands"] = double(kind != 0 ? 10 : 0);
+  state.counters["ends"] = double(kind == 2 ? 4 : 2);
+  state.counters["vertices"] = double(positions.size());
 }
 
 void BM_SurfaceBuild(benchmark::State& state) {
@@ -177,7 +211,7 @@ BENCHMARK(BM_SurfaceBuild)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000
 BENCHMARK(BM_FullSolve)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MoveObstacle)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_LoadFlow)->ArgsProduct({{100'000}, {0, 1}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LoadFlow)->ArgsProduct({{100'000}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FoamAfterMove)->ArgsProduct({{100'000, 1'500'000}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 

@@ -145,13 +145,14 @@ class RippleMotionTest : public StraightChannelTest {
   // The motions of the ripples and of the particles' flow, between frames kFirst, kFirst +
   // kApart and kFirst + 2 kApart of the channel with its boulder at `boulder` and `islands`.
   std::vector<Motion> render_motions(WaterMaterial material, const glm::vec3& boulder,
-                                     const std::vector<ProceduralIsland>& islands = {}) {
+                                     const std::vector<ProceduralIsland>& islands = {},
+                                     const std::optional<ProceduralConfluence>& confluence = {}) {
     WaterLook look;
     look.material = material;
     boulder_ = boulder;
     set_camera({0.0f, 9.0f, -4.5f}, {0.0f, 0.0f, 2.5f}, kView);
     const Status status =
-        create_channel(make_create_info(kView.width, kView.height), boulder, look, {}, islands);
+        create_channel(make_create_info(kView.width, kView.height), boulder, look, {}, islands, confluence);
     EXPECT_TRUE(status.ok()) << status.message();
     frames_ = render_still(0, kFirst + 2 * kApart + 1);
     const std::vector<Frame>& frames = frames_;
@@ -296,6 +297,35 @@ TEST_F(RippleMotionTest, RipplesFollowTheFlowAroundAnIsland) {
   EXPECT_LE(median(angles), 10.0);
   EXPECT_NEAR(median(ratios), 1.0, 0.2);
   EXPECT_LE(median(turning), 15.0);
+}
+
+// Two tributaries, 30 degrees apart, join at z = 0 (the channel's 12 m split 6 and 6 above it):
+// the ripples in each tributary, in the river below and where they meet follow the flow.
+TEST_F(RippleMotionTest, RipplesFollowTheFlowWhereTwoTributariesJoin) {
+  const ProceduralConfluence confluence{0.0f, 0.0f, 30.0f};
+  const std::vector<Motion> all =
+      render_motions(WaterMaterial::kTiledDirectionalFlow, {0.0f, 0.0f, 50.0f}, {}, confluence);
+  std::vector<double> angles, ratios, junction;
+  size_t left = 0, right = 0;
+  for (const Motion& m : all) {
+    const double angle = degrees_apart(m.measured, m.expected);
+    angles.push_back(angle);
+    ratios.push_back(glm::length(m.measured) / glm::length(m.expected));
+    left += m.at.y < -0.5f && m.at.x > 0.5f ? 1 : 0;
+    right += m.at.y < -0.5f && m.at.x < -0.5f ? 1 : 0;
+    if (m.at.y > -1.0f && m.at.y < 3.0f) junction.push_back(angle);
+  }
+  std::printf(
+      "where two tributaries join: %zu windows (%zu in the left tributary, %zu in the right), "
+      "median angular error %.1f deg, median speed ratio %.2f; %zu within 3 m below the tip, "
+      "%.1f deg\n",
+      angles.size(), left, right, median(angles), median(ratios), junction.size(), median(junction));
+  EXPECT_GT(left, 10u);
+  EXPECT_GT(right, 10u);
+  EXPECT_GT(junction.size(), 10u);
+  EXPECT_LE(median(angles), 10.0);
+  EXPECT_NEAR(median(ratios), 1.0, 0.2);
+  EXPECT_LE(median(junction), 15.0);
 }
 
 }  // namespace

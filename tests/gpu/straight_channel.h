@@ -9,6 +9,7 @@
 #include <glm/matrix.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <optional>
 #include <vector>
 
 #include "render_frames.h"
@@ -23,7 +24,8 @@ class StraightChannelTest : public RenderTest {
   static constexpr float kChannelWidth = 12.0f;
 
   static SceneFile channel_scene(const glm::vec3& boulder,
-                                 const std::vector<ProceduralIsland>& islands = {}) {
+                                 const std::vector<ProceduralIsland>& islands = {},
+                                 const std::optional<ProceduralConfluence>& confluence = {}) {
     SceneFile scene;
     scene.path = "straight-channel.json";
     ProceduralRiverParams& river = scene.rivers[0].procedural;
@@ -32,6 +34,7 @@ class StraightChannelTest : public RenderTest {
     river.width = kChannelWidth;
     river.width_variation = 0.0f;
     river.islands = islands;
+    river.confluence = confluence;
     Obstacle obstacle;
     obstacle.centre = boulder;
     obstacle.radius = kBoulderRadius;
@@ -39,16 +42,18 @@ class StraightChannelTest : public RenderTest {
     return scene;
   }
 
-  // The world of the channel with its boulder at `boulder`, `objects` and `islands`, and the
+  // The world of the channel with its boulder at `boulder`, `objects`, `islands` and
+  // `confluence`, and the
   // water of the channel with the boulder as a runtime obstacle (so that move_boulder can move
   // it), which reflects the world unless `info` names a reflection of its own; the world's
   // ground and objects are its occluders.
   Status create_channel(CreateInfo info, const glm::vec3& boulder, const WaterLook& look = {},
                         const std::vector<SceneObject>& objects = {},
-                        const std::vector<ProceduralIsland>& islands = {}) {
+                        const std::vector<ProceduralIsland>& islands = {},
+                        const std::optional<ProceduralConfluence>& confluence = {}) {
     renderer_.reset();
     world_.reset();
-    scene_ = channel_scene(boulder, islands);
+    scene_ = channel_scene(boulder, islands, confluence);
     scene_.look = look;
     scene_.objects = objects;
     WorldCreateInfo world_info = context_->world_create_info(info.color_format, info.depth_format);
