@@ -80,10 +80,14 @@ float ProceduralRiver::terrain_height(float x, float z) const {
   // (and to its tip below it); out of it the tributaries' banks lie further out by its width.
   float tongue_shelf = -std::numeric_limits<float>::max();
   if (params_.confluence) {
+    // Along the river, where the section through (x, z) crosses the centreline (the mesh's
+    // sections are square to it, so off the centreline z runs ahead of it or behind).
+    const double slope = centre_slope(z);
+    const double along = z + double(lateral) * slope / std::sqrt(1.0 + slope * slope);
     const float middle = half_width * static_cast<float>(tongue_fraction_);
-    const float half = static_cast<float>(tongue_half_width(z));
+    const float half = static_cast<float>(tongue_half_width(along));
     const float from_middle = lateral - middle;
-    const float beyond_tip = std::max(0.0f, z - params_.confluence->tip_z);
+    const float beyond_tip = std::max(0.0f, static_cast<float>(along) - params_.confluence->tip_z);
     const float outside = std::hypot(std::abs(from_middle) - half, beyond_tip);
     if (beyond_tip == 0.0f && std::abs(from_middle) < half) {
       return params_.bank_height * glm::smoothstep(0.0f, bank_run, half - std::abs(from_middle));
@@ -315,8 +319,9 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
           return Status::error(text_format(
               "procedural river: sections %u and %u cross near z = %g (the meander is too tight "
               "for the width: raise meander_wavelength or section_spacing, or lower "
-              "meander_amplitude or width)",
-              k, k + 1, mesh.positions[a[j]].z));
+              "meander_amplitude or width%s)",
+              k, k + 1, mesh.positions[a[j]].z,
+              params_.confluence ? ", or the confluence's angle_deg, which widens the river above its tip" : ""));
         }
         mesh.indices.insert(mesh.indices.end(), {p, q, r});
       }

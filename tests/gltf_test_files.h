@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/common.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -65,6 +66,30 @@ inline void write_channel_gltf(const std::filesystem::path& gltf, int sections, 
        << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << positions.size() / 3
        << R"(,"type":"VEC3","min":[)" << x - half << "," << -drop * spacing * static_cast<float>(sections - 1)
        << ",0],\"max\":[" << x + half << ",0," << spacing * static_cast<float>(sections - 1) << "]},"
+       << R"({"bufferView":1,"componentType":5125,"count":)" << indices.size() << R"(,"type":"SCALAR"}]})";
+  write_text(gltf, json.str());
+}
+
+// A river surface of any shape (mesh "River"), as glTF with a .bin.
+inline void write_river_gltf(const std::filesystem::path& gltf, const std::vector<glm::vec3>& points,
+                             const std::vector<uint32_t>& indices) {
+  std::vector<float> positions;
+  glm::vec3 lo(1e30f), hi(-1e30f);
+  for (const glm::vec3& p : points) {
+    positions.insert(positions.end(), {p.x, p.y, p.z});
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  const std::vector<size_t> at = write_bin(gltf, positions, indices);
+  std::ostringstream json;
+  json << R"({"asset":{"version":"2.0"},"meshes":[{"name":"River","primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+       << R"("buffers":[{"uri":")" << std::filesystem::path(gltf).replace_extension(".bin").filename().string()
+       << R"(","byteLength":)" << at[2] << "}],"
+       << R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" << at[1]
+       << R"(},{"buffer":0,"byteOffset":)" << at[1] << R"(,"byteLength":)" << at[2] - at[1] << "}],"
+       << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << points.size()
+       << R"(,"type":"VEC3","min":[)" << lo.x << "," << lo.y << "," << lo.z << "],\"max\":[" << hi.x << ","
+       << hi.y << "," << hi.z << "]},"
        << R"({"bufferView":1,"componentType":5125,"count":)" << indices.size() << R"(,"type":"SCALAR"}]})";
   write_text(gltf, json.str());
 }

@@ -28,6 +28,13 @@ Status in_scene(const SceneFile& scene, const Status& status) {
   return Status::error(scene.path + ": " + status.message(), status.code());
 }
 
+// A river's error in its scene: one about its named ends ("ends[2]: ...") names the key.
+Status in_scene(const SceneFile& scene, size_t river_index, const Status& status) {
+  if (status.message().rfind("ends", 0) != 0) return in_scene(scene, status);
+  return Status::error(scene.path + ": " + scene.rivers[river_index].key + "." + status.message(),
+                       status.code());
+}
+
 double cross2(glm::dvec2 o, glm::dvec2 a, glm::dvec2 b) {
   return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
 }
@@ -293,7 +300,7 @@ Status scene_river_shape(const SceneFile* scene, size_t river_index, SceneRiverD
       Status status = load_river_mesh(river.gltf, river.mesh, &gltf);
       if (status.ok()) status = resolve_ends(river, gltf.positions, &data.ends);
       if (status.ok()) status = gltf_river_data(std::move(gltf), &data);
-      if (!status.ok()) return in_scene(*scene, status);
+      if (!status.ok()) return in_scene(*scene, river_index, status);
     } else {
       const Status status = ProceduralRiver::validate(river.procedural);
       if (!status.ok()) return in_scene(*scene, status);
@@ -339,7 +346,7 @@ Status build_scene_river_flow(const SceneFile& scene, size_t river_index, double
   RiverSurface surface;
   Status status = RiverSurface::build(out->positions, data.mesh.indices,
                                       river_surface_options(data.ends), &surface);
-  if (!status.ok()) return in_scene(scene, status);
+  if (!status.ok()) return in_scene(scene, river_index, status);
   FlowParams flow{data.flow.discharge, data.flow.shepard_power, data.flow.search_radius};
   flow.end_discharges = surface_end_discharges(surface, data.ends);
   status = StreamFunction::create(std::move(surface), flow, &out->flow);

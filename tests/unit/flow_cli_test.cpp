@@ -15,8 +15,10 @@
 #include <gtest/gtest.h>
 
 #include "gltf_test_files.h"
+#include "river_network_meshes.h"
 #include "run_command.h"
 #include "siviflow/sim/procedural_river.h"
+#include "siviflow/text_format.h"
 
 namespace siviflow::testing {
 namespace {
@@ -114,6 +116,46 @@ TEST_F(FlowCliTest, ProceduralRiverWithAnIslandDescribesItsArms) {
     ++shore;
   }
   EXPECT_GT(shore, 20u);
+}
+
+// A Y from glTF with its ends named by vertex: --describe finds the network, its ends with their
+// discharges and the tongue's psi; in the CSV the tongue holds it. Unbalanced ends, or one named
+// by a vertex that is on no end, are refused with the key.
+TEST_F(FlowCliTest, GltfConfluenceWithNamedEnds) {
+  const test::YMesh y = test::y_channel(4.0f, 24.0f, 16.0f, 10.0f, 0.25f, 0.5f, 8);
+  write_river_gltf(dir_ / "y.gltf", y.mesh.positions, y.mesh.indices);
+  const auto scene = [&](uint32_t left_vertex, double out) {
+    write_text(dir_ / "scene.json",
+               text_format(R"({"version":1,"river":{"gltf":"y.gltf","ends":[)"
+                           R"({"vertex":%u,"inflow":5.0},{"vertex":%u,"inflow":2.5},{"vertex":%u,"outflow":%g}]}})",
+                           left_vertex, y.right_end, y.main_end, out));
+    return run_siviflow("flow " + (dir_ / "scene.json").string() + " --describe --out " +
+                        (dir_ / "flow.csv").string());
+  };
+  const RunResult r = scene(y.left_end, 7.5);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* part : {"a network of", "end 0, outflow", "7.5 m^2/s", "end 1, inflow", "tongue 0: psi 2.5",
+                           "the left bank: psi 7.5", "0 islands, 3 arms, 1 junction",
+                           "arm from the left bank to tongue 0: 5 m^2/s"}) {
+    EXPECT_NE(r.output.find(part), std::string::npos) << part << " in\n" << r.output;
+  }
+  std::string header;
+  size_t tongue = 0;
+  for (const Row& row : read_csv(dir_ / "flow.csv", &header)) {
+    if (row.v[5] != 0 || row.v[7] != 0 || row.v[8] != 0) continue;
+    EXPECT_NEAR(row.v[9], 2.5, 1e-6) << "tongue vertex " << row.v[0];
+    ++tongue;
+  }
+  EXPECT_GT(tongue, 40u);
+
+  const RunResult unbalanced = scene(y.left_end, 7.0);
+  EXPECT_EQ(unbalanced.exit_code, 1);
+  EXPECT_NE(unbalanced.output.find("river.ends: the ends do not balance: 7.5 m^2/s flows in (5 + 2.5) and 7 m^2/s out (7)"),
+            std::string::npos) << unbalanced.output;
+  const RunResult off_end = scene(5, 7.5);
+  EXPECT_EQ(off_end.exit_code, 1);
+  EXPECT_NE(off_end.output.find("river.ends[0]: vertex 5 is not on the border"), std::string::npos) << off_end.output;
+  EXPECT_NE(off_end.output.find("not on an end"), std::string::npos) << off_end.output;
 }
 
 TEST_F(FlowCliTest, ProceduralRiverWithAMovingObstacle) {

@@ -95,6 +95,64 @@ TEST(ProceduralRiver, AnIslandIsLandCutOutOfTheWater) {
   }
 }
 
+// A confluence: a network of three ends (the generator names them), the tongue land between
+// the tributaries, each tributary as wide as its share of the river and water to its shores.
+TEST(ProceduralRiver, AConfluenceJoinsTwoTributaries) {
+  ProceduralRiverParams params;
+  params.vertices_across = 25;
+  params.width = 20.0f;
+  params.width_variation = 0.0f;
+  params.meander_amplitude = 3.0f;  // the banks above the tip part: a gentle meander
+  params.confluence = ProceduralConfluence{-40.0f, 2.5f, 30.0f};
+  const ProceduralRiver river(params);
+  RiverMesh mesh;
+  const Status generated = river.generate_mesh(&mesh);
+  ASSERT_TRUE(generated.ok()) << generated.message();
+  ASSERT_EQ(mesh.depth.size(), mesh.positions.size());
+  ASSERT_EQ(mesh.ends.size(), 3u);
+  RiverSurfaceOptions options;
+  for (const RiverMeshEnd& end : mesh.ends) options.ends.push_back({end.vertex, end.inflow});
+  RiverSurface surface;
+  const Status status = RiverSurface::build(mesh.positions, mesh.indices, options, &surface);
+  ASSERT_TRUE(status.ok()) << status.message();
+  ASSERT_TRUE(surface.network());
+  EXPECT_FALSE(surface.ends()[0].inflow);
+  // The tributaries: 7.5 m on the left (width / 2 - offset), 12.5 m on the right.
+  for (const RiverEnd& end : surface.ends()) {
+    const float expected = end.inflow ? (mesh.ends[end.mark].width) : 20.0f;
+    EXPECT_NEAR(end.width, expected, 0.01f) << "end " << end.mark;
+  }
+  EXPECT_NEAR(mesh.ends[1].width, 7.5f, 0.01f);
+  EXPECT_NEAR(mesh.ends[2].width, 12.5f, 0.01f);
+  // 40 m above the tip the tongue is 2 * 40 tan 15 = 21.4 m wide: land in its middle, water in
+  // the middle of each tributary beyond it.
+  const float z = -80.0f, half = 40.0f * std::tan(15.0f * 3.14159265f / 180.0f);
+  const float middle = river.centreline_x(z) + 2.5f;
+  EXPECT_GT(river.terrain_height(middle, z), 0.9f * params.bank_height);
+  EXPECT_GT(river.depth_at(middle + half + 3.75f, z), 0.5f * params.depth);
+  EXPECT_GT(river.depth_at(middle - half - 6.25f, z), 0.5f * params.depth);
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    EXPECT_GT(river.terrain_height(mesh.positions[v].x, mesh.positions[v].z), -params.depth - 1e-3f);
+    // The terrain takes the meander's sections as approximately square to it: within 2 cm.
+    EXPECT_LE(river.terrain_height(mesh.positions[v].x, mesh.positions[v].z), 0.02f) << "vertex " << v << " on land";
+  }
+}
+
+TEST(ProceduralRiver, ABadConfluenceNamesItsParameter) {
+  for (const auto& [confluence, key] :
+       {std::pair{ProceduralConfluence{0.0f, 0.0f, 0.0f}, "confluence.angle_deg"},
+        std::pair{ProceduralConfluence{0.0f, 0.0f, 150.0f}, "confluence.angle_deg"},
+        std::pair{ProceduralConfluence{500.0f, 0.0f, 30.0f}, "confluence.tip_z"},
+        std::pair{ProceduralConfluence{0.0f, 5.5f, 30.0f}, "confluence.offset"},
+        std::pair{ProceduralConfluence{NAN, 0.0f, 30.0f}, "confluence.tip_z"}}) {
+    ProceduralRiverParams params;
+    params.confluence = confluence;
+    const Status status = ProceduralRiver::validate(params);
+    ASSERT_FALSE(status.ok()) << key;
+    EXPECT_NE(status.message().find(key), std::string::npos) << status.message();
+  }
+}
+
 TEST(ProceduralRiver, SeedChangesTheRiverDeterministically) {
   ProceduralRiverParams a;
   ProceduralRiverParams b = a;
