@@ -229,14 +229,7 @@ Status Renderer::Impl::create_river() {
       obstacles.push_back(flow_obstacle(info.river->obstacles[i]));
     }
   }
-  FlowParams params{flow.discharge, flow.shepard_power, flow.search_radius};
-  params.end_discharges = std::move(input.end_discharges);
-  if (!params.end_discharges.empty()) {  // named ends bring the discharge in
-    params.discharge = 0.0f;
-    for (size_t e = 0; e < params.end_discharges.size(); ++e) {
-      if (input.surface.ends()[e].inflow) params.discharge += params.end_discharges[e];
-    }
-  }
+  const FlowParams params = river_flow_params(flow, input);
   return SharedRiver::create(table, info.allocation_callbacks, std::move(input), params,
                              std::move(obstacles), &river);
 }

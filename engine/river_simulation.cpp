@@ -68,6 +68,18 @@ Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   return Status::success();
 }
 
+FlowParams river_flow_params(const RiverFlowParams& flow, const RiverInput& input) {
+  FlowParams params{flow.discharge, flow.shepard_power, flow.search_radius};
+  params.end_discharges = input.end_discharges;
+  if (!params.end_discharges.empty()) {
+    params.discharge = 0.0f;
+    for (size_t e = 0; e < params.end_discharges.size(); ++e) {
+      if (input.surface.ends()[e].inflow) params.discharge += params.end_discharges[e];
+    }
+  }
+  return params;
+}
+
 RiverSurfaceOptions river_surface_options(std::span<const WaterRiverEnd> ends) {
   RiverSurfaceOptions options;
   for (const WaterRiverEnd& end : ends) options.ends.push_back({end.vertex, end.inflow});

@@ -41,6 +41,9 @@ struct RiverInput {
   std::vector<float> end_discharges;  // FlowParams::end_discharges: per surface end, or none
 };
 
+// The solver's parameters for a host's flow: with named ends, their discharges (in the order of
+// `input`'s surface) and their inflows' sum as the discharge.
+FlowParams river_flow_params(const RiverFlowParams& flow, const RiverInput& input);
 // The surface options that name a river's ends (none: vertex 0's end is the upstream one).
 RiverSurfaceOptions river_surface_options(std::span<const WaterRiverEnd> ends);
 // Their discharges in the order of `surface`'s ends (built with those options), or none.

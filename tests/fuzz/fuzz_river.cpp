@@ -1,5 +1,6 @@
 // A river as a host hands it to the renderer (CreateInfo::river), from the fuzzer's bytes: a
-// strip of sections with extreme, degenerate and duplicated positions, depths and slopes; flow
+// strip of sections, or a network of arms with its ends named or not, with extreme, degenerate
+// and duplicated positions, depths and slopes; flow
 // parameters; circle and polygon obstacles with keys. Through the same checks, the river
 // surface, the stream-function solve, obstacles added, moved, replaced and removed at runtime,
 // keyframed time, point queries, and a few frames of particles and flow textures under fuzzed
@@ -54,6 +55,55 @@ void fuzz_strip(FuzzedDataProvider& in, std::vector<glm::vec3>* positions,
   if (in.ConsumeIntegralInRange<int>(0, 15) == 0) indices->push_back(0);
 }
 
+// A network: 2 or 3 arms of `across` cells joining at z = 0 into a channel on to +z, their
+// tongues widening upstream by the fuzzer's spread, each vertex nudged or thrown now and then.
+// Its ends go to `ends`, named or not, their discharges balanced or not.
+void fuzz_fan(FuzzedDataProvider& in, std::vector<glm::vec3>* positions, std::vector<uint32_t>* indices,
+              std::vector<siviflow::WaterRiverEnd>* ends) {
+  const uint32_t arms = in.ConsumeIntegralInRange<uint32_t>(2, 3);
+  const uint32_t across = in.ConsumeIntegralInRange<uint32_t>(1, kMaxAcross / 2);
+  const float arm_width = mostly(in, 4.0f, 0.0f, 20.0f);
+  const float spacing = mostly(in, 1.0f, 0.0f, 10.0f);
+  const float spread = mostly(in, 0.25f, -1.0f, 3.0f);
+  auto row = [&](float z, float left, float right, uint32_t cells) {
+    std::vector<uint32_t> ids;
+    for (uint32_t j = 0; j <= cells; ++j) {
+      glm::vec3 p(left + (right - left) * float(j) / float(cells), 0.0f, z);
+      if (in.ConsumeIntegralInRange<int>(0, 7) == 0) p += extreme_vec3(in, -1.0f, 1.0f);
+      ids.push_back(uint32_t(positions->size()));
+      positions->push_back(p);
+    }
+    return ids;
+  };
+  auto zip = [&](const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+    for (size_t j = 0; j + 1 < a.size(); ++j) indices->insert(indices->end(), {a[j], b[j], a[j + 1], a[j + 1], b[j], b[j + 1]});
+  };
+  const float half = 0.5f * float(arms) * arm_width;
+  std::vector<uint32_t> tips = row(0.0f, half, -half, arms * across), prev = tips;
+  for (uint32_t k = 1, rows = in.ConsumeIntegralInRange<uint32_t>(1, kMaxSections / 2); k <= rows; ++k) {
+    std::vector<uint32_t> next = row(float(k) * spacing, half, -half, arms * across);
+    zip(prev, next);
+    prev = std::move(next);
+  }
+  const bool named = in.ConsumeBool();
+  std::vector<float> inflow(arms);
+  float total = 0.0f;
+  for (float& q : inflow) total += q = mostly(in, 2.0f, -1.0f, 50.0f);
+  if (named) ends->push_back({prev[prev.size() / 2], false, mostly(in, total, -1.0f, 100.0f)});
+  for (uint32_t i = 0; i < arms; ++i) {
+    prev.assign(tips.begin() + i * across, tips.begin() + (i + 1) * across + 1);
+    const float shift_rate = (0.5f * float(arms - 1) - float(i)) * 2.0f * spread;
+    for (uint32_t k = 1, rows = in.ConsumeIntegralInRange<uint32_t>(1, kMaxSections / 2); k <= rows; ++k) {
+      const float left = half - float(i) * arm_width + float(k) * spacing * shift_rate;
+      std::vector<uint32_t> next = row(-float(k) * spacing, left, left - arm_width, across);
+      zip(next, prev);
+      prev = std::move(next);
+    }
+    if (named) ends->push_back({in.ConsumeIntegralInRange<int>(0, 15) == 0 ? in.ConsumeIntegral<uint32_t>() : prev[prev.size() / 2],
+                                in.ConsumeIntegralInRange<int>(0, 15) != 0, inflow[i]});
+  }
+}
+
 siviflow::WaterObstacle fuzz_obstacle(FuzzedDataProvider& in, float length) {
   siviflow::WaterObstacle o;
   o.centre = {extreme_or(in, -10.0f, 10.0f), mostly(in, 0.0f, -2.0f, 2.0f),
@@ -93,7 +143,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
   std::vector<glm::vec3> positions;
   std::vector<uint32_t> indices;
-  fuzz_strip(in, &positions, &indices);
+  std::vector<siviflow::WaterRiverEnd> ends;
+  if (in.ConsumeIntegralInRange<int>(0, 3) == 0) {
+    fuzz_fan(in, &positions, &indices, &ends);
+  } else {
+    fuzz_strip(in, &positions, &indices);
+  }
   std::vector<float> depth(positions.size());
   std::vector<float> slope(positions.size());
   for (float& d : depth) d = mostly(in, 1.5f, -1.0f, 10.0f);
@@ -112,6 +167,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   host.flow.shepard_power = mostly(in, 1.5f, -1.0f, 8.0f);
   host.flow.search_radius = mostly(in, 0.0f, -1.0f, 1e3f);
   host.obstacles = obstacles;
+  host.ends = ends;
   // As Renderer::create takes it.
   siviflow::RiverInput input;
   if (!siviflow::river_input_from(host, &input).ok()) return 0;
@@ -121,9 +177,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     flow_obstacles.push_back(siviflow::flow_obstacle(obstacles[i]));
   }
   siviflow::RiverFlow flow;
-  if (!flow.create(std::move(input),
-                   {host.flow.discharge, host.flow.shepard_power, host.flow.search_radius},
-                   std::move(flow_obstacles)).ok()) {
+  const siviflow::FlowParams params = siviflow::river_flow_params(host.flow, input);
+  if (!flow.create(std::move(input), params, std::move(flow_obstacles)).ok()) {
     return 0;
   }
   siviflow::RiverView view;

@@ -2,13 +2,20 @@
 // sections and banks from its topology, and give every vertex its section, bank flag, section
 // width, in-river distances to both margins and the section's flow direction.
 //
-// The mesh must be a strip: a triangulated band whose rows (sections) run from bank to bank,
-// every triangle joining two neighbouring sections. Sections may differ in width and in vertex
-// count. The strip may have holes, the islands: a section that meets an island goes on from its
-// far side, so the island's shore is a border like the banks, between two arms of the river.
-// An island vertex has no distance to either side (d_left = d_right = 0, both borders its own). The vertex order does not matter, except that the upstream end is the end section
-// holding vertex `RiverSurfaceOptions::upstream_vertex` (vertex 0 by default: the paper's "first
-// vertex is a corner"). The left bank is on the left looking downstream with +Y up (glTF).
+// The mesh is a strip: a triangulated band whose rows (sections) run from bank to bank, every
+// triangle joining two neighbouring sections. Sections may differ in width and in vertex count.
+// The strip may have holes, the islands: a section that meets an island goes on from its far
+// side, so the island's shore is a border like the banks, between two arms of the river. An
+// island vertex has no distance to either side (d_left = d_right = 0, both borders its own). The
+// vertex order does not matter, except that the upstream end is the end section holding vertex
+// `RiverSurfaceOptions::upstream_vertex` (vertex 0 by default: the paper's "first vertex is a
+// corner"). The left bank is on the left looking downstream with +Y up (glTF).
+//
+// Or the mesh is a network (river_network.cpp): more than two ends, found at the corners of its
+// outer border, arms parting and joining about tongues of land (a confluence: several inflows
+// and one outflow; a fork: one inflow and several outflows), islands anywhere. Its sections are
+// counted from that single end, each a row's arms from border to border; a tongue's vertices
+// have no distance to either side, as an island's.
 //
 // Vertices at exactly the same position are welded (a glTF export splits vertices along UV
 // seams and sharp edges, and a non-indexed mesh repeats every vertex): the topology is built on
