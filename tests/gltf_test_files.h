@@ -36,40 +36,6 @@ std::vector<size_t> write_bin(const std::filesystem::path& gltf, const Arrays&..
   return offsets;
 }
 
-// A straight channel along +Z, `across` vertices per section, width w, as glTF with a .bin;
-// with a `drop` it descends that many metres per metre downstream; its centreline at x = `x`.
-inline void write_channel_gltf(const std::filesystem::path& gltf, int sections, int across,
-                               float width, float spacing, float drop = 0.0f, float x = 0.0f) {
-  std::vector<float> positions;
-  for (int k = 0; k < sections; ++k) {
-    for (int j = 0; j < across; ++j) {
-      positions.push_back(x + width * 0.5f - width * static_cast<float>(j) / (across - 1));  // left = +X
-      positions.push_back(-drop * spacing * static_cast<float>(k));
-      positions.push_back(spacing * static_cast<float>(k));
-    }
-  }
-  std::vector<uint32_t> indices;
-  for (int k = 0; k + 1 < sections; ++k) {
-    for (int j = 0; j + 1 < across; ++j) {
-      const uint32_t a = k * across + j, b = a + 1, c = a + across, d = c + 1;
-      indices.insert(indices.end(), {a, c, b, b, c, d});
-    }
-  }
-  const std::vector<size_t> at = write_bin(gltf, positions, indices);
-  const float half = width * 0.5f;
-  std::ostringstream json;
-  json << R"({"asset":{"version":"2.0"},"meshes":[{"name":"River","primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
-       << R"("buffers":[{"uri":")" << std::filesystem::path(gltf).replace_extension(".bin").filename().string()
-       << R"(","byteLength":)" << at[2] << "}],"
-       << R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":)" << at[1]
-       << R"(},{"buffer":0,"byteOffset":)" << at[1] << R"(,"byteLength":)" << at[2] - at[1] << "}],"
-       << R"("accessors":[{"bufferView":0,"componentType":5126,"count":)" << positions.size() / 3
-       << R"(,"type":"VEC3","min":[)" << x - half << "," << -drop * spacing * static_cast<float>(sections - 1)
-       << ",0],\"max\":[" << x + half << ",0," << spacing * static_cast<float>(sections - 1) << "]},"
-       << R"({"bufferView":1,"componentType":5125,"count":)" << indices.size() << R"(,"type":"SCALAR"}]})";
-  write_text(gltf, json.str());
-}
-
 // A river surface of any shape (mesh "River"), as glTF with a .bin.
 inline void write_river_gltf(const std::filesystem::path& gltf, const std::vector<glm::vec3>& points,
                              const std::vector<uint32_t>& indices) {
@@ -92,6 +58,27 @@ inline void write_river_gltf(const std::filesystem::path& gltf, const std::vecto
        << hi.y << "," << hi.z << "]},"
        << R"({"bufferView":1,"componentType":5125,"count":)" << indices.size() << R"(,"type":"SCALAR"}]})";
   write_text(gltf, json.str());
+}
+
+// A straight channel along +Z, `across` vertices per section, width w, as glTF with a .bin;
+// with a `drop` it descends that many metres per metre downstream; its centreline at x = `x`.
+inline void write_channel_gltf(const std::filesystem::path& gltf, int sections, int across,
+                               float width, float spacing, float drop = 0.0f, float x = 0.0f) {
+  std::vector<glm::vec3> positions;
+  for (int k = 0; k < sections; ++k) {
+    for (int j = 0; j < across; ++j) {
+      positions.push_back({x + width * 0.5f - width * static_cast<float>(j) / (across - 1),  // left = +X
+                           -drop * spacing * static_cast<float>(k), spacing * static_cast<float>(k)});
+    }
+  }
+  std::vector<uint32_t> indices;
+  for (int k = 0; k + 1 < sections; ++k) {
+    for (int j = 0; j + 1 < across; ++j) {
+      const uint32_t a = k * across + j, b = a + 1, c = a + across, d = c + 1;
+      indices.insert(indices.end(), {a, c, b, b, c, d});
+    }
+  }
+  write_river_gltf(gltf, positions, indices);
 }
 
 // An axis-aligned box from -half to +half (12 triangles, indexed), as glTF with a .bin.

@@ -5,19 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <glm/geometric.hpp>
 #include <string>
 #include <vector>
 
-#include "run_command.h"
-#include "siviflow/image_files.h"
+#include "captured_flow.h"
 #include "y_laplace_oracle.h"
 
 namespace siviflow::testing {
 namespace {
-
-namespace fs = std::filesystem;
 
 // A straight river 20 m wide and 120 m long, 1 m quads; two tributaries 10 m wide, 30 degrees
 // apart, join at z = -20, the left (+X) bringing 12 m^2/s and the right 8. p = 1 with a search
@@ -32,18 +28,11 @@ constexpr const char* kScene = R"({"version":1,
   "camera":{"fov_y_deg":50.0,"keys":[{"t":0.0,"position":[0.0,100.0,-14.99],"target":[0.0,0.0,-15.0]}]}})";
 
 TEST(ConfluenceCapture, TheCapturedFlowIsTheOraclesWhereTheArmsJoin) {
-  const fs::path dir = fresh_test_dir("confluence_capture");
-  std::ofstream(dir / "scene.json") << kScene;
-  const RunResult run =
-      run_siviflow("capture " + (dir / "scene.json").string() +
-                   " --range 30:31 --size 640x360 --aov flow --validation --out " + dir.string());
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  ExrImage image;
-  ASSERT_TRUE(read_exr((dir / "frame_00030.exr").string(), &image).ok());
-  const std::vector<float>* water = image.find("water.A");
-  const std::vector<float>* fx = image.find("flow.X");
-  const std::vector<float>* fz = image.find("flow.Z");
-  ASSERT_TRUE(water && fx && fz);
+  CapturedFlow captured;
+  ASSERT_TRUE(capture_flow("confluence_capture", kScene, "640x360", &captured));
+  const std::vector<float>* water = captured.water;
+  const std::vector<float>* fx = captured.x;
+  const std::vector<float>* fz = captured.z;
 
   // The oracle's Y has its tip at z = 0.
   test::YShape shape;

@@ -138,11 +138,40 @@ TEST(ExampleScenes, LookPresetColoursTheWater) {
   EXPECT_GT(muddy_ratio, 1.4 * clear_ratio) << muddy_ratio << " against " << clear_ratio;
 }
 
+// A scene seen straight down from 90 m above (0, 0, cz) at 320x180 (screen right +X, down +Z,
+// 2.14 px a metre): frame 150 with the flow and foam AOVs, validated.
+struct FromAbove {
+  ExrImage image;
+  std::vector<bool> water;
+  double cz = 0.0;
+  size_t pixel(double x, double z) const {
+    const double px_per_m = 90.0 / (90.0 * std::tan(25.0 * M_PI / 180.0));
+    const int u = int(std::lround(160.0 + x * px_per_m)), v = int(std::lround(90.0 + (z - cz) * px_per_m));
+    EXPECT_TRUE(u >= 0 && u < 320 && v >= 0 && v < 180) << "(" << x << ", " << z << ") is out of view";
+    return size_t(std::clamp(v, 0, 179)) * 320u + size_t(std::clamp(u, 0, 319));
+  }
+};
+
+bool capture_from_above(Json scene, double cz, const std::string& name, FromAbove* out) {
+  const fs::path dir = fresh_test_dir("examples");
+  scene["camera"] = {{"fov_y_deg", 50.0},
+                     {"keys", {{{"t", 0.0}, {"position", {0.0, 90.0, cz + 0.01}}, {"target", {0.0, 0.0, cz}}}}}};
+  std::ofstream(dir / (name + ".json")) << scene.dump();
+  const RunResult run = run_siviflow("capture " + (dir / (name + ".json")).string() +
+                                     " --range 150:151 --size 320x180 --aov flow,foam --validation --out " +
+                                     dir.string());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  if (run.exit_code != 0 || !read_exr((dir / "frame_00150.exr").string(), &out->image).ok()) return false;
+  out->water = water_of(out->image);
+  out->cz = cz;
+  EXPECT_EQ(out->water.size(), 320u * 180u);
+  return out->water.size() == 320u * 180u;
+}
+
 // The island scene straightened and seen from 90 m above (screen right +X, down +Z, 2.14 px a
 // metre at 320x180): land where the island is, water flowing downstream in both its arms, and foam
 // in the island's wake (the water its tail leaves behind) beyond what mid-river carries above it.
 TEST(ExampleScenes, IslandPartsTheFlowAndLeavesAWake) {
-  const fs::path dir = fresh_test_dir("examples");
   Json scene = read_json(kScenes / "island.json");
   Json& procedural = scene["river"]["procedural"];
   ASSERT_EQ(procedural["islands"].size(), 1u);
@@ -150,23 +179,11 @@ TEST(ExampleScenes, IslandPartsTheFlowAndLeavesAWake) {
   const Json island = procedural["islands"][0];
   const double cz = island["center_z"], offset = island["offset"];
   const double half_length = 0.5 * island["length"].get<double>();
-  scene["camera"] = {{"fov_y_deg", 50.0},
-                     {"keys", {{{"t", 0.0}, {"position", {0.0, 90.0, cz + 0.01}}, {"target", {0.0, 0.0, cz}}}}}};
-  std::ofstream(dir / "above.json") << scene.dump();
-  const RunResult run = run_siviflow("capture " + (dir / "above.json").string() +
-                                     " --range 150:151 --size 320x180 --aov flow,foam --validation --out " +
-                                     dir.string());
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  ExrImage image;
-  ASSERT_TRUE(read_exr((dir / "frame_00150.exr").string(), &image).ok());
-  const std::vector<bool> water = water_of(image);
-  ASSERT_EQ(water.size(), 320u * 180u);
-  const double px_per_m = 90.0 / (90.0 * std::tan(25.0 * M_PI / 180.0));
-  const auto pixel = [&](double x, double z) {
-    const int u = int(std::lround(160.0 + x * px_per_m)), v = int(std::lround(90.0 + (z - cz) * px_per_m));
-    EXPECT_TRUE(u >= 0 && u < 320 && v >= 0 && v < 180) << "(" << x << ", " << z << ") is out of view";
-    return size_t(std::clamp(v, 0, 179)) * 320u + size_t(std::clamp(u, 0, 319));
-  };
+  FromAbove view;
+  ASSERT_TRUE(capture_from_above(scene, cz, "above", &view));
+  const std::vector<bool>& water = view.water;
+  const ExrImage& image = view.image;
+  const auto pixel = [&](double x, double z) { return view.pixel(x, z); };
   const std::vector<float>& flow_z = *image.find("flow.Z");
   const std::vector<float>& foam = *image.find("foam.Y");
   EXPECT_FALSE(water[pixel(offset, cz)]) << "the island's middle is land";
@@ -199,28 +216,15 @@ TEST(ExampleScenes, IslandPartsTheFlowAndLeavesAWake) {
 // down +Z, 2.14 px a metre at 320x180): land on the tongue, water flowing downstream in both
 // tributaries and in the river they make, the wider tributary bringing the more.
 TEST(ExampleScenes, ConfluenceJoinsTwoTributaries) {
-  const fs::path dir = fresh_test_dir("examples");
   Json scene = read_json(kScenes / "confluence.json");
   Json& procedural = scene["river"]["procedural"];
   procedural["meander_amplitude"] = 0.0;
   const double tip = procedural["confluence"]["tip_z"], offset = procedural["confluence"]["offset"];
-  scene["camera"] = {{"fov_y_deg", 50.0},
-                     {"keys", {{{"t", 0.0}, {"position", {0.0, 90.0, tip + 0.01}}, {"target", {0.0, 0.0, tip}}}}}};
-  std::ofstream(dir / "junction.json") << scene.dump();
-  const RunResult run = run_siviflow("capture " + (dir / "junction.json").string() +
-                                     " --range 150:151 --size 320x180 --aov flow,foam --validation --out " +
-                                     dir.string());
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  ExrImage image;
-  ASSERT_TRUE(read_exr((dir / "frame_00150.exr").string(), &image).ok());
-  const std::vector<bool> water = water_of(image);
-  ASSERT_EQ(water.size(), 320u * 180u);
-  const double px_per_m = 90.0 / (90.0 * std::tan(25.0 * M_PI / 180.0));
-  const auto pixel = [&](double x, double z) {
-    const int u = int(std::lround(160.0 + x * px_per_m)), v = int(std::lround(90.0 + (z - tip) * px_per_m));
-    EXPECT_TRUE(u >= 0 && u < 320 && v >= 0 && v < 180) << "(" << x << ", " << z << ") is out of view";
-    return size_t(std::clamp(v, 0, 179)) * 320u + size_t(std::clamp(u, 0, 319));
-  };
+  FromAbove view;
+  ASSERT_TRUE(capture_from_above(scene, tip, "junction", &view));
+  const std::vector<bool>& water = view.water;
+  const ExrImage& image = view.image;
+  const auto pixel = [&](double x, double z) { return view.pixel(x, z); };
   const std::vector<float>& flow_x = *image.find("flow.X");
   const std::vector<float>& flow_z = *image.find("flow.Z");
   // 12 m above the tip the tongue (30 degrees) is 6.4 m wide about the offset; each tributary

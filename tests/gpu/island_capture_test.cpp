@@ -5,20 +5,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <glm/geometric.hpp>
 #include <string>
 #include <vector>
 
+#include "captured_flow.h"
 #include "laplace_oracle.h"
-#include "run_command.h"
-#include "siviflow/image_files.h"
 #include "siviflow/sim/procedural_river.h"
 
 namespace siviflow::testing {
 namespace {
-
-namespace fs = std::filesystem;
 
 // A straight river 20 m wide and 120 m long, 1 m quads, an island 5 m wide and 40 m long 3 m
 // towards the left bank. p = 1 with a search radius far beyond the width: plug flow between the
@@ -31,18 +27,11 @@ constexpr const char* kScene = R"({"version":1,
   "camera":{"fov_y_deg":50.0,"keys":[{"t":0.0,"position":[0.0,90.0,0.01],"target":[0.0,0.0,0.0]}]}})";
 
 TEST(IslandCapture, TheCapturedFlowIsTheOraclesAboutTheIsland) {
-  const fs::path dir = fresh_test_dir("island_capture");
-  std::ofstream(dir / "scene.json") << kScene;
-  const RunResult run =
-      run_siviflow("capture " + (dir / "scene.json").string() +
-                   " --range 30:31 --size 320x180 --aov flow --validation --out " + dir.string());
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  ExrImage image;
-  ASSERT_TRUE(read_exr((dir / "frame_00030.exr").string(), &image).ok());
-  const std::vector<float>* water = image.find("water.A");
-  const std::vector<float>* fx = image.find("flow.X");
-  const std::vector<float>* fz = image.find("flow.Z");
-  ASSERT_TRUE(water && fx && fz);
+  CapturedFlow captured;
+  ASSERT_TRUE(capture_flow("island_capture", kScene, "320x180", &captured));
+  const std::vector<float>* water = captured.water;
+  const std::vector<float>* fx = captured.x;
+  const std::vector<float>* fz = captured.z;
 
   // The oracle, on the very mesh the capture drew.
   ProceduralRiverParams params;

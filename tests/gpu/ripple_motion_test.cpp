@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -270,62 +271,56 @@ TEST_F(RippleMotionTest, FlowMapRipplesMoveWithTheFlow) {
   expect_moves_with_the_flow("flow map", measure(WaterMaterial::kFlowMap));
 }
 
-// An island in mid-stream parts the flow (the boulder moved far downstream, out of view): the
-// ripples go where the flow goes in both its arms and where the flow turns at its head and tail.
-TEST_F(RippleMotionTest, RipplesFollowTheFlowAroundAnIsland) {
-  const ProceduralIsland island{3.0f, 0.0f, 10.0f, 3.0f};  // z from -2 to 8, x from -1.5 to 1.5
-  const std::vector<Motion> all =
-      render_motions(WaterMaterial::kTiledDirectionalFlow, {0.0f, 0.0f, 50.0f}, {island});
-  std::vector<double> angles, ratios, turning;
-  size_t left = 0, right = 0;
+// Ripples measured over a river part (an island, a junction): printed, and held to following
+// the flow: over 10 windows on each side (`left`, `right`) and in `focus` (where the flow turns),
+// the median angular error at most 10 degrees (15 in the focus), the median speed ratio 1 +- 0.2.
+void expect_ripples_follow(const std::vector<Motion>& all, const char* where,
+                           const std::function<bool(glm::vec2)>& left,
+                           const std::function<bool(glm::vec2)>& right,
+                           const std::function<bool(glm::vec2)>& focus, const char* focus_name) {
+  std::vector<double> angles, ratios, focused;
+  size_t on_left = 0, on_right = 0;
   for (const Motion& m : all) {
     const double angle = degrees_apart(m.measured, m.expected);
     angles.push_back(angle);
     ratios.push_back(glm::length(m.measured) / glm::length(m.expected));
-    const bool beside = m.at.y > -2.0f && m.at.y < 8.0f;
-    left += beside && m.at.x > 1.5f ? 1 : 0;
-    right += beside && m.at.x < -1.5f ? 1 : 0;
-    if (std::abs(m.at.y + 2.0f) < 2.0f || std::abs(m.at.y - 8.0f) < 2.0f) turning.push_back(angle);
+    on_left += left(m.at) ? 1 : 0;
+    on_right += right(m.at) ? 1 : 0;
+    if (focus(m.at)) focused.push_back(angle);
   }
-  std::printf(
-      "around the island: %zu windows (%zu left of it, %zu right), median angular error "
-      "%.1f deg, median speed ratio %.2f; %zu at its head and tail, %.1f deg\n",
-      angles.size(), left, right, median(angles), median(ratios), turning.size(), median(turning));
-  EXPECT_GT(left, 10u);
-  EXPECT_GT(right, 10u);
-  EXPECT_GT(turning.size(), 10u);
+  std::printf("%s: %zu windows (%zu on the left, %zu on the right), median angular error %.1f deg, "
+              "median speed ratio %.2f; %zu %s, %.1f deg\n",
+              where, angles.size(), on_left, on_right, median(angles), median(ratios), focused.size(),
+              focus_name, median(focused));
+  EXPECT_GT(on_left, 10u);
+  EXPECT_GT(on_right, 10u);
+  EXPECT_GT(focused.size(), 10u);
   EXPECT_LE(median(angles), 10.0);
   EXPECT_NEAR(median(ratios), 1.0, 0.2);
-  EXPECT_LE(median(turning), 15.0);
+  EXPECT_LE(median(focused), 15.0);
+}
+
+// An island in mid-stream parts the flow (the boulder moved far downstream, out of view): the
+// ripples go where the flow goes in both its arms and where the flow turns at its head and tail.
+TEST_F(RippleMotionTest, RipplesFollowTheFlowAroundAnIsland) {
+  const ProceduralIsland island{3.0f, 0.0f, 10.0f, 3.0f};  // z from -2 to 8, x from -1.5 to 1.5
+  expect_ripples_follow(
+      render_motions(WaterMaterial::kTiledDirectionalFlow, {0.0f, 0.0f, 50.0f}, {island}),
+      "around the island", [](glm::vec2 at) { return at.y > -2.0f && at.y < 8.0f && at.x > 1.5f; },
+      [](glm::vec2 at) { return at.y > -2.0f && at.y < 8.0f && at.x < -1.5f; },
+      [](glm::vec2 at) { return std::abs(at.y + 2.0f) < 2.0f || std::abs(at.y - 8.0f) < 2.0f; },
+      "at its head and tail");
 }
 
 // Two tributaries, 30 degrees apart, join at z = 0 (the channel's 12 m split 6 and 6 above it):
 // the ripples in each tributary, in the river below and where they meet follow the flow.
 TEST_F(RippleMotionTest, RipplesFollowTheFlowWhereTwoTributariesJoin) {
   const ProceduralConfluence confluence{0.0f, 0.0f, 30.0f};
-  const std::vector<Motion> all =
-      render_motions(WaterMaterial::kTiledDirectionalFlow, {0.0f, 0.0f, 50.0f}, {}, confluence);
-  std::vector<double> angles, ratios, junction;
-  size_t left = 0, right = 0;
-  for (const Motion& m : all) {
-    const double angle = degrees_apart(m.measured, m.expected);
-    angles.push_back(angle);
-    ratios.push_back(glm::length(m.measured) / glm::length(m.expected));
-    left += m.at.y < -0.5f && m.at.x > 0.5f ? 1 : 0;
-    right += m.at.y < -0.5f && m.at.x < -0.5f ? 1 : 0;
-    if (m.at.y > -1.0f && m.at.y < 3.0f) junction.push_back(angle);
-  }
-  std::printf(
-      "where two tributaries join: %zu windows (%zu in the left tributary, %zu in the right), "
-      "median angular error %.1f deg, median speed ratio %.2f; %zu within 3 m below the tip, "
-      "%.1f deg\n",
-      angles.size(), left, right, median(angles), median(ratios), junction.size(), median(junction));
-  EXPECT_GT(left, 10u);
-  EXPECT_GT(right, 10u);
-  EXPECT_GT(junction.size(), 10u);
-  EXPECT_LE(median(angles), 10.0);
-  EXPECT_NEAR(median(ratios), 1.0, 0.2);
-  EXPECT_LE(median(junction), 15.0);
+  expect_ripples_follow(
+      render_motions(WaterMaterial::kTiledDirectionalFlow, {0.0f, 0.0f, 50.0f}, {}, confluence),
+      "where two tributaries join", [](glm::vec2 at) { return at.y < -0.5f && at.x > 0.5f; },
+      [](glm::vec2 at) { return at.y < -0.5f && at.x < -0.5f; },
+      [](glm::vec2 at) { return at.y > -1.0f && at.y < 3.0f; }, "within 3 m below the tip");
 }
 
 }  // namespace

@@ -167,6 +167,15 @@ inline double vertex_flux(const StreamFunction& flow, size_t k) {
   return flux;
 }
 
+// How many nodes' psi or velocity differ between two solves of one river.
+inline size_t nodes_that_differ(const StreamFunction& a, const StreamFunction& b) {
+  size_t differ = 0;
+  for (size_t n = 0; n < a.node_psi().size(); ++n) {
+    differ += a.node_psi()[n] != b.node_psi()[n] || a.node_velocity()[n] != b.node_velocity()[n];
+  }
+  return differ;
+}
+
 // A triangle holding both nodes (an edge), preferring the one downstream of section k.
 inline uint32_t triangle_on_edge(const RiverSurface& s, uint32_t a, uint32_t b) {
   uint32_t found = UINT32_MAX;
