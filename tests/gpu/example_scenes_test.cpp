@@ -138,24 +138,24 @@ TEST(ExampleScenes, LookPresetColoursTheWater) {
   EXPECT_GT(muddy_ratio, 1.4 * clear_ratio) << muddy_ratio << " against " << clear_ratio;
 }
 
-// A scene seen straight down from 90 m above (0, 0, cz) at 320x180 (screen right +X, down +Z,
+// A scene seen straight down from 90 m above (cx, 0, cz) at 320x180 (screen right +X, down +Z,
 // 2.14 px a metre): frame 150 with the flow and foam AOVs, validated.
 struct FromAbove {
   ExrImage image;
   std::vector<bool> water;
-  double cz = 0.0;
+  double cx = 0.0, cz = 0.0;
   size_t pixel(double x, double z) const {
     const double px_per_m = 90.0 / (90.0 * std::tan(25.0 * M_PI / 180.0));
-    const int u = int(std::lround(160.0 + x * px_per_m)), v = int(std::lround(90.0 + (z - cz) * px_per_m));
+    const int u = int(std::lround(160.0 + (x - cx) * px_per_m)), v = int(std::lround(90.0 + (z - cz) * px_per_m));
     EXPECT_TRUE(u >= 0 && u < 320 && v >= 0 && v < 180) << "(" << x << ", " << z << ") is out of view";
     return size_t(std::clamp(v, 0, 179)) * 320u + size_t(std::clamp(u, 0, 319));
   }
 };
 
-bool capture_from_above(Json scene, double cz, const std::string& name, FromAbove* out) {
+bool capture_from_above(Json scene, double cz, const std::string& name, FromAbove* out, double cx = 0.0) {
   const fs::path dir = fresh_test_dir("examples");
   scene["camera"] = {{"fov_y_deg", 50.0},
-                     {"keys", {{{"t", 0.0}, {"position", {0.0, 90.0, cz + 0.01}}, {"target", {0.0, 0.0, cz}}}}}};
+                     {"keys", {{{"t", 0.0}, {"position", {cx, 90.0, cz + 0.01}}, {"target", {cx, 0.0, cz}}}}}};
   std::ofstream(dir / (name + ".json")) << scene.dump();
   const RunResult run = run_siviflow("capture " + (dir / (name + ".json")).string() +
                                      " --range 150:151 --size 320x180 --aov flow,foam --validation --out " +
@@ -163,6 +163,7 @@ bool capture_from_above(Json scene, double cz, const std::string& name, FromAbov
   EXPECT_EQ(run.exit_code, 0) << run.output;
   if (run.exit_code != 0 || !read_exr((dir / "frame_00150.exr").string(), &out->image).ok()) return false;
   out->water = water_of(out->image);
+  out->cx = cx;
   out->cz = cz;
   EXPECT_EQ(out->water.size(), 320u * 180u);
   return out->water.size() == 320u * 180u;
@@ -239,6 +240,25 @@ TEST(ExampleScenes, ConfluenceJoinsTwoTributaries) {
   // Each tributary runs towards the junction: the left one (+X) towards -X, the right towards +X.
   EXPECT_LT(flow_x[pixel(offset + half + 4.5, tip - 12.0)], 0.0f);
   EXPECT_GT(flow_x[pixel(offset - half - 7.5, tip - 12.0)], 0.0f);
+}
+
+// The glTF fork seen from above where it parts: an island in mid-river above, water flowing
+// downstream (+Z) in both arms, the left arm (12 m^2/s of its ends' 18) about twice as fast as the
+// right (6), both 6 m wide.
+TEST(ExampleScenes, GltfForkPartsTheFlowAsItsEndsSay) {
+  Json scene = read_json(kScenes / "gltf_fork.json");
+  scene["river"]["gltf"] = (kScenes / scene["river"]["gltf"].get<std::string>()).string();
+  FromAbove view;
+  ASSERT_TRUE(capture_from_above(scene, 0.0, "fork", &view, -60.0));
+  const auto pixel = [&](double x, double z) { return view.pixel(x, z); };
+  const std::vector<float>& flow_z = *view.image.find("flow.Z");
+  EXPECT_FALSE(view.water[pixel(-60.0, -30.0)]) << "the island";
+  EXPECT_FALSE(view.water[pixel(-60.0, 16.0)]) << "the land between the arms";
+  // Mid-arm, 16 m past the fork: each arm is 6 m wide, drawn apart 4 m either side.
+  const float left = flow_z[pixel(-60.0 + 4.0 + 3.0, 16.0)], right = flow_z[pixel(-60.0 - 4.0 - 3.0, 16.0)];
+  EXPECT_TRUE(view.water[pixel(-53.0, 16.0)] && view.water[pixel(-67.0, 16.0)]);
+  EXPECT_GT(right, 0.3f);
+  EXPECT_NEAR(left / right, 2.0, 0.3) << "left " << left << ", right " << right;
 }
 
 }  // namespace

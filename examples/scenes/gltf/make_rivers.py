@@ -5,6 +5,9 @@ cross-section, vertex 0 on the left bank of the upstream section, the water leve
 
   Bend     a river 10 m wide swinging 8 m either side of x = 0 over 120 m along +Z
   Channel  a straight channel 9 m wide along +Z at x = 40 m, beside it
+  Fork     a river 12 m wide along +Z at x = -60 m, from z = -60 parting at z = 0 into two arms
+           6 m wide that draw apart 0.25 m a metre each, the left one 50 m long and the right 36;
+           a rectangular island 1.5 m wide and 12 m long in mid-river above the fork
 
 Run it again after changing a number here; the committed files are its output.
 """
@@ -44,10 +47,47 @@ def strip(length, width, centre):
     return positions, indices
 
 
+def fork():
+    """A river parting into two arms (its rows square to +Z), the island's quads left out."""
+    x0, width, spread, across = -60.0, 12.0, 0.25, 8  # across: quads across each arm
+    positions, indices = [], []
+
+    def row(z, left, right, cells):
+        first = len(positions)
+        for j in range(cells + 1):
+            positions.append((left + (right - left) * j / cells, 0.0, z))
+        return list(range(first, first + cells + 1))
+
+    def zip_rows(a, b, skip=lambda j: False):
+        for j in range(len(a) - 1):
+            if not skip(j):
+                indices.extend([a[j], a[j + 1], b[j], a[j + 1], b[j + 1], b[j]])
+
+    half = 0.5 * width
+    rows = [row(-60.0 + SPACING * k, x0 + half, x0 - half, 2 * across) for k in range(31)]
+    for k in range(30):  # the island: quads 7 and 8 across, rows 12 to 17 (z -36 to -24)
+        zip_rows(rows[k], rows[k + 1], lambda j, k=k: 12 <= k < 18 and j in (7, 8))
+    tip = rows[-1]
+    for side, length in ((0, 50.0), (1, 36.0)):
+        prev = tip[:across + 1] if side == 0 else tip[across:]
+        for k in range(1, int(round(length / SPACING)) + 1):
+            z = SPACING * k
+            shift = spread * z * (1 if side == 0 else -1)
+            left = x0 + (half if side == 0 else 0.0) + shift
+            nxt = row(z, left, left - half, across)
+            zip_rows(prev, nxt)
+            prev = nxt
+    # The island's inner vertices belong to no triangle: drop them.
+    used = sorted(set(indices))
+    new_index = {old: new for new, old in enumerate(used)}
+    return [positions[i] for i in used], [new_index[i] for i in indices]
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     meshes = [("Bend", strip(120.0, 10.0, bend_centre)),
-              ("Channel", strip(120.0, 9.0, lambda z: 40.0))]
+              ("Channel", strip(120.0, 9.0, lambda z: 40.0)),
+              ("Fork", fork())]
     blob = bytearray()
     gltf = {"asset": {"version": "2.0", "generator": "examples/scenes/gltf/make_rivers.py"},
             "scene": 0, "scenes": [{"nodes": list(range(len(meshes)))}],
