@@ -82,7 +82,7 @@ FlowParams river_flow_params(const RiverFlowParams& flow, const RiverInput& inpu
 
 RiverSurfaceOptions river_surface_options(std::span<const WaterRiverEnd> ends) {
   RiverSurfaceOptions options;
-  for (const WaterRiverEnd& end : ends) options.ends.push_back({end.vertex, end.inflow});
+  for (const WaterRiverEnd& end : ends) options.ends.push_back({end.vertex, end.inflow, end.at_point, end.point});
   return options;
 }
 

@@ -122,6 +122,8 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
   net.layer = layers_with_free_edges(adj, root, across);
   for (const uint32_t l : net.layer) net.max_layer = std::max(net.max_layer, l);
   const std::vector<uint32_t>& layer = net.layer;
+  // Messages count sections from upstream, as the surface does (a confluence's root is downstream).
+  auto section_of = [&](uint32_t l) { return sides.root_is_inflow ? l : net.max_layer - l; };
 
   for (size_t t = 0; t < tris.size() / 3; ++t) {
     const uint32_t a = tris[3 * t], b = tris[3 * t + 1], c = tris[3 * t + 2];
@@ -131,7 +133,7 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
           "inside section %u instead of joining two neighbouring sections (where arms meet, "
           "they meet at a shallow angle, their sections turning gradually)",
           t, vertex_name(mesh, a).c_str(), vertex_name(mesh, b).c_str(),
-          vertex_name(mesh, c).c_str(), layer[a]));
+          vertex_name(mesh, c).c_str(), section_of(layer[a])));
     }
   }
   for (size_t i = 0; i < side_count; ++i) {
@@ -145,7 +147,7 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
             "vertex %s",
             vertex_name(mesh, end.front()).c_str(), vertex_name(mesh, end.back()).c_str(),
             vertex_name(mesh, end.front()).c_str(), vertex_name(mesh, n).c_str(),
-            layer[end.front()], layer[n], layer[end.front()], layer[n],
+            section_of(layer[end.front()]), section_of(layer[n]), layer[end.front()], layer[n],
             vertex_name(mesh, root.front()).c_str()));
       }
     }
@@ -166,13 +168,13 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
       return Status::error(text_format(
           "the river network is not made of sections: section %u branches at vertex %s (%u "
           "neighbours in the same section)",
-          layer[n], vertex_name(mesh, n).c_str(), count));
+          section_of(layer[n]), vertex_name(mesh, n).c_str(), count));
     }
     if (count < 2) {
       return Status::error(text_format(
           "the river network is not made of sections: section %u stops at vertex %s in the "
           "water (a section runs from one border to another)",
-          layer[n], vertex_name(mesh, n).c_str()));
+          section_of(layer[n]), vertex_name(mesh, n).c_str()));
     }
   }
   const std::vector<glm::dvec2> grad = layer_gradients(mesh, layer);
@@ -201,7 +203,7 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
         failed = Status::error(text_format(
             "the river network is not made of sections: section %u meets one border twice, at "
             "vertices %s and %s (a bay?): each section runs from one border to another",
-            layer[b], vertex_name(mesh, b).c_str(), vertex_name(mesh, cur).c_str()));
+            section_of(layer[b]), vertex_name(mesh, b).c_str(), vertex_name(mesh, cur).c_str()));
         return;
       }
       glm::dvec2 g(0.0);
@@ -213,7 +215,7 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
         failed = Status::error(text_format(
             "cannot tell left from right in section %u of the river network: from vertex %s to "
             "vertex %s it does not run across the flow",
-            layer[b], vertex_name(mesh, path.front()).c_str(),
+            section_of(layer[b]), vertex_name(mesh, path.front()).c_str(),
             vertex_name(mesh, path.back()).c_str()));
         return;
       }
@@ -235,7 +237,7 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
       return Status::error(text_format(
           "the river network is not made of sections: section %u has a ring of vertices (vertex "
           "%s among them) that meets no border",
-          layer[n], vertex_name(mesh, n).c_str()));
+          section_of(layer[n]), vertex_name(mesh, n).c_str()));
     }
   }
   std::stable_sort(net.segments.begin(), net.segments.end(),

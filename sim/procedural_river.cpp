@@ -345,7 +345,8 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
   if (params_.confluence) {
     // Above the tip each section has two arms: from the left bank to the tongue, and from the
     // tongue to the right bank, the banks and the tongue's shores parted by its half-width.
-    const uint32_t j_tip = tongue_vertex(params_, frames[tip].half_width);
+    // The tongue's vertex as the terrain has it (the constructor's, from the width at tip_z).
+    const uint32_t j_tip = static_cast<uint32_t>(std::lround(0.5 * (1.0 - tongue_fraction_) * double(across - 1)));
     std::vector<uint32_t> prev_left(across), prev_right;
     std::iota(prev_left.begin(), prev_left.end(), 0u);  // the tip's section, first in the grid
     prev_right.assign(prev_left.begin() + j_tip, prev_left.end());

@@ -54,6 +54,11 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
   }
   std::string corner_names;
   for (const size_t c : corners) corner_names += (corner_names.empty() ? "" : ", ") + name(w.loop[c]);
+  if (!options.ends.empty() && corners.size() <= 4) {
+    return Status::error(text_format(
+        "ends: %zu ends are named, but the river mesh has 2 (a strip: its corners are at vertices %s)",
+        options.ends.size(), corner_names.c_str()));
+  }
   if (corners.size() < 6 || corners.size() % 2 != 0) {
     return Status::error(text_format(
         "the river mesh is neither a strip nor a network: its outer border has %zu corners "
@@ -69,45 +74,65 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
   NetworkSides sides;
   sides.sides = sides_between(w.loop, corners);
   const size_t side_count = sides.sides.size();
-  // Where each named end lies: the sides holding its vertex (two at a corner).
+  // Where each named end lies: the sides holding its vertex (two at a corner), or the end side
+  // nearest its point.
   std::vector<uint32_t> mark_node;
   for (size_t m = 0; m < options.ends.size(); ++m) {
     const uint32_t v = options.ends[m].vertex;
-    if (v >= w.vertex_count) {
+    if (!options.ends[m].at_point && v >= w.vertex_count) {
       return Status::error(text_format("ends[%zu]: vertex %u is not in the river mesh (%zu vertices)",
                                        m, v, w.vertex_count));
     }
-    mark_node.push_back(w.node_of_vertex[v]);
+    mark_node.push_back(options.ends[m].at_point ? kNoNode : w.node_of_vertex[v]);
   }
-  const uint32_t upstream_node = w.node_of_vertex[options.upstream_vertex];
+  // Without named ends, build() has checked the upstream vertex; with them it is not read.
+  const uint32_t upstream_node = options.ends.empty() ? w.node_of_vertex[options.upstream_vertex] : kNoNode;
+  auto distance_to = [&](const std::vector<uint32_t>& side, const glm::vec3& point) {
+    double d = std::numeric_limits<double>::max();
+    for (const uint32_t n : side) d = std::min(d, glm::distance(DVec3(pos[n]), DVec3(point)));
+    return d;
+  };
   // With the ends on the even or the odd sides: which side each mark (or the upstream vertex)
-  // names, or an empty answer where one lies on no end or two share one.
-  auto ends_named = [&](size_t parity, size_t* bad_mark) {
+  // names, or an empty answer where one lies on no end or two share one; `far` sums how far the
+  // named points lie from their ends.
+  auto ends_named = [&](size_t parity, size_t* bad_mark, double* far, size_t* matched) {
     const std::vector<uint32_t> wanted =
         options.ends.empty() ? std::vector<uint32_t>{upstream_node} : mark_node;
     std::vector<size_t> side_of(wanted.size(), SIZE_MAX);
+    *far = 0.0;
+    *matched = 0;
     for (size_t m = 0; m < wanted.size(); ++m) {
+      size_t best = SIZE_MAX;
+      double best_d = std::numeric_limits<double>::max();
       for (size_t i = parity; i < side_count; i += 2) {
         const auto& side = sides.sides[i];
-        if (std::find(side.begin(), side.end(), wanted[m]) == side.end()) continue;
-        if (std::find(side_of.begin(), side_of.end(), i) != side_of.end()) break;  // taken
-        side_of[m] = i;
-        break;
+        const double d = wanted[m] == kNoNode
+                             ? distance_to(side, options.ends[m].point)
+                             : (std::find(side.begin(), side.end(), wanted[m]) != side.end() ? 0.0 : best_d);
+        if (d < best_d) {
+          best_d = d;
+          best = i;
+        }
       }
-      if (side_of[m] == SIZE_MAX) {
-        *bad_mark = m;
-        return std::vector<size_t>();
+      if (best == SIZE_MAX || std::find(side_of.begin(), side_of.end(), best) != side_of.end()) {
+        if (*bad_mark == SIZE_MAX) *bad_mark = m;
+        continue;
       }
+      side_of[m] = best;
+      *far += best_d;
+      ++*matched;
     }
-    return side_of;
+    return *bad_mark == SIZE_MAX ? side_of : std::vector<size_t>();
   };
   auto end_length = [&](size_t parity) {
     double len = 0.0;
     for (size_t i = parity; i < side_count; i += 2) len += path_length(pos, sides.sides[i]);
     return len;
   };
-  size_t bad[2] = {0, 0};
-  const std::vector<size_t> named[2] = {ends_named(0, &bad[0]), ends_named(1, &bad[1])};
+  size_t bad[2] = {SIZE_MAX, SIZE_MAX}, matched[2] = {0, 0};
+  double far[2] = {0.0, 0.0};
+  const std::vector<size_t> named[2] = {ends_named(0, &bad[0], &far[0], &matched[0]),
+                                        ends_named(1, &bad[1], &far[1], &matched[1])};
   size_t parity = 0;
   if (named[0].empty() && named[1].empty()) {
     if (options.ends.empty()) {
@@ -116,13 +141,21 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
           "ends run between the corners at vertices %s)",
           options.upstream_vertex, corner_names.c_str()));
     }
-    const size_t m = bad[0];
+    const size_t m = bad[matched[1] > matched[0] ? 1 : 0];  // the way more marks agree with
+    const RiverEndMark& mark = options.ends[m];
     return Status::error(text_format(
-        "ends[%zu]: vertex %u is not on an end of the river mesh, or shares its end with another "
+        "ends[%zu]: %s is not on an end of the river mesh, or shares its end with another "
         "(the ends run between the corners at vertices %s)",
-        m, options.ends[m].vertex, corner_names.c_str()));
+        m, mark.at_point ? text_format("the end nearest (%g, %g, %g)", mark.point.x, mark.point.y, mark.point.z).c_str()
+                         : text_format("vertex %u", mark.vertex).c_str(),
+        corner_names.c_str()));
   }
-  if (named[0].empty() || (!named[1].empty() && end_length(1) < end_length(0))) parity = 1;
+  // Both ways work: the one nearer the named points, else with the shorter ends (a river is
+  // longer than it is wide).
+  if (named[0].empty() ||
+      (!named[1].empty() && (far[1] != far[0] ? far[1] < far[0] : end_length(1) < end_length(0)))) {
+    parity = 1;
+  }
   const std::vector<size_t>& side_of_mark = named[parity];
   sides.is_end.assign(side_count, 0);
   for (size_t i = parity; i < side_count; i += 2) sides.is_end[i] = 1;
@@ -159,6 +192,11 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
 
   // --- Border ids: the root end's left and right banks, the islands, the other banks.
   const size_t island_count = w.island_loops.size();
+  if (island_count + net.bank_count > size_t{std::numeric_limits<BorderId>::max()}) {
+    return Status::error(text_format(
+        "the river network has %zu islands and %u banks, more borders than the limit of %u",
+        island_count, net.bank_count, unsigned{std::numeric_limits<BorderId>::max()}));
+  }
   const auto root_segment = std::find_if(net.segments.begin(), net.segments.end(),
                                          [](const ArmSegment& s) { return s.layer == 0; });
   std::vector<BorderId> border_id(net.bank_count + island_count);

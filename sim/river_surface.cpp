@@ -224,6 +224,13 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     return Status::error("ends: a single end is named, where a river has at least two");
   }
   for (size_t m = 0; m < options.ends.size(); ++m) {
+    if (options.ends[m].at_point) {
+      const glm::vec3& p = options.ends[m].point;
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        return Status::error(text_format("ends[%zu]: the point (%g, %g, %g) is not finite", m, p.x, p.y, p.z));
+      }
+      continue;
+    }
     if (options.ends[m].vertex >= vertex_count) {
       return Status::error(text_format("ends[%zu]: vertex %u is not in the river mesh (%zu vertices)",
                                        m, options.ends[m].vertex, vertex_count));
@@ -238,7 +245,12 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     upstream_vertex = options.ends[options.ends[0].inflow ? 0 : 1].vertex;
   }
   const bool read_upstream = options.ends.size() <= 2;
-  if (read_upstream && upstream_vertex >= vertex_count) {
+  // A strip's inflow named by a point: the border's vertex nearest it (found with the border).
+  const RiverEndMark* upstream_point = nullptr;
+  if (options.ends.size() == 2 && options.ends[options.ends[0].inflow ? 0 : 1].at_point) {
+    upstream_point = &options.ends[options.ends[0].inflow ? 0 : 1];
+  }
+  if (read_upstream && upstream_point == nullptr && upstream_vertex >= vertex_count) {
     return Status::error(text_format("the upstream vertex %u is not in the river mesh (%zu vertices)",
                                      upstream_vertex, vertex_count));
   }
@@ -404,6 +416,23 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   if (std::find(on_border.begin(), on_border.end(), 1) == on_border.end()) {
     return Status::error("the river mesh is closed (it has no border): a river is an open strip");
   }
+  // The border node nearest a point (none off the border).
+  auto nearest_border_node = [&](const glm::vec3& point) {
+    uint32_t best = kNoNode;
+    double best_d = std::numeric_limits<double>::max();
+    for (uint32_t n = 0; n < node_count; ++n) {
+      const double d = on_border[n] ? glm::distance(to_d(pos[n]), to_d(point)) : best_d;
+      if (d < best_d) {
+        best_d = d;
+        best = n;
+      }
+    }
+    return best;
+  };
+  if (upstream_point != nullptr) {
+    const uint32_t n = nearest_border_node(upstream_point->point);
+    if (n != kNoNode) upstream_vertex = node_vertex[n];
+  }
   const uint32_t upstream_node = read_upstream ? node_of_vertex[upstream_vertex] : kNoNode;
   if (read_upstream && !on_border[upstream_node]) {
     return Status::error(text_format(
@@ -415,7 +444,10 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   std::vector<std::vector<uint32_t>> island_loops;
   {
     // With named ends: the outer border is the one that holds the first.
-    const uint32_t first_end_node = read_upstream ? kNoNode : node_of_vertex[options.ends[0].vertex];
+    const uint32_t first_end_node =
+        read_upstream ? kNoNode
+        : options.ends[0].at_point ? nearest_border_node(options.ends[0].point)
+                                   : node_of_vertex[options.ends[0].vertex];
     auto is_outer_loop = [&](const std::vector<uint32_t>& walked) {
       return std::find(walked.begin(), walked.end(), first_end_node) != walked.end();
     };
@@ -443,7 +475,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
         island_loops.push_back(std::move(walked));
       }
     }
-    if (loop.empty()) {
+    if (loop.empty()) {  // only a named vertex can miss the border
       return Status::error(text_format(
           "ends[0]: vertex %u is not on the border of the river mesh, so not on an end",
           options.ends[0].vertex));
@@ -548,7 +580,9 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
       const Status network = build_network(welded, options, out);
       if (network.ok()) return network;
       return Status::error(as_strip + "; nor is it a network of " + std::to_string(sharp / 2) +
-                           " ends: " + network.message());
+                           " ends with vertex " + std::to_string(upstream_vertex) +
+                           "'s the only inflow: " + network.message() +
+                           " (a confluence takes its ends named, each an inflow or an outflow)");
     }
     if (sharp >= 6) {
       return Status::error(text_format(
@@ -698,11 +732,16 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     s.ends_.push_back(end);
   }
   for (size_t m = 0; m < options.ends.size(); ++m) {
-    if (!options.ends[m].inflow && s.node_section_[node_of_vertex[options.ends[m].vertex]] != section_count - 1) {
+    const RiverEndMark& mark = options.ends[m];
+    if (mark.inflow) continue;
+    const uint32_t n = mark.at_point ? nearest_border_node(mark.point) : node_of_vertex[mark.vertex];
+    if (s.node_section_[n] != section_count - 1) {
       return Status::error(text_format(
-          "ends[%zu]: vertex %u is not on the downstream end of the river (the end across from "
-          "the inflow at vertex %u)",
-          m, options.ends[m].vertex, upstream_vertex));
+          "ends[%zu]: %s is not on the downstream end of the river (the end across from the "
+          "inflow at vertex %u)",
+          m, mark.at_point ? text_format("the border's vertex %u nearest (%g, %g, %g)", node_vertex[n], mark.point.x, mark.point.y, mark.point.z).c_str()
+                           : text_format("vertex %u", mark.vertex).c_str(),
+          upstream_vertex));
     }
   }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <string>
 #include <memory>
 #include <utility>
@@ -233,29 +232,17 @@ WaterObstacle water_obstacle(const Obstacle& obstacle) {
   return out;
 }
 
-// The scene's ends of a river on its mesh: a point's end is the one holding the vertex nearest
-// it. Errors name the key.
+// The scene's ends of a river on its mesh (a point names the end nearest it). Errors name the key.
 Status resolve_ends(const SceneRiver& river, std::span<const glm::vec3> positions,
                     std::vector<WaterRiverEnd>* out) {
   out->clear();
   for (size_t i = 0; i < river.ends.size(); ++i) {
     const SceneRiverEnd& end = river.ends[i];
-    WaterRiverEnd placed{end.vertex, end.inflow, end.discharge};
     if (end.by_vertex && end.vertex >= positions.size()) {
       return Status::error(text_format("%s.ends[%zu].vertex: %u is not in the river mesh (%zu vertices)",
                                        river.key.c_str(), i, end.vertex, positions.size()));
     }
-    if (!end.by_vertex) {
-      double nearest = std::numeric_limits<double>::max();
-      for (uint32_t v = 0; v < positions.size(); ++v) {
-        const double d = glm::distance(glm::dvec3(positions[v]), glm::dvec3(end.near));
-        if (d < nearest) {
-          nearest = d;
-          placed.vertex = v;
-        }
-      }
-    }
-    out->push_back(placed);
+    out->push_back({end.vertex, end.inflow, end.discharge, !end.by_vertex, end.near});
   }
   return Status::success();
 }

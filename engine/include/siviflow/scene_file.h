@@ -96,7 +96,7 @@ inline constexpr uint32_t kDefaultRenderSeed = 1;
 struct SceneRiverEnd {
   bool by_vertex = true;
   uint32_t vertex = 0;      // by_vertex: the river mesh's vertex
-  glm::vec3 near{0.0f};     // else: the end holding the mesh vertex nearest this point
+  glm::vec3 near{0.0f};     // else: the end nearest this point
   bool inflow = true;
   float discharge = 0.0f;   // m^2/s, >= 0
 };

@@ -43,11 +43,14 @@ struct RiverFlowParams {
   float search_radius = 0.0f; // s in metres; 0: 3 x the widest section
 };
 
-// One open end of a river (where water enters or leaves), named by any vertex on it.
+// One open end of a river (where water enters or leaves), named by any vertex on it, or as the
+// end nearest a point.
 struct WaterRiverEnd {
   uint32_t vertex = 0;
   bool inflow = true;
   float discharge = 0.0f;  // m^2/s through it, >= 0; the ends balance (in = out)
+  bool at_point = false;   // the end nearest `point` (river space), not the one holding `vertex`
+  glm::vec3 point{0.0f};
 };
 
 struct WaterRiver {

@@ -35,10 +35,13 @@ namespace siviflow {
 // Which margin a vertex lies on. The values are those of the `bank` column of `siviflow flow`.
 enum class Bank : int8_t { kLeft = -1, kNone = 0, kRight = 1 };
 
-// One end of the river named by the caller: a vertex on it, and which way the water crosses it.
+// One end of the river named by the caller: a vertex on it (or the end nearest a point), and
+// which way the water crosses it.
 struct RiverEndMark {
   uint32_t vertex = 0;
   bool inflow = true;
+  bool at_point = false;   // the end nearest `point` instead of the one holding `vertex`
+  glm::vec3 point{0.0f};
 };
 
 struct RiverSurfaceOptions {
