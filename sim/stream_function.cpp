@@ -115,7 +115,7 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
   };
   for (size_t i = 0; i < s.islands().size(); ++i) add_tangents(s.island_nodes(i), true);
   for (size_t b = 0; b < s.banks().size(); ++b) add_tangents(s.bank_nodes(b), false);
-  f.find_tips();
+  f.find_junctions();
   std::sort(f.shore_tangent_.begin(), f.shore_tangent_.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
 
@@ -209,62 +209,33 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
   };
   const double psi = interpolate(dl, psi_left, dr, psi_right);
 
-  // Beyond a tongue's tip the streamline parting its arms leaves from the tip: the field as if
-  // the tongue went on (a divider where the tip is across the river, at the tongue's psi),
-  // giving way to the plain one with the distance from the tip (river_tuning.h).
-  for (const Tip& tip : tips_) {
-    if (tip.left != left || tip.right != right) continue;
-    const double x = std::abs(double{surface_.sections()[surface_.node_section()[n]].along} - tip.along);
+  // Beyond a junction the streamlines parting its arms leave from its tips: the field as if the
+  // tongues went on (a divider at each tip's place across the river, at its tongue's psi),
+  // giving way to the plain one with the distance from the tips (river_tuning.h).
+  for (const Junction& junction : junctions_) {
+    if (junction.left != left || junction.right != right) continue;
+    const double x = std::abs(double{surface_.sections()[surface_.node_section()[n]].along} - junction.along);
     const double width = double{surface_.node_d_left()[n]} + surface_.node_d_right()[n];
     const double g = std::exp(-kTipRelaxationRoot * std::sqrt(x / width) - kTipRelaxationLinear * x / width) *
                      blend(1.0 - x / (kTipReachWidths * width));
     if (g <= 0.0) continue;
-    const double arc = surface_.node_d_left()[n], divider = tip.fraction * width;
-    const double parted = arc < divider ? interpolate(dl, psi_left, divider - arc, tip.psi)
-                                        : interpolate(arc - divider, tip.psi, dr, psi_right);
-    return psi + g * (parted - psi);
-  }
-  return psi;
-}
-
-void StreamFunction::find_tips() {
-  const RiverSurface& s = surface_;
-  if (!s.network()) return;
-  // The tip lies nearest the root end: the last section of a confluence, the first of a fork.
-  const bool confluence = !s.ends()[0].inflow;
-  const auto section = s.node_section();
-  for (size_t b = 0; b < s.banks().size(); ++b) {
-    const BorderId tongue = s.banks()[b].border;
-    if (tongue < island_border(s.islands().size())) continue;  // a bank of the root end
-    const auto path = s.bank_nodes(b);
-    uint32_t tip = path[0];
-    for (const uint32_t n : path) {
-      if (confluence ? section[n] > section[tip] : section[n] < section[tip]) tip = n;
-    }
-    // The arms either side: the water next to the tip, its outer borders and widths.
-    Tip t;
-    t.along = s.sections()[section[tip]].along;
-    t.psi = border_psi_[tongue];
-    double left_width = 0.0, right_width = 0.0;
-    for (const uint32_t tri : s.node_triangles(tip)) {
-      for (int i = 0; i < 3; ++i) {
-        const uint32_t m = s.triangles()[3 * size_t{tri} + i];
-        if (section[m] != section[tip]) continue;
-        const double width = double{s.node_d_left()[m]} + s.node_d_right()[m];
-        if (s.node_right_border(m) == tongue && s.node_left_border(m) != tongue) {
-          t.left = s.node_left_border(m);
-          left_width = width;
-        }
-        if (s.node_left_border(m) == tongue && s.node_right_border(m) != tongue) {
-          t.right = s.node_right_border(m);
-          right_width = width;
-        }
+    // The dividers (or borders) either side of the node, and how far along the section.
+    const double arc = surface_.node_d_left()[n];
+    double to_left = dl, left_psi = psi_left, to_right = dr, right_psi = psi_right;
+    for (const auto& [fraction, tongue_psi] : junction.dividers) {
+      const double at = fraction * width;
+      if (at <= arc) {
+        to_left = arc - at;
+        left_psi = tongue_psi;
+      } else {
+        to_right = at - arc;
+        right_psi = tongue_psi;
+        break;
       }
     }
-    const bool left = left_width > 0.0, right = right_width > 0.0;
-    t.fraction = left && right ? left_width / (left_width + right_width) : 0.5;
-    if (left && right) tips_.push_back(t);
+    return psi + g * (interpolate(to_left, left_psi, to_right, right_psi) - psi);
   }
+  return psi;
 }
 
 double StreamFunction::node_psi_free(uint32_t n) const {
@@ -341,7 +312,7 @@ void StreamFunction::update_node_velocity(uint32_t n) {
 size_t StreamFunction::memory_bytes() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return surface_.memory_bytes() + bytes(psi_) + bytes(wet_) + bytes(node_velocity_) +
-         bytes(tips_) + bytes(border_psi_) + bytes(end_discharge_) + bytes(shore_tangent_) +
+         bytes(junctions_) + bytes(border_psi_) + bytes(end_discharge_) + bytes(shore_tangent_) +
          bytes(obstacles_) + bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
          triangle_grid_.memory_bytes() + bytes(node_stamp_) + bytes(triangle_stamp_) +
          bytes(scratch_nodes_) + bytes(scratch_triangles_);

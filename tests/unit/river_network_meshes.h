@@ -25,14 +25,18 @@ struct FanMesh {
 // side by side, the left one on +X, each tongue widening by 2 `spread` metres per metre; arm i
 // reaches back to z = -arm_lengths[i]. Rows every `dz` along, `across` cells across each arm.
 // `cut`, when given, says which quads (k along from the tips' row, j across) of the main
-// channel's grid to cut out as islands (cut_grid_quads).
+// channel's grid to cut out as islands (cut_grid_quads). With `blunt` cells, each tongue ends
+// square, that many cells wide, instead of in a point.
 inline FanMesh fan_channel(float arm_width, float main_length, const std::vector<float>& arm_lengths,
                            float spread, float dz, uint32_t across,
-                           const std::function<bool(uint32_t, uint32_t)>& cut = nullptr) {
+                           const std::function<bool(uint32_t, uint32_t)>& cut = nullptr,
+                           uint32_t blunt = 0) {
   FanMesh fan;
   TestMesh& m = fan.mesh;
   const uint32_t arms = uint32_t(arm_lengths.size());
-  const float half = 0.5f * float(arms) * arm_width;
+  const float cell = arm_width / float(across);
+  const uint32_t main_cells = arms * across + (arms - 1) * blunt;
+  const float half = 0.5f * float(main_cells) * cell;
   auto row = [&](float z, float x_left, float x_right, uint32_t cells) {
     std::vector<uint32_t> ids;
     for (uint32_t j = 0; j <= cells; ++j) {
@@ -49,10 +53,10 @@ inline FanMesh fan_channel(float arm_width, float main_length, const std::vector
   };
   // The main channel first, a grid strip from the tips' row on.
   const uint32_t main_rows = uint32_t(std::lround(main_length / dz));
-  const uint32_t main_across = arms * across + 1;
-  std::vector<uint32_t> prev = row(0.0f, half, -half, arms * across);
+  const uint32_t main_across = main_cells + 1;
+  std::vector<uint32_t> prev = row(0.0f, half, -half, main_cells);
   for (uint32_t k = 1; k <= main_rows; ++k) {
-    std::vector<uint32_t> next = row(float(k) * dz, half, -half, arms * across);
+    std::vector<uint32_t> next = row(float(k) * dz, half, -half, main_cells);
     zip(prev, next);
     prev = std::move(next);
   }
@@ -64,12 +68,12 @@ inline FanMesh fan_channel(float arm_width, float main_length, const std::vector
   // Then each arm, from the tips' row (the grid's first, which the cut leaves whole) upstream.
   for (uint32_t i = 0; i < arms; ++i) {
     prev.clear();
-    for (uint32_t j = 0; j <= across; ++j) prev.push_back(i * across + j);
+    for (uint32_t j = 0; j <= across; ++j) prev.push_back(i * (across + blunt) + j);
     const uint32_t rows = uint32_t(std::lround(arm_lengths[i] / dz));
     const float shift_rate = (0.5f * float(arms - 1) - float(i)) * 2.0f * spread;
     for (uint32_t k = 1; k <= rows; ++k) {
       const float z = -float(k) * dz, shift = float(k) * dz * shift_rate;
-      const float left = half - float(i) * arm_width + shift;
+      const float left = half - float(i) * (arm_width + float(blunt) * cell) + shift;
       std::vector<uint32_t> next = row(z, left, left - arm_width, across);
       zip(next, prev);
       prev = std::move(next);

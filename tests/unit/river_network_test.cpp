@@ -233,6 +233,44 @@ TEST(RiverNetwork, ARockMovedAboutTheJunctionEqualsAFreshSolve) {
   }
 }
 
+// Three arms meeting on one row (two tips side by side), and two meeting about a blunt tongue
+// (its end square, 2 cells wide): the field beyond the tips bends from them, with no jump across
+// the river at the tips' row. p = 1 and a wide radius: plug flow, Q / W, away from the tips.
+TEST(RiverNetwork, ArmsMeetingSideBySideOrAboutABluntTongueJumpNowhere) {
+  for (const auto& [arms, blunt] : {std::pair{3u, 0u}, std::pair{2u, 2u}}) {
+    const std::vector<float> lengths(arms, 10.0f);
+    const test::FanMesh fan = test::fan_channel(4.0f, 24.0f, lengths, 0.25f, 0.5f, 8, nullptr, blunt);
+    RiverSurfaceOptions options;
+    options.ends.push_back({fan.main_end, false});
+    std::vector<float> per_mark{5.0f};
+    for (uint32_t i = 0; i < arms; ++i) {
+      options.ends.push_back({fan.arm_ends[i], true});
+      per_mark.push_back(i == 0 ? 3.0f : 2.0f / float(arms - 1));
+    }
+    RiverSurface s;
+    const Status built = RiverSurface::build(fan.mesh.positions, fan.mesh.indices, options, &s);
+    ASSERT_TRUE(built.ok()) << built.message();
+    FlowParams params;
+    params.discharge = 5.0f;
+    params.p = 1.0f;
+    params.search_radius = 1000.0f;
+    params.end_discharges = by_end(s, per_mark);
+    StreamFunction flow;
+    ASSERT_TRUE(StreamFunction::create(std::move(s), params, &flow).ok());
+    const float width = float(arms) * 4.0f + float(arms - 1) * 0.5f * float(blunt);
+    const double plug = 5.0 / width;
+    double fastest = 0.0;
+    for (uint32_t n = 0; n < flow.surface().node_count(); ++n) {
+      const glm::vec3 p = flow.surface().node_positions()[n];
+      if (p.z < -1.0f || p.z > 3.0f) continue;
+      fastest = std::max(fastest, double(glm::length(flow.node_velocity()[n])));
+    }
+    // The left arm brings 3 of 5 m^2/s in 4 m: 0.75 m/s against the plug flow's 5 / 12.
+    EXPECT_LT(fastest, 2.5 * plug) << arms << " arms, blunt " << blunt << ": plug flow " << plug;
+    EXPECT_EQ(flow.surface().ends().size(), arms + 1);
+  }
+}
+
 void expect_flow_error(const std::vector<float>& discharges, float total,
                        std::initializer_list<const char*> parts) {
   const YMesh y = y_mesh();

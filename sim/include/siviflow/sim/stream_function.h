@@ -155,17 +155,19 @@ class StreamFunction {
   std::vector<double> psi_;
   std::vector<uint8_t> wet_;
   std::vector<glm::vec3> node_velocity_;
-  // Where two arms of a network meet, the tip of the tongue between them. Beyond it the
-  // streamline parting the arms leaves from the tip (evaluate()), where the water's fraction
-  // `fraction` of the way across from the left lies at the tip's section.
-  struct Tip {
-    double along = 0.0;     // the tip's section's
-    double fraction = 0.5;  // the left arm's share of the width at the tip
-    double psi = 0.0;       // the tongue's
-    BorderId left = 0, right = 0;  // the outer borders of the water beyond the tip
+  // Where arms of a network meet: the tips of the tongues between them in one section, and the
+  // water beyond, between the outermost arms' outer borders. Beyond it the streamlines parting
+  // the arms leave from the tips (evaluate()).
+  struct Junction {
+    double along = 0.0;  // the tips' section's
+    BorderId left = 0, right = 0;  // the outer borders of the water beyond
+    // Each tip's place across the water, as the arms' share of the width left of it at the tips'
+    // section, and its tongue's psi; from the left.
+    std::vector<std::pair<double, double>> dividers;
   };
-  void find_tips();
-  std::vector<Tip> tips_;
+  // The junctions of a network (none for a strip), from border_psi_ (network_junctions.cpp).
+  void find_junctions();
+  std::vector<Junction> junctions_;
   std::vector<double> border_psi_;  // by BorderId
   std::vector<double> end_discharge_;
   // Every island shore node's tangent, and in a network every bank node's (a shore is a
