@@ -60,6 +60,68 @@ std::vector<double> angle_sums(const std::vector<glm::vec3>& pos, const std::vec
   return sum;
 }
 
+// The border node nearest a point (kNoNode where the mesh has no border).
+uint32_t nearest_on_border(const std::vector<glm::vec3>& pos, const std::vector<uint8_t>& on_border,
+                           const glm::vec3& point) {
+  uint32_t best = kNoNode;
+  double best_d = std::numeric_limits<double>::max();
+  for (uint32_t n = 0; n < pos.size(); ++n) {
+    if (!on_border[n]) continue;
+    const double d = glm::distance(to_d(pos[n]), to_d(point));
+    if (d < best_d) {
+      best_d = d;
+      best = n;
+    }
+  }
+  return best;
+}
+
+// The named ends' own checks: at least two, each vertex in the mesh and each point finite, and a
+// strip's two one of each kind.
+Status check_end_marks(const RiverSurfaceOptions& options, size_t vertex_count) {
+  if (options.ends.size() == 1) {
+    return Status::error("ends: a single end is named, where a river has at least two");
+  }
+  for (size_t m = 0; m < options.ends.size(); ++m) {
+    const RiverEndMark& mark = options.ends[m];
+    const glm::vec3& p = mark.point;
+    if (mark.at_point && !(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))) {
+      return Status::error(text_format("ends[%zu]: the point (%g, %g, %g) is not finite", m, p.x, p.y, p.z));
+    }
+    if (!mark.at_point && mark.vertex >= vertex_count) {
+      return Status::error(text_format("ends[%zu]: vertex %u is not in the river mesh (%zu vertices)",
+                                       m, mark.vertex, vertex_count));
+    }
+  }
+  if (options.ends.size() == 2 && options.ends[0].inflow == options.ends[1].inflow) {
+    return Status::error(text_format(
+        "ends: both named ends are %s, where a strip has one inflow and one outflow",
+        options.ends[0].inflow ? "inflows" : "outflows"));
+  }
+  return Status::success();
+}
+
+// A strip's named outflow lies on its last section.
+Status check_named_outflow(const RiverSurfaceOptions& options, const std::vector<glm::vec3>& pos,
+                           const std::vector<uint8_t>& on_border, const std::vector<uint32_t>& node_of_vertex,
+                           const std::vector<uint32_t>& node_vertex, const std::vector<uint32_t>& node_section,
+                           uint32_t last_section, uint32_t upstream_vertex) {
+  for (size_t m = 0; m < options.ends.size(); ++m) {
+    const RiverEndMark& mark = options.ends[m];
+    if (mark.inflow) continue;
+    const uint32_t n = mark.at_point ? nearest_on_border(pos, on_border, mark.point) : node_of_vertex[mark.vertex];
+    if (node_section[n] == last_section) continue;
+    const std::string what = mark.at_point ? text_format("the border's vertex %u nearest (%g, %g, %g)", node_vertex[n],
+                                                         mark.point.x, mark.point.y, mark.point.z)
+                                           : text_format("vertex %u", mark.vertex);
+    return Status::error(text_format(
+        "ends[%zu]: %s is not on the downstream end of the river (the end across from the inflow "
+        "at vertex %u)",
+        m, what.c_str(), upstream_vertex));
+  }
+  return Status::success();
+}
+
 double path_length(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& path) {
   double len = 0.0;
   for (size_t i = 1; i < path.size(); ++i) len += glm::distance(to_d(pos[path[i - 1]]), to_d(pos[path[i]]));
@@ -217,40 +279,16 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
           index_at(i), vertex_count));
     }
   }
-  // The upstream end: the named inflow of a strip's two named ends, else upstream_vertex (which
-  // a network with named ends does not read).
-  uint32_t upstream_vertex = options.upstream_vertex;
-  if (options.ends.size() == 1) {
-    return Status::error("ends: a single end is named, where a river has at least two");
-  }
-  for (size_t m = 0; m < options.ends.size(); ++m) {
-    if (options.ends[m].at_point) {
-      const glm::vec3& p = options.ends[m].point;
-      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
-        return Status::error(text_format("ends[%zu]: the point (%g, %g, %g) is not finite", m, p.x, p.y, p.z));
-      }
-      continue;
-    }
-    if (options.ends[m].vertex >= vertex_count) {
-      return Status::error(text_format("ends[%zu]: vertex %u is not in the river mesh (%zu vertices)",
-                                       m, options.ends[m].vertex, vertex_count));
-    }
-  }
-  if (options.ends.size() == 2) {
-    if (options.ends[0].inflow == options.ends[1].inflow) {
-      return Status::error(text_format(
-          "ends: both named ends are %s, where a strip has one inflow and one outflow",
-          options.ends[0].inflow ? "inflows" : "outflows"));
-    }
-    upstream_vertex = options.ends[options.ends[0].inflow ? 0 : 1].vertex;
-  }
+  SIVIFLOW_TRY(check_end_marks(options, vertex_count));
+  // The upstream end: the named inflow of a strip's two named ends (a vertex, or a point whose
+  // nearest border node is found with the border), else upstream_vertex; a network with named
+  // ends reads neither.
   const bool read_upstream = options.ends.size() <= 2;
-  // A strip's inflow named by a point: the border's vertex nearest it (found with the border).
-  const RiverEndMark* upstream_point = nullptr;
-  if (options.ends.size() == 2 && options.ends[options.ends[0].inflow ? 0 : 1].at_point) {
-    upstream_point = &options.ends[options.ends[0].inflow ? 0 : 1];
-  }
-  if (read_upstream && upstream_point == nullptr && upstream_vertex >= vertex_count) {
+  const RiverEndMark* named_inflow =
+      options.ends.size() == 2 ? &options.ends[options.ends[0].inflow ? 0 : 1] : nullptr;
+  const uint32_t upstream_vertex = named_inflow != nullptr ? named_inflow->vertex : options.upstream_vertex;
+  const bool upstream_at_point = named_inflow != nullptr && named_inflow->at_point;
+  if (read_upstream && !upstream_at_point && upstream_vertex >= vertex_count) {
     return Status::error(text_format("the upstream vertex %u is not in the river mesh (%zu vertices)",
                                      upstream_vertex, vertex_count));
   }
@@ -416,24 +454,9 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   if (std::find(on_border.begin(), on_border.end(), 1) == on_border.end()) {
     return Status::error("the river mesh is closed (it has no border): a river is an open strip");
   }
-  // The border node nearest a point (none off the border).
-  auto nearest_border_node = [&](const glm::vec3& point) {
-    uint32_t best = kNoNode;
-    double best_d = std::numeric_limits<double>::max();
-    for (uint32_t n = 0; n < node_count; ++n) {
-      const double d = on_border[n] ? glm::distance(to_d(pos[n]), to_d(point)) : best_d;
-      if (d < best_d) {
-        best_d = d;
-        best = n;
-      }
-    }
-    return best;
-  };
-  if (upstream_point != nullptr) {
-    const uint32_t n = nearest_border_node(upstream_point->point);
-    if (n != kNoNode) upstream_vertex = node_vertex[n];
-  }
-  const uint32_t upstream_node = read_upstream ? node_of_vertex[upstream_vertex] : kNoNode;
+  const uint32_t upstream_node = !read_upstream     ? kNoNode
+                                 : upstream_at_point ? nearest_on_border(pos, on_border, named_inflow->point)
+                                                     : node_of_vertex[upstream_vertex];
   if (read_upstream && !on_border[upstream_node]) {
     return Status::error(text_format(
         "river vertex %u marks the upstream end but is not on the border of the mesh: the "
@@ -446,7 +469,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     // With named ends: the outer border is the one that holds the first.
     const uint32_t first_end_node =
         read_upstream ? kNoNode
-        : options.ends[0].at_point ? nearest_border_node(options.ends[0].point)
+        : options.ends[0].at_point ? nearest_on_border(pos, on_border, options.ends[0].point)
                                    : node_of_vertex[options.ends[0].vertex];
     auto is_outer_loop = [&](const std::vector<uint32_t>& walked) {
       return std::find(walked.begin(), walked.end(), first_end_node) != walked.end();
@@ -580,7 +603,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
       const Status network = build_network(welded, options, out);
       if (network.ok()) return network;
       return Status::error(as_strip + "; nor is it a network of " + std::to_string(sharp / 2) +
-                           " ends with vertex " + std::to_string(upstream_vertex) +
+                           " ends with vertex " + std::to_string(node_vertex[upstream_node]) +
                            "'s the only inflow: " + network.message() +
                            " (a confluence takes its ends named, each an inflow or an outflow)");
     }
@@ -731,19 +754,8 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
                         s.section_nodes_.begin() + sec.first_node + sec.node_count);
     s.ends_.push_back(end);
   }
-  for (size_t m = 0; m < options.ends.size(); ++m) {
-    const RiverEndMark& mark = options.ends[m];
-    if (mark.inflow) continue;
-    const uint32_t n = mark.at_point ? nearest_border_node(mark.point) : node_of_vertex[mark.vertex];
-    if (s.node_section_[n] != section_count - 1) {
-      return Status::error(text_format(
-          "ends[%zu]: %s is not on the downstream end of the river (the end across from the "
-          "inflow at vertex %u)",
-          m, mark.at_point ? text_format("the border's vertex %u nearest (%g, %g, %g)", node_vertex[n], mark.point.x, mark.point.y, mark.point.z).c_str()
-                           : text_format("vertex %u", mark.vertex).c_str(),
-          upstream_vertex));
-    }
-  }
+  SIVIFLOW_TRY(check_named_outflow(options, pos, on_border, node_of_vertex, node_vertex, s.node_section_,
+                                   section_count - 1, node_vertex[upstream_node]));
 
   if (node_count != vertex_count) {  // else both maps are the identity: not worth 8 bytes a vertex
     s.node_of_vertex_ = std::move(node_of_vertex);
