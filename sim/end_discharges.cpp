@@ -18,7 +18,8 @@ bool agree(double a, double b, double scale = 0.0) {
 
 std::string end_name(const RiverSurface& s, size_t e) {
   const RiverEnd& end = s.ends()[e];
-  const std::string named = end.mark != kNoEndMark ? text_format(", ends[%u]", end.mark) : std::string();
+  const std::string named =
+      end.mark != kNoEndMark ? text_format(", ends[%u]", end.mark) : std::string();
   return text_format("end %zu (the %s at vertex %u%s)", e, end.inflow ? "inflow" : "outflow",
                      s.vertex_of_node(s.end_nodes(e)[0]), named.c_str());
 }

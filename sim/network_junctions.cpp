@@ -31,7 +31,8 @@ void StreamFunction::find_junctions() {
     const auto path = s.bank_nodes(b);
     tip.section = section[path[0]];
     for (const uint32_t n : path) {
-      tip.section = confluence ? std::max(tip.section, section[n]) : std::min(tip.section, section[n]);
+      tip.section =
+          confluence ? std::max(tip.section, section[n]) : std::min(tip.section, section[n]);
     }
     // The arms either side: the water of that section beside the tongue (a blunt tip has
     // several nodes there, a pointed one one).
@@ -73,7 +74,8 @@ void StreamFunction::find_junctions() {
       junction.right = tip->right;
       tip = right_of(*tip);
     }
-    for (const auto& [left_width, tongue] : at) junction.dividers.emplace_back(left_width / width, border_psi_[tongue]);
+    for (const auto& [left_width, tongue] : at)
+      junction.dividers.emplace_back(left_width / width, border_psi_[tongue]);
     junctions_.push_back(std::move(junction));
   }
 }

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>
 
@@ -90,7 +89,8 @@ Status layer_network(const MeshView& mesh, const NetworkSides& sides, NetworkLay
   const uint32_t root_left_bank = net.side_bank[(sides.root + side_count - 1) % side_count];
   const uint32_t root_right_bank = net.side_bank[(sides.root + 1) % side_count];
   std::vector<uint32_t> left_at(max_hops + 1, kNoNode), right_at(max_hops + 1, kNoNode);
-  for (const size_t side : {(sides.root + side_count - 1) % side_count, (sides.root + 1) % side_count}) {
+  for (const size_t side :
+       {(sides.root + side_count - 1) % side_count, (sides.root + 1) % side_count}) {
     std::vector<uint32_t>& at = net.side_bank[side] == root_left_bank ? left_at : right_at;
     for (const uint32_t n : sides.sides[side]) {
       if (at[hops[n]] == kNoNode) at[hops[n]] = n;

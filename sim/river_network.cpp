@@ -2,10 +2,9 @@
 // the root end, and per node the two borders of its arm and the distances to them.
 #include <algorithm>
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <limits>
 #include <string>
-
-#include <glm/geometric.hpp>
 
 #include "network_layering.h"
 #include "river_welded.h"
@@ -19,7 +18,8 @@ using DVec3 = glm::dvec3;
 
 double path_length(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& path) {
   double len = 0.0;
-  for (size_t i = 1; i < path.size(); ++i) len += glm::distance(DVec3(pos[path[i - 1]]), DVec3(pos[path[i]]));
+  for (size_t i = 1; i < path.size(); ++i)
+    len += glm::distance(DVec3(pos[path[i - 1]]), DVec3(pos[path[i]]));
   return len;
 }
 
@@ -53,11 +53,13 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
     if (w.angles[w.loop[i]] < kNetworkCornerMaxAngle) corners.push_back(i);
   }
   std::string corner_names;
-  for (const size_t c : corners) corner_names += (corner_names.empty() ? "" : ", ") + name(w.loop[c]);
+  for (const size_t c : corners)
+    corner_names += (corner_names.empty() ? "" : ", ") + name(w.loop[c]);
   if (!options.ends.empty() && corners.size() <= 4) {
-    return Status::error(text_format(
-        "ends: %zu ends are named, but the river mesh has 2 (a strip: its corners are at vertices %s)",
-        options.ends.size(), corner_names.c_str()));
+    return Status::error(
+        text_format("ends: %zu ends are named, but the river mesh has 2 (a strip: its corners are "
+                    "at vertices %s)",
+                    options.ends.size(), corner_names.c_str()));
   }
   if (corners.size() < 6 || corners.size() % 2 != 0) {
     return Status::error(text_format(
@@ -80,13 +82,14 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
   for (size_t m = 0; m < options.ends.size(); ++m) {
     const uint32_t v = options.ends[m].vertex;
     if (!options.ends[m].at_point && v >= w.vertex_count) {
-      return Status::error(text_format("ends[%zu]: vertex %u is not in the river mesh (%zu vertices)",
-                                       m, v, w.vertex_count));
+      return Status::error(text_format(
+          "ends[%zu]: vertex %u is not in the river mesh (%zu vertices)", m, v, w.vertex_count));
     }
     mark_node.push_back(options.ends[m].at_point ? kNoNode : w.node_of_vertex[v]);
   }
   // Without named ends, build() has checked the upstream vertex; with them it is not read.
-  const uint32_t upstream_node = options.ends.empty() ? w.node_of_vertex[options.upstream_vertex] : kNoNode;
+  const uint32_t upstream_node =
+      options.ends.empty() ? w.node_of_vertex[options.upstream_vertex] : kNoNode;
   auto distance_to = [&](const std::vector<uint32_t>& side, const glm::vec3& point) {
     double d = std::numeric_limits<double>::max();
     for (const uint32_t n : side) d = std::min(d, glm::distance(DVec3(pos[n]), DVec3(point)));
@@ -106,9 +109,10 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
       double best_d = std::numeric_limits<double>::max();
       for (size_t i = parity; i < side_count; i += 2) {
         const auto& side = sides.sides[i];
-        const double d = wanted[m] == kNoNode
-                             ? distance_to(side, options.ends[m].point)
-                             : (std::find(side.begin(), side.end(), wanted[m]) != side.end() ? 0.0 : best_d);
+        const double d =
+            wanted[m] == kNoNode
+                ? distance_to(side, options.ends[m].point)
+                : (std::find(side.begin(), side.end(), wanted[m]) != side.end() ? 0.0 : best_d);
         if (d < best_d) {
           best_d = d;
           best = i;
@@ -146,8 +150,11 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
     return Status::error(text_format(
         "ends[%zu]: %s is not on an end of the river mesh, or shares its end with another "
         "(the ends run between the corners at vertices %s)",
-        m, mark.at_point ? text_format("the end nearest (%g, %g, %g)", mark.point.x, mark.point.y, mark.point.z).c_str()
-                         : text_format("vertex %u", mark.vertex).c_str(),
+        m,
+        mark.at_point
+            ? text_format("the end nearest (%g, %g, %g)", mark.point.x, mark.point.y, mark.point.z)
+                  .c_str()
+            : text_format("vertex %u", mark.vertex).c_str(),
         corner_names.c_str()));
   }
   // Both ways work: the one nearer the named points, else with the shorter ends (a river is
@@ -241,7 +248,8 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
   // on its border from both sides.
   std::vector<uint8_t> arms_at(node_count, 0);
   for (const ArmSegment& seg : net.segments) {
-    for (const uint32_t n : {net.segment_nodes[seg.first], net.segment_nodes[seg.first + seg.count - 1]}) {
+    for (const uint32_t n :
+         {net.segment_nodes[seg.first], net.segment_nodes[seg.first + seg.count - 1]}) {
       arms_at[n] = static_cast<uint8_t>(std::min(arms_at[n] + 1, 2));
     }
   }
@@ -338,7 +346,8 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
       if (k == 0) continue;
       double nearest = std::numeric_limits<double>::max();
       for (const uint32_t m : w.adj.of(n)) {
-        if (s.node_section_[m] + 1 == k) nearest = std::min(nearest, glm::distance(DVec3(pos[n]), DVec3(pos[m])));
+        if (s.node_section_[m] + 1 == k)
+          nearest = std::min(nearest, glm::distance(DVec3(pos[n]), DVec3(pos[m])));
       }
       if (nearest == std::numeric_limits<double>::max()) continue;
       step_sum[k] += nearest;
@@ -365,11 +374,14 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
       continue;
     }
     const uint32_t l = net.layer[side.front()];
-    const auto seg = std::find_if(net.segments.begin(), net.segments.end(), [&](const ArmSegment& a) {
-      const uint32_t a0 = net.segment_nodes[a.first], a1 = net.segment_nodes[a.first + a.count - 1];
-      return a.layer == l && a.count == side.size() &&
-             ((a0 == side.front() && a1 == side.back()) || (a0 == side.back() && a1 == side.front()));
-    });
+    const auto seg =
+        std::find_if(net.segments.begin(), net.segments.end(), [&](const ArmSegment& a) {
+          const uint32_t a0 = net.segment_nodes[a.first],
+                         a1 = net.segment_nodes[a.first + a.count - 1];
+          return a.layer == l && a.count == side.size() &&
+                 ((a0 == side.front() && a1 == side.back()) ||
+                  (a0 == side.back() && a1 == side.front()));
+        });
     if (seg == net.segments.end()) {
       return Status::error(text_format(
           "the river network's end from vertex %s to vertex %s is not one section of water",
@@ -389,8 +401,8 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
     s.ends_.push_back(end);
   }
   for (const std::vector<uint32_t>& island : w.island_loops) {
-    s.islands_.push_back({static_cast<uint32_t>(s.island_nodes_.size()),
-                          static_cast<uint32_t>(island.size())});
+    s.islands_.push_back(
+        {static_cast<uint32_t>(s.island_nodes_.size()), static_cast<uint32_t>(island.size())});
     s.island_nodes_.insert(s.island_nodes_.end(), island.begin(), island.end());
   }
 
@@ -399,7 +411,8 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
   for (size_t t = 0; t < tris.size() / 3; ++t) {
     uint32_t* tri = &tris[3 * t];
     const DVec3 a(pos[tri[0]]);
-    if (glm::cross(DVec3(pos[tri[1]]) - a, DVec3(pos[tri[2]]) - a).y < 0.0) std::swap(tri[1], tri[2]);
+    if (glm::cross(DVec3(pos[tri[1]]) - a, DVec3(pos[tri[2]]) - a).y < 0.0)
+      std::swap(tri[1], tri[2]);
   }
 
   if (node_count != w.vertex_count) {

@@ -3,9 +3,8 @@
 #pragma once
 
 #include <cstdint>
-#include <vector>
-
 #include <glm/vec3.hpp>
+#include <vector>
 
 #include "siviflow/sim/river_surface.h"
 #include "strip_layering.h"
@@ -21,8 +20,8 @@ struct RiverSurface::Welded {
   std::vector<uint32_t>& node_of_vertex;
   std::vector<std::vector<uint32_t>>& island_loops;
   std::vector<uint32_t>& node_island;
-  const std::vector<uint32_t>& loop;     // the outer border
-  const std::vector<double>& angles;     // the water's angle at every border node
+  const std::vector<uint32_t>& loop;  // the outer border
+  const std::vector<double>& angles;  // the water's angle at every border node
   size_t vertex_count;
 };
 

@@ -7,10 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <glm/vec3.hpp>
 #include <utility>
 #include <vector>
-
-#include <glm/vec3.hpp>
 
 namespace siviflow::test {
 

@@ -50,7 +50,8 @@ TEST(ConfluenceCapture, TheCapturedFlowIsTheOraclesWhereTheArmsJoin) {
   for (double z = -58.0; z <= 28.0; z += 1.0) {
     for (double x = -24.0; x <= 24.0; x += 0.5) {
       if (!oracle.inside(x, z + 20.0, 1.5)) continue;
-      const int u = int(std::lround(320.0 + x * px_per_m)), v = int(std::lround(180.0 + (z + 15.0) * px_per_m));
+      const int u = int(std::lround(320.0 + x * px_per_m)),
+                v = int(std::lround(180.0 + (z + 15.0) * px_per_m));
       if (u < 0 || u >= 640 || v < 0 || v >= 360) continue;
       const size_t p = size_t(v) * 640u + size_t(u);
       if ((*water)[p] < 0.5f) continue;
@@ -70,9 +71,10 @@ TEST(ConfluenceCapture, TheCapturedFlowIsTheOraclesWhereTheArmsJoin) {
   const double median = errors[errors.size() / 2], p90 = errors[errors.size() * 9 / 10];
   const double tip_median = near_tip[near_tip.size() / 2];
   RecordProperty("error", "median " + std::to_string(median) + ", 90th percentile " +
-                              std::to_string(p90) + ", within 5 m of the tip " + std::to_string(tip_median));
-  std::printf("%zu samples: median %.4f, p90 %.4f, within 5 m of the tip (%zu) median %.4f\n", sampled,
-              median, p90, near_tip.size(), tip_median);
+                              std::to_string(p90) + ", within 5 m of the tip " +
+                              std::to_string(tip_median));
+  std::printf("%zu samples: median %.4f, p90 %.4f, within 5 m of the tip (%zu) median %.4f\n",
+              sampled, median, p90, near_tip.size(), tip_median);
   EXPECT_LT(median, 0.05);
   EXPECT_LT(p90, 0.15);
   EXPECT_LT(tip_median, 0.15);  // beside the tip the field bends most

@@ -5,9 +5,8 @@
 
 #include <cstdint>
 #include <functional>
-#include <vector>
-
 #include <glm/vec3.hpp>
+#include <vector>
 
 #include "river_test_meshes.h"
 #include "sim/grid_holes.h"
@@ -27,8 +26,9 @@ struct FanMesh {
 // `cut`, when given, says which quads (k along from the tips' row, j across) of the main
 // channel's grid to cut out as islands (cut_grid_quads). With `blunt` cells, each tongue ends
 // square, that many cells wide, instead of in a point.
-inline FanMesh fan_channel(float arm_width, float main_length, const std::vector<float>& arm_lengths,
-                           float spread, float dz, uint32_t across,
+inline FanMesh fan_channel(float arm_width, float main_length,
+                           const std::vector<float>& arm_lengths, float spread, float dz,
+                           uint32_t across,
                            const std::function<bool(uint32_t, uint32_t)>& cut = nullptr,
                            uint32_t blunt = 0) {
   FanMesh fan;
@@ -94,7 +94,8 @@ struct YMesh {
 // -right_length, the tongue between them widening by 2 `spread` metres per metre.
 inline YMesh y_channel(float arm_width, float main_length, float left_length, float right_length,
                        float spread, float dz, uint32_t across) {
-  FanMesh fan = fan_channel(arm_width, main_length, {left_length, right_length}, spread, dz, across);
+  FanMesh fan =
+      fan_channel(arm_width, main_length, {left_length, right_length}, spread, dz, across);
   return {std::move(fan.mesh), fan.main_end, fan.arm_ends[0], fan.arm_ends[1]};
 }
 

@@ -24,9 +24,8 @@ constexpr uint32_t kAcross = 8;
 constexpr double kLeftQ = 2.0, kRightQ = 1.0;
 
 YMesh y_mesh(const test::YShape& shape = kShape) {
-  return test::y_channel(float(shape.arm_width), float(shape.main_length),
-                         float(shape.left_length), float(shape.right_length), float(shape.spread),
-                         kDz, kAcross);
+  return test::y_channel(float(shape.arm_width), float(shape.main_length), float(shape.left_length),
+                         float(shape.right_length), float(shape.spread), kDz, kAcross);
 }
 
 RiverSurfaceOptions confluence_ends(const YMesh& y) {
@@ -123,7 +122,8 @@ TEST(RiverNetwork, TheStreamlineBetweenTheArmsLeavesTheTipAsLaplaceSays) {
   wide.spread = 0.5;
   wide.left_length = 8.0;
   for (const test::YShape& shape : {kShape, wide}) {
-    for (const auto& [left_q, right_q] : {std::pair{2.0, 1.0}, std::pair{1.0, 3.0}, std::pair{1.0, 1.0}}) {
+    for (const auto& [left_q, right_q] :
+         {std::pair{2.0, 1.0}, std::pair{1.0, 3.0}, std::pair{1.0, 1.0}}) {
       const StreamFunction flow = confluence_flow(1.0f, 1000.0f, left_q, right_q, shape);
       const double psi_tongue = flow.border_psi(island_border(0));
       EXPECT_NEAR(psi_tongue, right_q, 1e-9);
@@ -134,15 +134,17 @@ TEST(RiverNetwork, TheStreamlineBetweenTheArmsLeavesTheTipAsLaplaceSays) {
       for (const float z : {0.5f, 1.0f, 1.5f, 2.0f, 3.0f, 4.0f, 6.0f, 8.0f, 12.0f, 16.0f}) {
         const double ours = mesh_crossing(flow, z, psi_tongue);
         const double theirs = oracle.crossing(z, psi_tongue);
-        EXPECT_NEAR(ours, theirs, 0.02 * width)
-            << "spread " << shape.spread << ", inflows " << left_q << " and " << right_q << ", z = " << z;
+        EXPECT_NEAR(ours, theirs, 0.02 * width) << "spread " << shape.spread << ", inflows "
+                                                << left_q << " and " << right_q << ", z = " << z;
         worst = std::max(worst, std::abs(ours - theirs));
       }
       // Far downstream, the discharges' own split: the right inflow's share of the width.
       EXPECT_NEAR(mesh_crossing(flow, 16.0f, psi_tongue),
                   -shape.arm_width + width * right_q / (left_q + right_q), 1e-3 * width);
-      std::printf("spread %.2f, inflows %.0f and %.0f: the parting streamline within %.3f m of the "
-                  "oracle's\n", shape.spread, left_q, right_q, worst);
+      std::printf(
+          "spread %.2f, inflows %.0f and %.0f: the parting streamline within %.3f m of the "
+          "oracle's\n",
+          shape.spread, left_q, right_q, worst);
     }
   }
 }
@@ -161,7 +163,8 @@ TEST(RiverNetwork, EveryArmOfEverySectionCarriesItsDischarge) {
       const auto nodes = s.section_nodes(k);
       size_t first = 0;
       for (size_t i = 1; i <= nodes.size(); ++i) {
-        const bool arm_ends = i == nodes.size() || triangle_on_edge(s, nodes[i - 1], nodes[i]) == UINT32_MAX;
+        const bool arm_ends =
+            i == nodes.size() || triangle_on_edge(s, nodes[i - 1], nodes[i]) == UINT32_MAX;
         if (!arm_ends) continue;
         const double expected = flow.node_psi()[nodes[first]] - flow.node_psi()[nodes[i - 1]];
         double by_vertices = 0.0;
@@ -169,7 +172,8 @@ TEST(RiverNetwork, EveryArmOfEverySectionCarriesItsDischarge) {
         for (size_t j = first; j + 1 < i; ++j) {
           const glm::vec3 &u = pos[nodes[j]], &w = pos[nodes[j + 1]];
           const glm::dvec3 v = 0.5 * (glm::dvec3(vel[nodes[j]]) + glm::dvec3(vel[nodes[j + 1]]));
-          by_vertices += glm::dot(v, test::segment_normal(u, w)) * glm::distance(glm::dvec3(u), glm::dvec3(w));
+          by_vertices +=
+              glm::dot(v, test::segment_normal(u, w)) * glm::distance(glm::dvec3(u), glm::dvec3(w));
         }
         const float z = pos[nodes[first]].z;
         EXPECT_GT(expected, 0.0) << "section " << k;
@@ -222,8 +226,8 @@ TEST(RiverNetwork, ARockMovedAboutTheJunctionEqualsAFreshSolve) {
   rock.radius = 0.5f;
   rock.centre = {2.0f, 0.0f, -6.0f};
   ASSERT_TRUE(moved.set_obstacles({rock}).ok());
-  for (const glm::vec3 centre : {glm::vec3(-2.0f, 0.0f, -3.0f), glm::vec3(0.5f, 0.0f, 1.5f),
-                                 glm::vec3(-1.0f, 0.0f, 9.0f)}) {
+  for (const glm::vec3 centre :
+       {glm::vec3(-2.0f, 0.0f, -3.0f), glm::vec3(0.5f, 0.0f, 1.5f), glm::vec3(-1.0f, 0.0f, 9.0f)}) {
     ASSERT_TRUE(moved.move_obstacle(0, centre).ok());
     EXPECT_LT(moved.last_update().nodes_resolved, moved.surface().node_count());
     StreamFunction fresh = confluence_flow(1.5f, 9.0f);
@@ -239,7 +243,8 @@ TEST(RiverNetwork, ARockMovedAboutTheJunctionEqualsAFreshSolve) {
 TEST(RiverNetwork, ArmsMeetingSideBySideOrAboutABluntTongueJumpNowhere) {
   for (const auto& [arms, blunt] : {std::pair{3u, 0u}, std::pair{2u, 2u}}) {
     const std::vector<float> lengths(arms, 10.0f);
-    const test::FanMesh fan = test::fan_channel(4.0f, 24.0f, lengths, 0.25f, 0.5f, 8, nullptr, blunt);
+    const test::FanMesh fan =
+        test::fan_channel(4.0f, 24.0f, lengths, 0.25f, 0.5f, 8, nullptr, blunt);
     RiverSurfaceOptions options;
     options.ends.push_back({fan.main_end, false});
     std::vector<float> per_mark{5.0f};
@@ -282,23 +287,27 @@ void expect_flow_error(const std::vector<float>& discharges, float total,
   const Status status = StreamFunction::create(std::move(s), params, &flow);
   ASSERT_FALSE(status.ok());
   for (const char* part : parts) {
-    EXPECT_NE(status.message().find(part), std::string::npos) << status.message() << " lacks " << part;
+    EXPECT_NE(status.message().find(part), std::string::npos)
+        << status.message() << " lacks " << part;
   }
 }
 
 TEST(RiverNetwork, DischargesThatDoNotBalanceAreRefused) {
-  expect_flow_error({2.0f, 1.0f, 2.5f}, 3.0f, {"do not balance", "3 m^2/s flows in", "2.5 m^2/s out"});
+  expect_flow_error({2.0f, 1.0f, 2.5f}, 3.0f,
+                    {"do not balance", "3 m^2/s flows in", "2.5 m^2/s out"});
   expect_flow_error({2.0f, -1.0f, 1.0f}, 1.0f, {"-1", "inflow", "0 or more"});
   expect_flow_error({2.0f, 1.0f, 3.0f}, 4.0f, {"bring in 3", "discharge is 4"});
 }
 
-void expect_surface_error(const RiverSurfaceOptions& options, std::initializer_list<const char*> parts) {
+void expect_surface_error(const RiverSurfaceOptions& options,
+                          std::initializer_list<const char*> parts) {
   const YMesh y = y_mesh();
   RiverSurface s;
   const Status status = RiverSurface::build(y.mesh.positions, y.mesh.indices, options, &s);
   ASSERT_FALSE(status.ok());
   for (const char* part : parts) {
-    EXPECT_NE(status.message().find(part), std::string::npos) << status.message() << " lacks " << part;
+    EXPECT_NE(status.message().find(part), std::string::npos)
+        << status.message() << " lacks " << part;
   }
 }
 
