@@ -414,6 +414,33 @@ TEST(RiverSurfaceBad, NonManifoldEdge) {
   expect_error(m, {"non-manifold"});
 }
 
+// A triangle hanging off the strip by one corner (its other two vertices its own): two parts
+// touching at a single vertex, refused naming it.
+TEST(RiverSurfaceBad, DanglingTriangle) {
+  TestMesh m = test::straight_channel(4, 8, 5, 3);
+  const uint32_t corner = 0;  // the upstream end's left corner
+  const glm::vec3 p = m.positions[corner];
+  m.positions.push_back(p + glm::vec3(1.0f, 0.0f, -1.0f));
+  m.positions.push_back(p + glm::vec3(-0.5f, 0.0f, -1.5f));
+  m.indices.insert(m.indices.end(), {corner, uint32_t(m.positions.size() - 2), uint32_t(m.positions.size() - 1)});
+  expect_error(m, {"non-manifold at vertex 0"});
+}
+
+// A strip bent round until its left bank meets itself at one vertex: refused naming it.
+TEST(RiverSurfaceBad, BorderTouchingItself) {
+  // A ring of quads, 12 sections about the origin, the inner bank's last vertex welded onto its
+  // first: the ring is open (its ends apart) but its inner border passes twice through one point.
+  std::vector<std::vector<glm::vec3>> sections;
+  for (int k = 0; k <= 12; ++k) {
+    const float a = 6.2831853f * float(k) / 12.0f * 0.95f;
+    glm::vec3 in(2.0f * std::cos(a), 0.0f, 2.0f * std::sin(a));
+    if (k == 12) in = glm::vec3(2.0f, 0.0f, 0.0f);  // back onto section 0's inner vertex
+    sections.push_back(test::section_line(glm::vec3(4.0f * std::cos(a), 0.0f, 4.0f * std::sin(a)), in, 3));
+  }
+  const TestMesh m = test::mesh_from_sections(sections);
+  expect_error(m, {"non-manifold at vertex"});
+}
+
 TEST(RiverSurfaceBad, ClosedMesh) {
   TestMesh tetra;
   tetra.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}};
