@@ -16,12 +16,6 @@ namespace {
 
 using DVec3 = glm::dvec3;
 
-double path_length(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& path) {
-  double len = 0.0;
-  for (size_t i = 1; i < path.size(); ++i)
-    len += glm::distance(DVec3(pos[path[i - 1]]), DVec3(pos[path[i]]));
-  return len;
-}
 
 // The outer border split at its corners; is_end left for the caller.
 std::vector<std::vector<uint32_t>> sides_between(const std::vector<uint32_t>& loop,

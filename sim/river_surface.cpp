@@ -122,11 +122,6 @@ Status check_named_outflow(const RiverSurfaceOptions& options, const std::vector
   return Status::success();
 }
 
-double path_length(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& path) {
-  double len = 0.0;
-  for (size_t i = 1; i < path.size(); ++i) len += glm::distance(to_d(pos[path[i - 1]]), to_d(pos[path[i]]));
-  return len;
-}
 
 }  // namespace
 

@@ -176,9 +176,9 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
   }
   const double nearest_obstacle = nearest;
   const double p = params_.p;
-  // Pass 2, between the borders either side and the obstacles: w_i
-  // scaled by nearest^p, which is the product form of algorithms.md §1.1 divided by a common
-  // factor: finite and exact on a boundary, no overflow however many boundaries.
+  // Pass 2, between the borders either side and the obstacles: w_i scaled by nearest^p, which is
+  // the product form of algorithms.md §1.1 divided by a common factor: finite and exact on a
+  // boundary, no overflow however many boundaries.
   auto interpolate = [&](double to_left, double left_psi, double to_right, double right_psi) {
     double closest = nearest_obstacle;
     if (to_left < s) closest = std::min(closest, to_left);
@@ -216,6 +216,7 @@ double StreamFunction::evaluate(uint32_t n, bool use_obstacles, bool* wet) const
     if (junction.left != left || junction.right != right) continue;
     const double x = std::abs(double{surface_.sections()[surface_.node_section()[n]].along} - junction.along);
     const double width = double{surface_.node_d_left()[n]} + surface_.node_d_right()[n];
+    if (!(x < kTipReachWidths * width)) continue;  // past its reach (blend 0)
     const double g = std::exp(-kTipRelaxationRoot * std::sqrt(x / width) - kTipRelaxationLinear * x / width) *
                      blend(1.0 - x / (kTipReachWidths * width));
     if (g <= 0.0) continue;

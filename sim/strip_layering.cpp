@@ -114,6 +114,14 @@ std::string vertex_name(const MeshView& mesh, uint32_t node) {
   return std::to_string((*mesh.node_vertex)[node]);
 }
 
+double path_length(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& path) {
+  double length = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) {
+    length += glm::distance(glm::dvec3(pos[path[i - 1]]), glm::dvec3(pos[path[i]]));
+  }
+  return length;
+}
+
 Status layer_strip(const MeshView& mesh, const std::vector<uint32_t>& end_a,
                    const std::vector<uint32_t>& end_b, const std::vector<uint32_t>& bank_1,
                    const std::vector<uint32_t>& bank_2, Layering* out) {

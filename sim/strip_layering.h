@@ -51,6 +51,9 @@ struct MeshView {
 
 std::string vertex_name(const MeshView& mesh, uint32_t node);
 
+// Length of a path of nodes (a side of the border), in double.
+double path_length(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& path);
+
 // Hop distance of every node from `sources` (the mesh is connected: every node is reached).
 std::vector<uint32_t> hops_from(const Csr& adj, const std::vector<uint32_t>& sources);
 
