@@ -8,6 +8,8 @@ namespace siviflow {
 struct IndexRange {
   uint32_t first_index = 0;
   uint32_t index_count = 0;
+
+  bool operator==(const IndexRange&) const = default;
 };
 
 }  // namespace siviflow

@@ -151,6 +151,9 @@ void append_geometry(SceneGeometry&& other, SceneGeometry* into) {
   };
   for (LodPiece& piece : other.pieces) {
     for (IndexRange& level : piece.levels) level = shifted(level);
+    for (auto& edges : piece.skirts) {
+      for (IndexRange& skirt : edges) skirt = shifted(skirt);
+    }
     into->pieces.push_back(std::move(piece));
   }
   for (const IndexRange& boulder : other.obstacle_boulders) {

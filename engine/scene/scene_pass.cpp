@@ -118,6 +118,7 @@ void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertic
   VkPipeline bound = VK_NULL_HANDLE;
   VkDescriptorSet bound_set = VK_NULL_HANDLE;
   bool culling = false;
+  const gpu::SceneConstants* pushed = nullptr;
   for (const SceneDraw& d : draws) {
     const VkPipeline pipeline = d.material == 0 ? scene_pipeline_ : object_pipeline_;
     const bool cull = view.cull_back_faces && d.one_sided;
@@ -137,7 +138,11 @@ void ScenePass::draw(const DeviceTable& vk, VkCommandBuffer cmd, VkBuffer vertic
       bound_set = sets_[d.material];
       vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &bound_set, 0, nullptr);
     }
-    vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), d.constants);
+    // Pushed again only when they change: the terrain's chunks share the view's.
+    if (d.constants != pushed) {
+      vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), d.constants);
+      pushed = d.constants;
+    }
     vk.vkCmdDrawIndexed(cmd, d.index_count, 1, d.first_index, 0, 0);
   }
   vk.vkCmdPushConstants(cmd, layout_, kStages, 0, sizeof(gpu::SceneConstants), &sky);

@@ -1,6 +1,7 @@
 #include "scene/terrain_chunks.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -82,19 +83,27 @@ class ChunkBuilder {
           indices.insert(indices.end(), {a, c, b, b, c, d});
         }
       }
-      // Each skirt faces out of the chunk: a crack is seen from the neighbour's side.
-      const auto skirts_first = static_cast<uint32_t>(indices.size());
-      for (size_t i = 0; i + 1 < cols.size(); ++i) {
-        add_skirt(cols[i + 1], r0, cols[i], r0);
-        add_skirt(cols[i], r1, cols[i + 1], r1);
-      }
-      for (size_t j = 0; j + 1 < rows.size(); ++j) {
-        add_skirt(c0, rows[j], c0, rows[j + 1]);
-        add_skirt(c1, rows[j + 1], c1, rows[j]);
-      }
-      const auto end = static_cast<uint32_t>(indices.size());
-      piece.levels.push_back({first, end - first});
-      if (level == 0) piece.level0_skirt_index_count = end - skirts_first;
+      piece.levels.push_back({first, static_cast<uint32_t>(indices.size()) - first});
+      // Each skirt faces out of the chunk: a crack is seen from the neighbour's side. One run
+      // an edge, in kChunkEdges' order, right after the ground.
+      std::array<IndexRange, kChunkEdges>& skirts = piece.skirts.emplace_back();
+      const auto add_edge = [&](size_t edge, const auto& add_segments) {
+        const auto edge_first = static_cast<uint32_t>(indices.size());
+        add_segments();
+        skirts[edge] = {edge_first, static_cast<uint32_t>(indices.size()) - edge_first};
+      };
+      add_edge(0, [&] {
+        for (size_t i = 0; i + 1 < cols.size(); ++i) add_skirt(cols[i + 1], r0, cols[i], r0);
+      });
+      add_edge(1, [&] {
+        for (size_t i = 0; i + 1 < cols.size(); ++i) add_skirt(cols[i], r1, cols[i + 1], r1);
+      });
+      add_edge(2, [&] {
+        for (size_t j = 0; j + 1 < rows.size(); ++j) add_skirt(c0, rows[j], c0, rows[j + 1]);
+      });
+      add_edge(3, [&] {
+        for (size_t j = 0; j + 1 < rows.size(); ++j) add_skirt(c1, rows[j + 1], c1, rows[j]);
+      });
     }
     piece.lo.y -= skirt_depth_;
     piece.one_sided = true;  // ground seen from above, its skirts from outside
@@ -164,9 +173,16 @@ void add_chunked_grid(const std::vector<SceneVertex>& points, uint32_t columns, 
   const auto base = static_cast<uint32_t>(geometry->vertices.size());
   geometry->vertices.insert(geometry->vertices.end(), points.begin(), points.end());
   ChunkBuilder builder(points, columns, base, deepest + kSkirtMarginM, geometry);
-  for (Chunk& chunk : chunks) {
-    geometry->pieces.push_back(
-        builder.build(chunk.c0, chunk.c1, chunk.r0, chunk.r1, std::move(chunk.errors)));
+  // Chunks row by row, each row `per_row` of them: the pieces across the edges by offset.
+  const auto per_row = static_cast<int32_t>((columns + kChunkQuads - 1) / kChunkQuads);
+  const auto count = static_cast<int32_t>(chunks.size());
+  for (int32_t i = 0; i < count; ++i) {
+    Chunk& chunk = chunks[i];
+    LodPiece piece = builder.build(chunk.c0, chunk.c1, chunk.r0, chunk.r1, std::move(chunk.errors));
+    const int32_t column = i % per_row;
+    piece.across = {i >= per_row ? -per_row : 0, i + per_row < count ? per_row : 0,
+                    column > 0 ? -1 : 0, column + 1 < per_row ? 1 : 0};
+    geometry->pieces.push_back(std::move(piece));
   }
 }
 

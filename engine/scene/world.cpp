@@ -107,14 +107,13 @@ Status World::Impl::create_resources() {
   }
   pieces = std::move(geometry.pieces);
   // Every piece is static; the boulders stand for the renderer's obstacles, which it knows
-  // itself. The finest level stops particles, its skirts (under the ground) left out.
+  // itself. The finest level stops particles (its ground: the skirts lie under it).
   occluder_positions.reserve(geometry.vertices.size());
   for (const SceneVertex& v : geometry.vertices) occluder_positions.push_back(v.position);
   for (const LodPiece& piece : pieces) {
     const IndexRange& finest = piece.levels.front();
     const auto begin = geometry.indices.begin() + finest.first_index;
-    occluder_indices.insert(occluder_indices.end(), begin,
-                            begin + (finest.index_count - piece.level0_skirt_index_count));
+    occluder_indices.insert(occluder_indices.end(), begin, begin + finest.index_count);
   }
   assets.add_buffer({"world vertices", Access::VertexBufferRead, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                      bytes_of(geometry.vertices)});

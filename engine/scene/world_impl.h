@@ -80,7 +80,11 @@ struct World::Impl {
   // constants (translated to where the obstacle is). Per view: main, then mirrored.
   std::vector<SceneDraw> main_draws;
   std::vector<SceneDraw> reflection_draws;
-  std::vector<std::pair<float, SceneDraw>> sorted_pieces;  // kept: a steady frame allocates nothing
+  // Kept, so a steady frame allocates nothing: the draws by distance, each piece's level, the
+  // ranges of one piece.
+  std::vector<std::pair<float, SceneDraw>> sorted_pieces;
+  std::vector<uint32_t> piece_levels;
+  std::vector<IndexRange> piece_ranges;
   gpu::SceneConstants main_constants{};
   gpu::SceneConstants reflection_constants{};
   std::vector<gpu::SceneConstants> obstacle_constants;  // per obstacle: main, then mirrored

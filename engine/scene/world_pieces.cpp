@@ -46,16 +46,21 @@ gpu::SceneConstants posed(const gpu::SceneConstants& constants, glm::vec3 offset
 // frame's time, then the floats where their host placed them; `which` 0 main view, 1 mirrored.
 void World::Impl::select_draws(const CullView& view, const gpu::SceneConstants& constants,
                                size_t which, std::vector<SceneDraw>* draws, uint32_t* triangles) {
+  piece_levels.resize(pieces.size());
+  for (size_t i = 0; i < pieces.size(); ++i) piece_levels[i] = choose_level(pieces[i], view);
   std::vector<std::pair<float, SceneDraw>>& seen = sorted_pieces;
   seen.clear();
-  for (const LodPiece& piece : pieces) {
-    const uint32_t level = choose_level(piece, view);
-    if (level == kCulled) continue;
-    const IndexRange& range = piece.levels[level];
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    if (piece_levels[i] == kCulled) continue;
+    const LodPiece& piece = pieces[i];
     const glm::vec3 nearest = glm::clamp(view.camera, piece.lo, piece.hi);
-    seen.push_back({glm::length(nearest - view.camera),
-                    {range.first_index, range.index_count, &constants, piece.material,
-                     piece.one_sided}});
+    const float distance = glm::length(nearest - view.camera);
+    piece_ranges.clear();
+    append_piece_ranges(pieces, piece_levels, i, &piece_ranges);
+    for (const IndexRange& range : piece_ranges) {
+      seen.push_back({distance, {range.first_index, range.index_count, &constants, piece.material,
+                                 piece.one_sided}});
+    }
   }
   std::stable_sort(seen.begin(), seen.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });

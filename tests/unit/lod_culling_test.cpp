@@ -2,6 +2,7 @@
 // triangles, a chunk behind the camera, beside the frustum, beyond its far plane or below the
 // reflection's clip plane is not drawn, and a chunked grid's levels join ever fewer points with skirts at their edges.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <glm/geometric.hpp>
@@ -205,12 +206,23 @@ TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
   ASSERT_EQ(geometry.pieces.size(), 6u);
   const LodPiece& full = geometry.pieces[0];
   ASSERT_EQ(full.levels.size(), kTerrainLevels);
+  ASSERT_EQ(full.skirts.size(), kTerrainLevels);
   for (uint32_t level = 0; level < kTerrainLevels; ++level) {
     const uint32_t per_side = 16u >> level;
-    // Two triangles a quad, and two a skirt segment on four sides.
-    EXPECT_EQ(full.levels[level].index_count, 6u * per_side * per_side + 4u * 6u * per_side) << level;
+    // Two triangles a quad; two a skirt segment, each edge's skirt right after the one before.
+    EXPECT_EQ(full.levels[level].index_count, 6u * per_side * per_side) << level;
+    uint32_t next = full.levels[level].first_index + full.levels[level].index_count;
+    for (size_t edge = 0; edge < kChunkEdges; ++edge) {
+      EXPECT_EQ(full.skirts[level][edge].first_index, next) << level << " " << edge;
+      EXPECT_EQ(full.skirts[level][edge].index_count, 6u * per_side) << level << " " << edge;
+      next += full.skirts[level][edge].index_count;
+    }
   }
-  EXPECT_EQ(full.level0_skirt_index_count, 4u * 6u * 16u);
+  // Row by row, three chunks a row: the chunks across each edge.
+  using Across = std::array<int32_t, kChunkEdges>;
+  EXPECT_EQ(geometry.pieces[0].across, (Across{0, 3, 0, 1}));
+  EXPECT_EQ(geometry.pieces[4].across, (Across{-3, 0, -1, 1}));
+  EXPECT_EQ(geometry.pieces[5].across, (Across{-3, 0, -1, 0}));
   // Skirts hang below the ground, deeper than any level's error: the bounds reach down.
   float deepest = 0.0f;
   for (const LodPiece& piece : geometry.pieces) deepest = std::max(deepest, piece.level_error.back());
@@ -218,7 +230,9 @@ TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
   EXPECT_LE(full.hi.y, 1.0f);
   // Every level's triangles use grid points (or their hung copies) of its own chunk only.
   for (const LodPiece& piece : geometry.pieces) {
-    for (const IndexRange& level : piece.levels) {
+    std::vector<IndexRange> runs = piece.levels;
+    for (const auto& edges : piece.skirts) runs.insert(runs.end(), edges.begin(), edges.end());
+    for (const IndexRange& level : runs) {
       for (uint32_t i = level.first_index; i < level.first_index + level.index_count; ++i) {
         const glm::vec3& p = geometry.vertices.at(geometry.indices.at(i)).position;
         EXPECT_GE(p.x, piece.lo.x - 1e-4f);
@@ -233,7 +247,9 @@ TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
   for (const LodPiece& piece : geometry.pieces) {
     EXPECT_TRUE(piece.one_sided);
     const glm::vec3 centre = 0.5f * (piece.lo + piece.hi);
-    for (const IndexRange& level : piece.levels) {
+    std::vector<IndexRange> runs = piece.levels;
+    for (const auto& edges : piece.skirts) runs.insert(runs.end(), edges.begin(), edges.end());
+    for (const IndexRange& level : runs) {
       for (uint32_t i = level.first_index; i < level.first_index + level.index_count; i += 3) {
         const glm::vec3& a = geometry.vertices[geometry.indices[i]].position;
         const glm::vec3& b = geometry.vertices[geometry.indices[i + 1]].position;
@@ -251,6 +267,56 @@ TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
   // The chunk of 8 x 4 quads (the corner) coarsens as far as its longer side allows.
   EXPECT_EQ(geometry.pieces[5].levels.size(), 4u);
   EXPECT_EQ(geometry.pieces[5].level_error.size(), 4u);
+}
+
+// The ranges a chunk draws, at the levels chosen for all.
+std::vector<IndexRange> ranges_of(const SceneGeometry& geometry, const std::vector<uint32_t>& levels,
+                                  size_t i) {
+  std::vector<IndexRange> ranges;
+  append_piece_ranges(geometry.pieces, levels, i, &ranges);
+  return ranges;
+}
+
+IndexRange joined(IndexRange a, const IndexRange& b) {
+  EXPECT_EQ(a.first_index + a.index_count, b.first_index);
+  a.index_count += b.index_count;
+  return a;
+}
+
+// A chunk's level with all four skirts.
+IndexRange whole(const LodPiece& piece, uint32_t level) {
+  IndexRange range = piece.levels[level];
+  for (const IndexRange& skirt : piece.skirts[level]) range = joined(range, skirt);
+  return range;
+}
+
+TEST(TerrainChunks, SkirtsOnlyWhereACrackCanOpen) {
+  // 3 x 3 chunks: the middle one (4) has a neighbour across every edge.
+  const SceneGeometry geometry = rolling_grid(48, 48, 1.0f);
+  ASSERT_EQ(geometry.pieces.size(), 9u);
+  const LodPiece& middle = geometry.pieces[4];
+  std::vector<uint32_t> levels(9, 1);
+  // All at one level: they share every edge's points, and the middle one draws its ground only.
+  EXPECT_EQ(ranges_of(geometry, levels, 4), std::vector<IndexRange>{middle.levels[1]});
+  // A corner chunk hangs skirts along the grid's border, where no chunk lies across: its first
+  // row's joined to its ground, its first column's apart.
+  const LodPiece& corner = geometry.pieces[0];
+  EXPECT_EQ(ranges_of(geometry, levels, 0),
+            (std::vector<IndexRange>{joined(corner.levels[1], corner.skirts[1][0]), corner.skirts[1][2]}));
+  // The chunk across the last row finer, the one across the first column coarser: a skirt on
+  // each of those edges (the two joined), on both sides of each.
+  levels[7] = 0;
+  levels[3] = 2;
+  EXPECT_EQ(ranges_of(geometry, levels, 4),
+            (std::vector<IndexRange>{middle.levels[1], joined(middle.skirts[1][1], middle.skirts[1][2])}));
+  // Those two differ from every neighbour (or lie on the border) across every edge: ground and
+  // all skirts, one range.
+  EXPECT_EQ(ranges_of(geometry, levels, 7), std::vector<IndexRange>{whole(geometry.pieces[7], 0)});
+  EXPECT_EQ(ranges_of(geometry, levels, 3), std::vector<IndexRange>{whole(geometry.pieces[3], 2)});
+  // A neighbour not drawn opens no crack.
+  levels[7] = kCulled;
+  levels[3] = kCulled;
+  EXPECT_EQ(ranges_of(geometry, levels, 4), std::vector<IndexRange>{middle.levels[1]});
 }
 
 }  // namespace
