@@ -6,14 +6,12 @@
 
 layout(push_constant) uniform Push { SceneConstants scene; };
 layout(set = 0, binding = 0) uniform sampler2D base_color;
-layout(location = 0) in vec3 in_world;  // scene.vert's output, declared so that it is consumed
-layout(location = 1) in vec3 in_irradiance;
-layout(location = 2) in vec4 in_color;
-layout(location = 3) in vec2 in_texcoord;
-layout(location = 4) in vec4 in_fog;
+layout(location = 0) in vec4 in_surface;  // scene.vert's: the texture coordinate, red, green
+layout(location = 1) in vec4 in_lit;      // w: blue
+layout(location = 2) in vec3 in_haze;
 layout(location = 0) out vec4 out_color;
 
 void main() {
-  vec3 albedo = texture(base_color, in_texcoord).rgb * in_color.rgb;
-  out_color = vec4(shade_scene(albedo, in_irradiance, in_fog), 1.0);
+  vec3 albedo = texture(base_color, in_surface.xy).rgb * vec3(in_surface.zw, in_lit.w);
+  out_color = vec4(shade_scene(albedo, in_lit.rgb, in_haze), 1.0);
 }

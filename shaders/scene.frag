@@ -7,11 +7,9 @@
 
 layout(push_constant) uniform Push { SceneConstants scene; };
 layout(set = 0, binding = 0) uniform sampler2D ground_detail;
-layout(location = 0) in vec3 in_world;
-layout(location = 1) in vec3 in_irradiance;
-layout(location = 2) in vec4 in_color;
-layout(location = 3) in vec2 in_texcoord;
-layout(location = 4) in vec4 in_fog;
+layout(location = 0) in vec4 in_surface;  // scene.vert's
+layout(location = 1) in vec4 in_lit;
+layout(location = 2) in vec3 in_haze;
 layout(location = 0) out vec4 out_color;
 
 const vec3 kRiverbed = vec3(0.30, 0.27, 0.21);
@@ -32,12 +30,12 @@ vec3 ground_albedo(float above, float rock, float wobble) {
 
 void main() {
   // Two scales of the tileable detail texture, in world metres, break up the colours.
-  vec2 fine = texture(ground_detail, in_world.xz * 0.25).rg;
-  float coarse = texture(ground_detail, in_world.xz * 0.031).g;
+  vec2 fine = texture(ground_detail, in_surface.xy * 0.25).rg;
+  float coarse = texture(ground_detail, in_surface.xy * 0.031).g;
   float detail = fine.r * 0.6 + coarse * 0.4;
-  // (Interpolated, the ground's alpha is only near SIVIFLOW_GROUND_VERTEX: any negative one.)
-  vec3 base = in_color.a < 0.0 ? ground_albedo(in_texcoord.x, in_texcoord.y, fine.g + coarse - 1.0)
-                               : in_color.rgb;
+  // (Interpolated, only the ground's w is negative.)
+  vec3 base = in_lit.w < 0.0 ? ground_albedo(in_surface.z, in_surface.w, fine.g + coarse - 1.0)
+                             : vec3(in_surface.zw, in_lit.w);
   vec3 albedo = base * mix(0.75, 1.25, detail);
-  out_color = vec4(shade_scene(albedo, in_irradiance, in_fog), 1.0);
+  out_color = vec4(shade_scene(albedo, in_lit.rgb, in_haze), 1.0);
 }

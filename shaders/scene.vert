@@ -8,11 +8,14 @@ layout(location = SIVIFLOW_ATTR_POSITION) in vec3 in_position;
 layout(location = SIVIFLOW_ATTR_NORMAL) in vec3 in_normal;
 layout(location = SIVIFLOW_ATTR_COLOR) in vec4 in_color;
 layout(location = SIVIFLOW_ATTR_TEXCOORD) in vec2 in_texcoord;
-layout(location = 0) out vec3 out_world;
-layout(location = 1) out vec3 out_irradiance;
-layout(location = 2) out vec4 out_color;
-layout(location = 3) out vec2 out_texcoord;
-layout(location = 4) out vec4 out_fog;
+// The object pipeline's (glTF objects, object.frag): a base-colour texture coordinate in place
+// of the world position.
+layout(constant_id = 0) const bool kTextured = false;
+// x, y: world x and z, or (kTextured) the texture coordinate. z, w: the ground's height above
+// the water and its rock (SIVIFLOW_GROUND_VERTEX), else the colour's red and green.
+layout(location = 0) out vec4 out_surface;
+layout(location = 1) out vec4 out_lit;  // SceneLight::lit; w: -1 for the ground, else the blue
+layout(location = 2) out vec3 out_haze;
 
 out gl_PerVertex {
   vec4 gl_Position;
@@ -20,13 +23,11 @@ out gl_PerVertex {
 };
 
 void main() {
-  out_world = in_position;
-  float occlusion = in_color.a < 0.0 ? 1.0 : in_color.a;  // ground: SIVIFLOW_GROUND_VERTEX
-  SceneLight light = light_scene(scene, occlusion, in_position, in_normal);
-  out_irradiance = light.irradiance;
-  out_fog = light.fog;
-  out_color = in_color;
-  out_texcoord = in_texcoord;
+  const bool ground = in_color.a < 0.0;  // SIVIFLOW_GROUND_VERTEX
+  SceneLight light = light_scene(scene, ground ? 1.0 : in_color.a, in_position, in_normal);
+  out_surface = vec4(kTextured ? in_texcoord : in_position.xz, ground ? in_texcoord : in_color.rg);
+  out_lit = vec4(light.lit, ground ? -1.0 : in_color.b);
+  out_haze = light.haze;
   gl_Position = scene.view_proj * vec4(in_position, 1.0);
   // The reflection pass sets a water plane here; the main view uses a plane that keeps all.
   gl_ClipDistance[0] = dot(scene.clip_plane.xyz, in_position) + scene.clip_plane.w;

@@ -4,9 +4,11 @@
 // glTF mesh of large triangles gets its fog and sun interpolated linearly across each).
 #include "sky_common.glsl"
 
+// A vertex's light, in the form that shades a fragment in one multiply-add (shade_scene): fewer
+// values to interpolate, which a software rasterizer pays for per triangle and per pixel.
 struct SceneLight {
-  vec3 irradiance;  // sun (Lambert) plus hemispheric sky light: multiplies the albedo
-  vec4 fog;         // rgb sky colour of the view direction, a fog amount (0 clear .. 1 sky)
+  vec3 lit;   // sun (Lambert) plus hemispheric sky light, less the fog's share: multiplies the albedo
+  vec3 haze;  // the sky colour of the view direction times the fog's share (0 clear .. 1 sky)
 };
 
 SceneLight light_scene(SceneConstants scene, float occlusion, vec3 world, vec3 normal) {
@@ -15,17 +17,18 @@ SceneLight light_scene(SceneConstants scene, float occlusion, vec3 world, vec3 n
   // Sun (Lambert) plus a hemispheric sky term scaled by ambient occlusion.
   float diffuse = max(dot(n, sun), 0.0);
   vec3 sky_light = mix(vec3(0.20, 0.19, 0.17), vec3(0.35, 0.45, 0.62), n.y * 0.5 + 0.5);
-  SceneLight light;
-  light.irradiance = vec3(1.0, 0.95, 0.85) * 1.1 * diffuse + sky_light * occlusion;
+  vec3 irradiance = vec3(1.0, 0.95, 0.85) * 1.1 * diffuse + sky_light * occlusion;
   // Height-attenuated exponential fog towards the sky colour of the view direction.
   vec3 to_vertex = world - scene.camera_position.xyz;
   float dist = length(to_vertex);
   vec3 direction = to_vertex / max(dist, 1e-4);
-  float fog = 1.0 - exp(-scene.fog.x * dist * exp(-scene.fog.y * max(world.y + scene.fog.z, 0.0)));
-  light.fog = vec4(sky_radiance(direction, sun, 0.0), clamp(fog, 0.0, 1.0));
+  float fog = clamp(1.0 - exp(-scene.fog.x * dist * exp(-scene.fog.y * max(world.y + scene.fog.z, 0.0))),
+                    0.0, 1.0);
+  SceneLight light;
+  light.lit = irradiance * (1.0 - fog);
+  light.haze = sky_radiance(direction, sun, 0.0) * fog;
   return light;
 }
 
-vec3 shade_scene(vec3 albedo, vec3 irradiance, vec4 fog) {
-  return mix(albedo * irradiance, fog.rgb, fog.a);
-}
+// The albedo lit and fogged: mix(albedo * irradiance, sky, fog).
+vec3 shade_scene(vec3 albedo, vec3 lit, vec3 haze) { return albedo * lit + haze; }

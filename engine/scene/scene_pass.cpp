@@ -42,6 +42,7 @@ Status ScenePass::create(const GpuContext& gpu, VkPipelineCache cache, VkFormat 
   SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, scene, &scene_pipeline_));
   GraphicsPipelineDesc object = scene;
   object.fragment_shader = "object.frag";
+  object.vertex_constants = {1};  // scene.vert's kTextured
   return create_graphics_pipeline(gpu, cache, object, &object_pipeline_);
 }
 

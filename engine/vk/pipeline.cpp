@@ -47,14 +47,20 @@ Status create_graphics_pipeline(const GpuContext& gpu, VkPipelineCache cache,
     stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
     stages[1].module = fragment;
     stages[1].pName = "main";
+    // Constant i at offset 4 i, in either stage.
     std::vector<VkSpecializationMapEntry> entries;
-    for (uint32_t i = 0; i < desc.fragment_constants.size(); ++i) {
+    const size_t most = std::max(desc.vertex_constants.size(), desc.fragment_constants.size());
+    for (uint32_t i = 0; i < most; ++i) {
       entries.push_back({i, i * static_cast<uint32_t>(sizeof(uint32_t)), sizeof(uint32_t)});
     }
-    const VkSpecializationInfo specialization{
-        static_cast<uint32_t>(entries.size()), entries.data(),
-        desc.fragment_constants.size() * sizeof(uint32_t), desc.fragment_constants.data()};
-    if (!entries.empty()) stages[1].pSpecializationInfo = &specialization;
+    const auto specialization = [&entries](const std::vector<uint32_t>& constants) {
+      return VkSpecializationInfo{static_cast<uint32_t>(constants.size()), entries.data(),
+                                  constants.size() * sizeof(uint32_t), constants.data()};
+    };
+    const VkSpecializationInfo vertex_specialization = specialization(desc.vertex_constants);
+    const VkSpecializationInfo fragment_specialization = specialization(desc.fragment_constants);
+    if (!desc.vertex_constants.empty()) stages[0].pSpecializationInfo = &vertex_specialization;
+    if (!desc.fragment_constants.empty()) stages[1].pSpecializationInfo = &fragment_specialization;
 
     VkPipelineVertexInputStateCreateInfo vertex_input{
         VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
