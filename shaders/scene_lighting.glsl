@@ -7,7 +7,7 @@
 // A vertex's light, in the form that shades a fragment in one multiply-add (shade_scene): fewer
 // values to interpolate, which a software rasterizer pays for per triangle and per pixel.
 struct SceneLight {
-  vec3 lit;   // sun (Lambert) plus hemispheric sky light, less the fog's share: multiplies the albedo
+  vec3 lit;   // sun (Lambert) and hemispheric sky light less the fog's share: times the albedo
   vec3 haze;  // the sky colour of the view direction times the fog's share (0 clear .. 1 sky)
 };
 
@@ -22,8 +22,8 @@ SceneLight light_scene(SceneConstants scene, float occlusion, vec3 world, vec3 n
   vec3 to_vertex = world - scene.camera_position.xyz;
   float dist = length(to_vertex);
   vec3 direction = to_vertex / max(dist, 1e-4);
-  float fog = clamp(1.0 - exp(-scene.fog.x * dist * exp(-scene.fog.y * max(world.y + scene.fog.z, 0.0))),
-                    0.0, 1.0);
+  float density = scene.fog.x * exp(-scene.fog.y * max(world.y + scene.fog.z, 0.0));
+  float fog = clamp(1.0 - exp(-density * dist), 0.0, 1.0);
   SceneLight light;
   light.lit = irradiance * (1.0 - fog);
   light.haze = sky_radiance(direction, sun, 0.0) * fog;

@@ -17,7 +17,8 @@
 
 namespace siviflow {
 
-// A terrain chunk's edges: its first and last row of quads, its first and last column.
+// A terrain chunk's edges: the grid lines it begins and ends on, first its rows', then its
+// columns'.
 constexpr size_t kChunkEdges = 4;
 
 // A static piece of the world: a terrain chunk with its levels of detail, or an object.
@@ -50,9 +51,10 @@ constexpr uint32_t kCulled = ~uint32_t{0};
 // The level `piece` is drawn at in `view`, or kCulled.
 uint32_t choose_level(const LodPiece& piece, const CullView& view);
 
-// What piece `i` of `pieces` draws at `levels[i]` (each piece's choose_level): its level's
-// ground, and the skirts of the edges across which a chunk is drawn at another level or none
-// lies (a crack opens only between levels), ranges that touch joined; appended to `out`.
+// What piece `i` of `pieces` draws at `levels[i]` (each piece's choose_level; not kCulled): its
+// level's ground, and the skirts of the edges across which a chunk is drawn at another level or
+// none lies (a crack opens only between levels), ranges that touch joined; appended to `out`.
+// `levels` holds a level for every piece, so the pieces across (by `across`) are found in it.
 void append_piece_ranges(std::span<const LodPiece> pieces, std::span<const uint32_t> levels,
                          size_t i, std::vector<IndexRange>* out);
 

@@ -22,7 +22,7 @@ struct GraphicsPipelineDesc {
   // (32 bits each; a bool is 0 or 1). Variants that would otherwise be uniform branches, which a software
   // rasterizer pays for even when untaken.
   std::vector<uint32_t> fragment_constants;
-  std::vector<uint32_t> vertex_constants;  // the vertex shader's, likewise
+  std::vector<uint32_t> vertex_constants;  // the vertex shader's, laid out alike
   std::vector<VkVertexInputBindingDescription> bindings;
   std::vector<VkVertexInputAttributeDescription> attributes;
   VkPipelineLayout layout = VK_NULL_HANDLE;

@@ -270,8 +270,8 @@ TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
 }
 
 // The ranges a chunk draws, at the levels chosen for all.
-std::vector<IndexRange> ranges_of(const SceneGeometry& geometry, const std::vector<uint32_t>& levels,
-                                  size_t i) {
+std::vector<IndexRange> ranges_of(const SceneGeometry& geometry,
+                                  const std::vector<uint32_t>& levels, size_t i) {
   std::vector<IndexRange> ranges;
   append_piece_ranges(geometry.pieces, levels, i, &ranges);
   return ranges;
@@ -302,13 +302,15 @@ TEST(TerrainChunks, SkirtsOnlyWhereACrackCanOpen) {
   // row's joined to its ground, its first column's apart.
   const LodPiece& corner = geometry.pieces[0];
   EXPECT_EQ(ranges_of(geometry, levels, 0),
-            (std::vector<IndexRange>{joined(corner.levels[1], corner.skirts[1][0]), corner.skirts[1][2]}));
+            (std::vector<IndexRange>{joined(corner.levels[1], corner.skirts[1][0]),
+                                     corner.skirts[1][2]}));
   // The chunk across the last row finer, the one across the first column coarser: a skirt on
   // each of those edges (the two joined), on both sides of each.
   levels[7] = 0;
   levels[3] = 2;
   EXPECT_EQ(ranges_of(geometry, levels, 4),
-            (std::vector<IndexRange>{middle.levels[1], joined(middle.skirts[1][1], middle.skirts[1][2])}));
+            (std::vector<IndexRange>{middle.levels[1],
+                                     joined(middle.skirts[1][1], middle.skirts[1][2])}));
   // Those two differ from every neighbour (or lie on the border) across every edge: ground and
   // all skirts, one range.
   EXPECT_EQ(ranges_of(geometry, levels, 7), std::vector<IndexRange>{whole(geometry.pieces[7], 0)});
@@ -317,6 +319,54 @@ TEST(TerrainChunks, SkirtsOnlyWhereACrackCanOpen) {
   levels[7] = kCulled;
   levels[3] = kCulled;
   EXPECT_EQ(ranges_of(geometry, levels, 4), std::vector<IndexRange>{middle.levels[1]});
+}
+
+// The grid points a skirt hangs from (each segment's two upper corners; the rest are hung copies).
+std::vector<uint32_t> hung_from(const SceneGeometry& geometry, const IndexRange& skirt) {
+  std::vector<uint32_t> points;
+  for (uint32_t i = skirt.first_index; i < skirt.first_index + skirt.index_count; i += 6) {
+    points.push_back(geometry.indices[i]);
+    points.push_back(geometry.indices[i + 2]);
+  }
+  std::sort(points.begin(), points.end());
+  points.erase(std::unique(points.begin(), points.end()), points.end());
+  return points;
+}
+
+TEST(TerrainChunks, ASkirtHangsFromTheEdgeItSharesWithTheChunkAcross) {
+  // Two grids, the second appended after the first: its ranges and offsets move with it.
+  SceneGeometry geometry = rolling_grid(3 * kChunkQuads, 2 * kChunkQuads, 1.0f);
+  const size_t first_grid = geometry.pieces.size();
+  append_geometry(rolling_grid(2 * kChunkQuads, 3 * kChunkQuads, 2.0f), &geometry);
+  ASSERT_EQ(geometry.pieces.size(), first_grid + 6);
+  size_t shared_edges = 0;
+  for (size_t i = 0; i < geometry.pieces.size(); ++i) {
+    const LodPiece& piece = geometry.pieces[i];
+    const size_t grid_begin = i < first_grid ? 0 : first_grid;
+    const size_t grid_end = i < first_grid ? first_grid : geometry.pieces.size();
+    for (size_t level = 0; level < piece.skirts.size(); ++level) {
+      // The skirts lie right after the level's ground, in the appended index buffer.
+      EXPECT_EQ(piece.skirts[level][0].first_index,
+                piece.levels[level].first_index + piece.levels[level].index_count);
+      for (size_t edge = 0; edge < kChunkEdges; ++edge) {
+        const int32_t across = piece.across[edge];
+        if (across == 0) continue;
+        const size_t other = i + across;
+        ASSERT_GE(other, grid_begin) << i << " " << edge;
+        ASSERT_LT(other, grid_end) << i << " " << edge;
+        // Its first row's line is the last row's of the chunk before it, and so on: at one level
+        // both hang from the same grid points.
+        const size_t facing = edge ^ 1u;
+        EXPECT_EQ(geometry.pieces[other].across[facing], -across);
+        EXPECT_EQ(hung_from(geometry, piece.skirts[level][edge]),
+                  hung_from(geometry, geometry.pieces[other].skirts[level][facing]))
+            << i << " " << edge << " " << level;
+        ++shared_edges;
+      }
+    }
+  }
+  // 3 x 2 chunks share 7 edges and 2 x 3 share 7, counted from both sides at 4 levels.
+  EXPECT_EQ(shared_edges, 2u * 14u * kTerrainLevels);
 }
 
 }  // namespace
