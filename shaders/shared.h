@@ -150,9 +150,8 @@ struct FlowConstants {
 //   .b      bits 0-11 and 12-23: the map offset at the tile centre (hashed offset minus the
 //           scroll, mod 1) in 1/4096; bits 24-31: the foam at the tile centre (0..1, the
 //           particle's, sim/foam.h) in 1/255
-//   .a      two halves (packHalf2x16): the factor of (a, b) that turns a sampled tilt back into
-//           world x/z, with the roughness of the tile's speed; log2 |M|, the normal map's level
-//           of detail over the fragment's (tdf_encode_tile)
+//   .a      float bits of the factor of (a, b) that turns a sampled tilt back into world x/z,
+//           with the roughness of the tile's speed (tdf_encode_tile)
 #define SIVIFLOW_TILE_TABLE_MAX 512u
 // Water heights (R32_SFLOAT, world-aligned samples, see FlowTileConstants.heights) are this or
 // more where no water is near: the lattice points there are no tile of any water fragment.

@@ -56,12 +56,10 @@ uvec4 tdf_encode_tile(ivec2 lattice, vec3 flow, float foam, float periods, float
   uint foam_bits = uint(round(clamp(foam, 0.0, 1.0) * 255.0));
   // What every fragment would otherwise derive from (a, b) for each of its four tiles: the
   // factor of R(+angle) by which a sampled tilt turns back into world x/z, scaled by the
-  // roughness (repeat / scale, times the roughness of this speed), and the normal map's level of
-  // detail over the fragment's own, log2 |M|.
+  // roughness (repeat / scale, times the roughness of this speed).
   float back = mix(kTdfStillRoughness, 1.0, fast) * repeat_tiles / scale;
-  float lod_offset = log2(scale / repeat_tiles);
   return uvec4(floatBitsToUint(ab), offset_bits.x | (offset_bits.y << 12) | (foam_bits << 24),
-               packHalf2x16(vec2(back, lod_offset)));
+               floatBitsToUint(back));
 }
 
 // A tile table texel's map offset (xy) and foam (z), unpacked.
