@@ -29,7 +29,7 @@
 //     and the sampler's own derivatives give the footprint's level of detail. Chosen per pixel,
 //     a quad straddling a tile edge would see the coordinate jump and read the 1x1 mip; now its
 //     pixels past the edge take the tile beside them a pixel further, where that grid's weight
-//     is next to zero. An explicit level of detail (textureLod, textureGrad) cost lavapipe 13
+//     is next to zero. An explicit level of detail (textureLod, textureGrad) cost lavapipe 11
 //     to 22 % more of the material, its mip levels picked per pixel instead of per quad.
 // Scroll: phase = fract(time * rate), with the rate quantised to whole cycles per
 // SIVIFLOW_TDF_TIME_PERIOD, so time wrapped to [0, period) on the CPU (in double) is seamless

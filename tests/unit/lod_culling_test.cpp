@@ -200,6 +200,13 @@ TEST(ViewCulling, ANarrowedViewCullsWhatLiesOutsideItsPart) {
   EXPECT_TRUE(box_outside_view({-21.0f, -2.0f, 40.0f}, {-20.0f, -1.0f, 41.0f}, narrowed));
 }
 
+// Every run of a piece's index buffer: its levels' ground, then their skirts.
+std::vector<IndexRange> runs_of(const LodPiece& piece) {
+  std::vector<IndexRange> runs = piece.levels;
+  for (const auto& edges : piece.skirts) runs.insert(runs.end(), edges.begin(), edges.end());
+  return runs;
+}
+
 TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
   const SceneGeometry geometry = rolling_grid(40, 20, 1.0f);
   // 40 x 20 quads in 16-quad chunks: 3 x 2, the last row and column narrower.
@@ -230,9 +237,7 @@ TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
   EXPECT_LE(full.hi.y, 1.0f);
   // Every level's triangles use grid points (or their hung copies) of its own chunk only.
   for (const LodPiece& piece : geometry.pieces) {
-    std::vector<IndexRange> runs = piece.levels;
-    for (const auto& edges : piece.skirts) runs.insert(runs.end(), edges.begin(), edges.end());
-    for (const IndexRange& level : runs) {
+    for (const IndexRange& level : runs_of(piece)) {
       for (uint32_t i = level.first_index; i < level.first_index + level.index_count; ++i) {
         const glm::vec3& p = geometry.vertices.at(geometry.indices.at(i)).position;
         EXPECT_GE(p.x, piece.lo.x - 1e-4f);
@@ -247,9 +252,7 @@ TEST(TerrainChunks, LevelsJoinFewerPointsAndHangSkirts) {
   for (const LodPiece& piece : geometry.pieces) {
     EXPECT_TRUE(piece.one_sided);
     const glm::vec3 centre = 0.5f * (piece.lo + piece.hi);
-    std::vector<IndexRange> runs = piece.levels;
-    for (const auto& edges : piece.skirts) runs.insert(runs.end(), edges.begin(), edges.end());
-    for (const IndexRange& level : runs) {
+    for (const IndexRange& level : runs_of(piece)) {
       for (uint32_t i = level.first_index; i < level.first_index + level.index_count; i += 3) {
         const glm::vec3& a = geometry.vertices[geometry.indices[i]].position;
         const glm::vec3& b = geometry.vertices[geometry.indices[i + 1]].position;
