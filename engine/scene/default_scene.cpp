@@ -166,8 +166,10 @@ SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vect
   add_terrain(river, &geometry);
   // Boulders on both banks, and trees: a piece each.
   // Each where the river leaves land for it, a metre from the water (a wider river, a
-  // confluence's, may cover the spot).
-  const auto dry = [&](float x, float z) {
+  // confluence's, may cover the spot); `offset` across the valley from the centreline at z, the
+  // spot on_ground stands it on.
+  const auto dry = [&](float offset, float z) {
+    const float x = river.centreline_x(z) + offset;
     for (const glm::vec2 d : {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(-1, 0), glm::vec2(0, 1), glm::vec2(0, -1)}) {
       if (river.depth_at(x + d.x, z + d.y) > 0.0f) return false;
     }
@@ -185,10 +187,10 @@ SceneGeometry build_scene_geometry(const ProceduralRiver& river, const std::vect
   }
   for (int i = 0; i < 6; ++i) {
     const float z = -60.0f + 22.0f * static_cast<float>(i);
-    const float x = ((i % 2 == 0) ? -1.0f : 1.0f) * (13.0f + 3.0f * static_cast<float>(i % 3));
-    if (!dry(x, z)) continue;
+    const float offset = ((i % 2 == 0) ? -1.0f : 1.0f) * (13.0f + 3.0f * static_cast<float>(i % 3));
+    if (!dry(offset, z)) continue;
     first = static_cast<uint32_t>(geometry.indices.size());
-    add_tree(on_ground(river, x, z), 7.0f + static_cast<float>(i % 3), &geometry);
+    add_tree(on_ground(river, offset, z), 7.0f + static_cast<float>(i % 3), &geometry);
     add_object_piece(first, &geometry);
   }
   add_obstacle_boulders(obstacles, &geometry);
