@@ -4,9 +4,11 @@ side in one PNG, a row per frame and a column per build, so a reader sees at a g
 change made the picture worse.
 
 usage: tools/scripts/contact_sheet.py --out SHEET.png [--size WxH] [--frames F,F,...]
-                                      [--scene SCENE.json] NAME=BINARY NAME=BINARY ...
+                                      [--scene SCENE.json] [--validation]
+                                      NAME=BINARY NAME=BINARY ...
   Each build renders each frame with `capture --range F:F+1 --preview` (lavapipe, 2 threads, as
-  CI renders); the columns come in the order given. The default scene when --scene is left out.
+  CI renders); the columns come in the order given. The default scene when --scene is left out;
+  --validation captures with the Khronos validation layer.
   Prints the mean and largest difference of each column against the first, per frame.
 """
 import argparse
@@ -95,10 +97,15 @@ def write_png(path, width, rows):
                                    chunk(b"IDAT", pixels) + chunk(b"IEND", b""))
 
 
-def render(binary, scene, size, frame, folder):
-    command = [binary, "capture"] + ([scene] if scene else []) + [
-        "--range", f"{frame}:{frame + 1}", "--size", size, "--preview", "--out", str(folder)]
-    done = subprocess.run(command, capture_output=True, text=True)
+def render(binary, args, frame, folder):
+    command = [binary, "capture"] + ([args.scene] if args.scene else []) + [
+        "--range", f"{frame}:{frame + 1}", "--size", args.size, "--preview", "--out", str(folder)]
+    if args.validation:
+        command.append("--validation")
+    try:
+        done = subprocess.run(command, capture_output=True, text=True)
+    except OSError as error:
+        sys.exit(f"{binary}: cannot run it: {error.strerror}")
     if done.returncode != 0:
         sys.exit(f"{binary} capture of frame {frame} failed:\n{done.stderr}")
     return read_png(pathlib.Path(folder) / f"frame_{frame:05d}.png")
@@ -110,12 +117,18 @@ def main():
     parser.add_argument("--size", default="640x360")
     parser.add_argument("--frames", default="0,75,150")
     parser.add_argument("--scene")
+    parser.add_argument("--validation", action="store_true")
     parser.add_argument("builds", nargs="+", metavar="NAME=BINARY")
     args = parser.parse_args()
     builds = [pair.split("=", 1) for pair in args.builds]
     if any(len(pair) != 2 for pair in builds):
         sys.exit("each build is NAME=BINARY")
-    frames = [int(f) for f in args.frames.split(",")]
+    try:
+        frames = [int(f) for f in args.frames.split(",")]
+    except ValueError:
+        sys.exit(f"--frames {args.frames}: not a comma list of frame numbers")
+    if any(f < 0 for f in frames):
+        sys.exit(f"--frames {args.frames}: a frame number is negative")
     os.environ.setdefault("VK_DRIVER_FILES", "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json")
     os.environ.setdefault("LP_NUM_THREADS", "2")
 
@@ -124,7 +137,7 @@ def main():
         cells = []
         for name, binary in builds:
             with tempfile.TemporaryDirectory() as folder:
-                cells.append(render(binary, args.scene, args.size, frame, folder))
+                cells.append(render(binary, args, frame, folder))
         first = cells[0][2]
         for (name, _), (_, _, rows) in zip(builds[1:], cells[1:]):
             diffs = [abs(a - b) for ra, rb in zip(first, rows) for a, b in zip(ra, rb)]

@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""tools/scripts/contact_sheet.py lays each build's frames side by side: the sheet's cells are
+the frames `capture --preview` writes, in the order given, two runs of one build differ by
+nothing, and a build that cannot run ends it with a message and no sheet.
+
+usage: contact_sheet_test.py SIVIFLOW SOURCE WORK [--env VAR=VALUE ...]
+  The script runs in this process; the --env variables reach only the siviflow it starts (a
+  sanitizer's preload is for siviflow, not for Python).
+"""
+import contextlib
+import io
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+
+WIDTH, HEIGHT, FRAMES = 64, 36, (0, 3)
+
+
+def run_sheet(contact_sheet, arguments):
+    """(exit status, what it printed) of the script's main() with these arguments."""
+    sys.argv = ["contact_sheet.py"] + arguments
+    printed = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(printed):
+            contact_sheet.main()
+    except SystemExit as end:
+        message = end.code if isinstance(end.code, str) else ""
+        return (1 if message else end.code or 0), printed.getvalue() + message
+    return 0, printed.getvalue()
+
+
+def main():
+    siviflow, source, work = sys.argv[1], pathlib.Path(sys.argv[2]), pathlib.Path(sys.argv[3])
+    for pair in sys.argv[5:] if sys.argv[4:5] == ["--env"] else []:
+        name, value = pair.split("=", 1)
+        os.environ[name] = value
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    sys.path.insert(0, str(source / "tools" / "scripts"))
+    import contact_sheet
+
+    sheet = work / "sheet.png"
+    status, printed = run_sheet(contact_sheet, [
+        "--out", str(sheet), "--size", f"{WIDTH}x{HEIGHT}", "--frames",
+        ",".join(map(str, FRAMES)), "--validation", f"a={siviflow}", f"b={siviflow}"])
+    if status != 0:
+        sys.exit(f"contact_sheet.py failed ({status}):\n{printed}")
+    failures = []
+    for frame in FRAMES:
+        if f"frame {frame}: b against a: mean 0.00, largest 0 of 255" not in printed:
+            failures.append(f"frame {frame}: not reported identical:\n{printed}")
+    width, height, rows = contact_sheet.read_png(sheet)
+    gap = contact_sheet.GAP
+    if (width, height) != (2 * WIDTH + 3 * gap, len(FRAMES) * (HEIGHT + gap) + gap):
+        failures.append(f"sheet is {width}x{height}")
+    for row_index, frame in enumerate(FRAMES):
+        subprocess.run([siviflow, "capture", "--range", f"{frame}:{frame + 1}", "--size",
+                        f"{WIDTH}x{HEIGHT}", "--preview", "--validation", "--out", str(work)],
+                       check=True, capture_output=True)
+        _, _, alone = contact_sheet.read_png(work / f"frame_{frame:05d}.png")
+        top = gap + row_index * (HEIGHT + gap)
+        for column in range(2):
+            left = 3 * (gap + column * (WIDTH + gap))
+            cell = [rows[top + y][left:left + 3 * WIDTH] for y in range(HEIGHT)]
+            if cell != alone:
+                failures.append(f"frame {frame}, column {column}: not the captured frame")
+    missing = work / "no-such-siviflow"
+    status, printed = run_sheet(contact_sheet, ["--out", str(work / "bad.png"), f"a={missing}"])
+    if status != 1 or str(missing) not in printed:
+        failures.append(f"a missing binary: exit {status}, {printed!r}")
+    if (work / "bad.png").exists():
+        failures.append("a failed sheet was written")
+    if failures:
+        sys.exit("\n".join(failures))
+    print(f"sheet {width}x{height} holds each frame in each column")
+
+
+if __name__ == "__main__":
+    main()
