@@ -228,6 +228,7 @@ Status Renderer::Impl::create_river() {
       if (!valid.ok()) return argument_error("CreateInfo::river->obstacles: " + valid.message());
       obstacles.push_back(flow_obstacle(info.river->obstacles[i]));
     }
+    if (info.river_copied != nullptr) info.river_copied(info.river_copied_user);
   }
   const FlowParams params = river_flow_params(flow, input);
   return SharedRiver::create(table, info.allocation_callbacks, std::move(input), params,

@@ -47,6 +47,8 @@ Status run_bench_once(HeadlessContext& context, const BenchOptions& options,
   SIVIFLOW_TRY(scene_river_data(scene, 0, &river));
   const WaterRiver water = river.river();
   info.river = &water;
+  info.river_copied = &SceneRiverData::release_arrays;  // the renderer holds its copy
+  info.river_copied_user = &river;
   info.look = scene != nullptr ? &scene->look : nullptr;
   info.depth_format = kDepthFormat;
   WorldCreateInfo world_info = context.world_create_info(kOutputFormat, kDepthFormat);

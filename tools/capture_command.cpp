@@ -245,10 +245,11 @@ Status Capture::run() {
   for (size_t i = 0; i < river_count; ++i) {
     const WaterRiver water = plan_.rivers[i].river();
     info.river = &water;
+    info.river_copied = &SceneRiverData::release_arrays;  // the renderer holds its copy
+    info.river_copied_user = &plan_.rivers[i];
     info.readback_images = i + 1 == river_count ? capture_readback_images(options_) : 0;
     rivers_.emplace_back();
     SIVIFLOW_TRY(Renderer::create(info, &rivers_.back()));
-    plan_.rivers[i] = {};  // the renderer holds its copy
     SIVIFLOW_TRY(rivers_.back()->set_occluders(world_->occluders()));
     river_renderers_.push_back(rivers_.back().get());
   }

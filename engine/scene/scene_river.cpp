@@ -219,6 +219,14 @@ WaterRiver SceneRiverData::river() const {
   return river;
 }
 
+void SceneRiverData::release_arrays(void* river) {
+  SceneRiverData& data = *static_cast<SceneRiverData*>(river);
+  data.mesh = RiverMesh();
+  data.slope = std::vector<float>();
+  data.obstacles = std::vector<WaterObstacle>();
+  data.ends = std::vector<WaterRiverEnd>();
+}
+
 namespace {
 
 // The host form of a flow obstacle of the scene (keys and all).

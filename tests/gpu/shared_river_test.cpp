@@ -46,10 +46,29 @@ struct Pane {
   HostBuffer mask;    // read back when the renderer was made with the water mask
 };
 
+// A host's river handed to the renderer with a river_copied callback, which counts its calls,
+// overwrites the arrays with what no river holds and frees them: a renderer that read them
+// after would draw another river (or, under AddressSanitizer, read freed memory).
+struct CopiedRiver {
+  SceneRiverData data;  // none: the built-in river, with the callback still set
+  int calls = 0;
+  static void spoil_and_release(void* user) {
+    auto* river = static_cast<CopiedRiver*>(user);
+    ++river->calls;
+    RiverMesh& mesh = river->data.mesh;
+    std::fill(mesh.positions.begin(), mesh.positions.end(), glm::vec3(NAN));
+    std::fill(mesh.indices.begin(), mesh.indices.end(), UINT32_MAX);
+    std::fill(mesh.depth.begin(), mesh.depth.end(), -1.0f);
+    std::fill(river->data.slope.begin(), river->data.slope.end(), -1.0f);
+    SceneRiverData::release_arrays(&river->data);
+  }
+};
+
 class SharedRiverTest : public GpuTest {
  protected:
   std::unique_ptr<Renderer> make(VkExtent2D extent, const Renderer* share = nullptr,
-                                 const SceneFile* scene = nullptr, uint32_t river = 0) {
+                                 const SceneFile* scene = nullptr, uint32_t river = 0,
+                                 CopiedRiver* copied = nullptr) {
     if (world_ == nullptr) {
       WorldCreateInfo world_info =
           context_->world_create_info(VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_D32_SFLOAT);
@@ -69,6 +88,12 @@ class SharedRiverTest : public GpuTest {
       EXPECT_TRUE(read.ok()) << read.message();
       water = data.river();
       info.river = &water;
+    }
+    if (copied != nullptr) {
+      water = copied->data.river();
+      info.river = copied->data.mesh.positions.empty() ? nullptr : &water;
+      info.river_copied = &CopiedRiver::spoil_and_release;
+      info.river_copied_user = copied;
     }
     std::unique_ptr<Renderer> renderer;
     Status status = Renderer::create(info, &renderer);
@@ -191,6 +216,26 @@ TEST_F(SharedRiverTest, OnUnifiedMemoryTheFlowReadsTheMeshFromTheGpuBuffers) {
                          input.surface.node_positions().begin()));
   EXPECT_TRUE(std::equal(field.indices.begin(), field.indices.end(),
                          input.surface.triangles().begin()));
+}
+
+TEST_F(SharedRiverTest, AHostMayFreeItsRiverOnceTheRendererHasCopiedIt) {
+  const VkExtent2D extent{kWidth, kHeight};
+  CopiedRiver copied;
+  ASSERT_TRUE(scene_river_data(nullptr, 0, &copied.data).ok());  // the built-in river, as a host's
+  auto freed = make(extent, nullptr, nullptr, 0, &copied);
+  ASSERT_NE(freed, nullptr);
+  EXPECT_EQ(copied.calls, 1);
+  EXPECT_TRUE(copied.data.mesh.positions.empty() && copied.data.slope.empty());
+  auto kept = make(extent);
+  Pane a{freed.get(), 0.0, targets(extent), {{0, 0}, extent}};
+  Pane b{kept.get(), 0.0, targets(extent), {{0, 0}, extent}};
+  render({&a});
+  render({&b});
+  EXPECT_EQ(differing_pixels(a, b), 0u) << "the freed river's renderer draws the same river";
+  // The built-in river is the renderer's own: there is nothing of the host's to free.
+  CopiedRiver none;
+  EXPECT_NE(make({64, 48}, nullptr, nullptr, 0, &none), nullptr);
+  EXPECT_EQ(none.calls, 0);
 }
 
 TEST_F(SharedRiverTest, TwoViewsInTwoImagesEqualEachAloneWithOneSolve) {

@@ -137,6 +137,13 @@ struct CreateInfo {
   // The river to render (siviflow/water_river.h); null: the built-in default river with its two
   // boulders. Read by create() only: the renderer copies what it needs.
   const WaterRiver* river = nullptr;
+  // Optional: called once by create(), as soon as the renderer holds its own copy of everything
+  // `river` points at and before it solves the flow and makes its buffers. The host may free the
+  // river's arrays there, so a long river is not held twice at the peak of creation (a 100 km
+  // river's mesh is about 60 MB). Not called for the built-in river, with share_river_with, or
+  // when create() fails before the copy is made.
+  void (*river_copied)(void* user) = nullptr;
+  void* river_copied_user = nullptr;
   // The water's starting look; null: WaterLook's defaults. Read by create() only; set_look()
   // changes it.
   const WaterLook* look = nullptr;

@@ -34,6 +34,9 @@ struct SceneRiverData {
   std::vector<WaterRiverEnd> ends;            // the scene's (or the generator's), or none
   std::optional<ProceduralRiver> procedural;  // the generator it came from, if it did
   WaterRiver river() const;
+  // For CreateInfo::river_copied, with river_copied_user this data: frees every array river()
+  // points into (the generator and the flow parameters stay).
+  static void release_arrays(void* river);
 };
 
 // River `river_index` of `scene` (null: the built-in default river, procedural, with its two
