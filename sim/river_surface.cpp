@@ -363,7 +363,9 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   // --- Node adjacency (sorted, unique), manifold edges and the border.
   Csr adj;
   adj.start.assign(node_count + 1, 0);
-  adj.list.reserve(tris.size());
+  // Each edge twice: a disc with h holes has V + T - 1 + h edges. Too small a reserve doubles
+  // at the end and holds both copies: 65 MB at once for a 100 km river.
+  adj.list.reserve(2 * (node_count + tri_count));
   std::vector<std::array<uint32_t, 2>> border_next(node_count, {kNoNode, kNoNode});
   std::vector<uint8_t> on_border(node_count, 0);
   size_t edge_count = 0;
@@ -518,6 +520,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
         "vertices each",
         loop.size()));
   }
+  border_next = std::vector<std::array<uint32_t, 2>>();  // walked: what follows holds more
   std::vector<uint32_t> node_island;
   if (!island_loops.empty()) {
     node_island.assign(node_count, kNoNode);
@@ -526,7 +529,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     }
   }
 
-  const std::vector<double> angles = angle_sums(pos, tris, on_border);
+  std::vector<double> angles = angle_sums(pos, tris, on_border);
   Welded welded{pos,         tris,         node_tris, adj,  node_vertex, node_of_vertex,
                 island_loops, node_island, loop,      angles, vertex_count};
   if (options.ends.size() > 2) return build_network(welded, options, out);
@@ -610,6 +613,9 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     return Status::error(as_strip);
   }
   const size_t section_count = layering.chain_start.size() - 1;
+  // Layered: the adjacency and the corners' angles are not read again.
+  adj = Csr();
+  angles = std::vector<double>();
 
   // --- Left and right: the left bank is on the +Y x downstream side.
   std::vector<DVec3> mid(section_count);

@@ -39,6 +39,7 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     sys.path.insert(0, str(source / "tools" / "scripts"))
+    sys.dont_write_bytecode = True  # nothing written into the source tree
     import contact_sheet
 
     sheet = work / "sheet.png"

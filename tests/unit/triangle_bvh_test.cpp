@@ -1,11 +1,13 @@
 // The ray-cast hierarchy at the extremes of its input: centroids spread by a denormal distance,
 // and positions past the world limit (siviflow/sim/world_limits.h). Bugs found by fuzzing and by
-// mutants of real glTF files (issue 28), each failing on the code before its fix.
+// mutants of real glTF files (issue 28), each failing on the code before its fix. And what a long
+// river's hierarchy holds.
 #include <cstdint>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "siviflow/sim/procedural_river.h"
 #include "sim/triangle_bvh.h"
 
 namespace siviflow {
@@ -32,6 +34,24 @@ TEST(TriangleBvh, PositionsPastTheWorldLimitAreRefusedByIndexAndValue) {
   TriangleBvh bvh;
   const Status s = TriangleBvh::build(positions, {}, &bvh, "Mesh");
   EXPECT_EQ(s.message(), "Mesh::positions[4] (-3.4e+38, 0, 0) lies beyond the world limit of ±1e+06 m");
+}
+
+// Leaves of up to 16 triangles: under 10.5 bytes a triangle (nodes and the triangle order); 8 held
+// 14.8. Every vertex is still found where it lies.
+TEST(TriangleBvh, AStripRiversHierarchyHoldsUnderElevenBytesATriangle) {
+  ProceduralRiverParams params;
+  params.length = 2000.0f;
+  RiverMesh mesh;
+  ASSERT_TRUE(ProceduralRiver(params).generate_mesh(&mesh).ok());
+  TriangleBvh bvh;
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok());
+  EXPECT_LE(static_cast<double>(bvh.memory_bytes()) / static_cast<double>(bvh.triangle_count()),
+            10.5);
+  for (uint32_t v = 0; v < mesh.positions.size(); v += 101) {
+    const glm::vec3& p = mesh.positions[v];
+    glm::dvec3 weights;
+    EXPECT_NE(bvh.locate_xz(p.x, p.z, &weights), UINT32_MAX) << "vertex " << v;
+  }
 }
 
 }  // namespace
