@@ -364,8 +364,9 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   Csr adj;
   adj.start.assign(node_count + 1, 0);
   // Each edge twice: a disc with h holes has V + T - 1 + h edges. Too small a reserve doubles
-  // at the end and holds both copies: 65 MB at once for a 100 km river.
-  adj.list.reserve(2 * (node_count + tri_count));
+  // at the end and holds both copies (65 MB at once for a 100 km river); pages never written
+  // cost nothing.
+  adj.list.reserve(2 * (node_count + tri_count + kMaxRiverIslands));
   std::vector<std::array<uint32_t, 2>> border_next(node_count, {kNoNode, kNoNode});
   std::vector<uint8_t> on_border(node_count, 0);
   size_t edge_count = 0;

@@ -62,6 +62,7 @@ Status run_bench_once(HeadlessContext& context, const BenchOptions& options,
   std::unique_ptr<Renderer> renderer;
   auto create_start = std::chrono::steady_clock::now();
   Status status = Renderer::create(info, &renderer);
+  info.river = nullptr;  // freed by river_copied; a second view shares the first's river
   if (status.ok()) status = renderer->set_occluders(world->occluders());
   out->create_ms = ms_since(create_start);
   SIVIFLOW_TRY(status);
@@ -85,10 +86,6 @@ Status run_bench_once(HeadlessContext& context, const BenchOptions& options,
     SIVIFLOW_TRY(create_temporal_targets(context, info.motion_format, info.reactive_format,
                                          extent, &second_targets));
   }
-
-  // The renderers copied the river: a host frees its arrays after create, and so does this one.
-  info.river = nullptr;
-  river = SceneRiverData{};
 
   std::vector<PassTime> times;
   std::vector<PassTime> world_times;

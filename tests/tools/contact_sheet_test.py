@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """tools/scripts/contact_sheet.py lays each build's frames side by side: the sheet's cells are
 the frames `capture --preview` writes, in the order given, two runs of one build differ by
-nothing, and a build that cannot run ends it with a message and no sheet.
+nothing, and a build that cannot run ends it with a message and no sheet. Its PNG reader undoes
+each of PNG's filters as worked out by hand here (the sheet's own writer and reader share the
+Paeth predictor, so a round trip alone would not tell).
 
 usage: contact_sheet_test.py SIVIFLOW SOURCE WORK [--env VAR=VALUE ...]
   The script runs in this process; the --env variables reach only the siviflow it starts (a
@@ -12,8 +14,10 @@ import io
 import os
 import pathlib
 import shutil
+import struct
 import subprocess
 import sys
+import zlib
 
 WIDTH, HEIGHT, FRAMES = 64, 36, (0, 3)
 
@@ -31,6 +35,24 @@ def run_sheet(contact_sheet, arguments):
     return 0, printed.getvalue()
 
 
+# A 2x4 RGB picture, and its scanlines filtered by hand with Sub, Up, Paeth and Average (the PNG
+# specification's section 9): in row 2 Paeth predicts from above for the first pixel, and for the
+# second from the corner (red) and from the left (green, blue).
+PIXELS = [bytes((10, 20, 30, 15, 25, 35)), bytes((12, 22, 32, 20, 30, 40)),
+          bytes((5, 5, 5, 200, 100, 50)), bytes((100, 100, 100, 50, 60, 70))]
+FILTERED = [bytes((1, 10, 20, 30, 5, 5, 5)), bytes((2, 2, 2, 2, 5, 5, 5)),
+            bytes((4, 249, 239, 229, 188, 95, 45)), bytes((3, 98, 98, 98, 156, 216, 251))]
+
+
+def hand_filtered_png(path):
+    def chunk(kind, body):
+        return struct.pack(">I", len(body)) + kind + body + struct.pack(
+            ">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
+    header = struct.pack(">IIBBBBB", 2, len(PIXELS), 8, 2, 0, 0, 0)
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) +
+                     chunk(b"IDAT", zlib.compress(b"".join(FILTERED))) + chunk(b"IEND", b""))
+
+
 def main():
     siviflow, source, work = sys.argv[1], pathlib.Path(sys.argv[2]), pathlib.Path(sys.argv[3])
     for pair in sys.argv[5:] if sys.argv[4:5] == ["--env"] else []:
@@ -42,13 +64,17 @@ def main():
     sys.dont_write_bytecode = True  # nothing written into the source tree
     import contact_sheet
 
+    failures = []
+    hand_filtered_png(work / "filters.png")
+    decoded = contact_sheet.read_png(work / "filters.png")
+    if decoded != (2, len(PIXELS), PIXELS):
+        failures.append(f"the hand-filtered PNG reads as {decoded}")
     sheet = work / "sheet.png"
     status, printed = run_sheet(contact_sheet, [
         "--out", str(sheet), "--size", f"{WIDTH}x{HEIGHT}", "--frames",
         ",".join(map(str, FRAMES)), "--validation", f"a={siviflow}", f"b={siviflow}"])
     if status != 0:
         sys.exit(f"contact_sheet.py failed ({status}):\n{printed}")
-    failures = []
     for frame in FRAMES:
         if f"frame {frame}: b against a: mean 0.00, largest 0 of 255" not in printed:
             failures.append(f"frame {frame}: not reported identical:\n{printed}")

@@ -33,8 +33,14 @@ def read_png(path):
     at, idat = len(PNG_SIGNATURE), b""
     width = height = channels = 0
     while at < len(data):
+        if at + 12 > len(data):
+            sys.exit(f"{path}: truncated")
         length, kind = struct.unpack(">I4s", data[at:at + 8])
         body = data[at + 8:at + 8 + length]
+        if len(body) != length:
+            sys.exit(f"{path}: truncated in its {kind.decode('latin-1')} chunk")
+        if kind == b"IEND":
+            break
         if kind == b"IHDR":
             width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
             channels = {2: 3, 6: 4}.get(colour, 0)
@@ -43,11 +49,20 @@ def read_png(path):
         elif kind == b"IDAT":
             idat += body
         at += 12 + length
-    raw = zlib.decompress(idat)
+    if channels == 0:
+        sys.exit(f"{path}: no IHDR chunk")
+    try:
+        raw = zlib.decompress(idat)
+    except zlib.error as error:
+        sys.exit(f"{path}: its pixels do not inflate ({error})")
     stride = width * channels
+    if len(raw) != height * (stride + 1):
+        sys.exit(f"{path}: {len(raw)} bytes of pixels for {width}x{height}")
     rows, previous = [], bytearray(stride)
     for y in range(height):
         line = raw[y * (stride + 1):(y + 1) * (stride + 1)]
+        if line[0] > 4:
+            sys.exit(f"{path}: row {y} has filter {line[0]}; PNG has 0 to 4")
         row = unfilter(line[0], bytearray(line[1:]), previous, channels)
         rows.append(bytes(row[i] for i in range(stride) if i % channels < 3))
         previous = row
@@ -79,6 +94,7 @@ def paeth(left, up, corner):
 
 
 def write_png(path, width, rows):
+    """Rows of RGB bytes, each `width` pixels, as an 8-bit RGB PNG."""
     def chunk(kind, body):
         return struct.pack(">I", len(body)) + kind + body + struct.pack(
             ">I", zlib.crc32(kind + body) & 0xFFFFFFFF)
@@ -135,9 +151,13 @@ def main():
     blocks = []  # a frame's row of cells
     for frame in frames:
         cells = []
-        for name, binary in builds:
+        for _, binary in builds:
             with tempfile.TemporaryDirectory() as folder:
                 cells.append(render(binary, args, frame, folder))
+        sizes = {(w, h) for w, h, _ in cells}
+        if len(sizes) != 1:
+            sys.exit(f"frame {frame}: the builds rendered different sizes: "
+                     + ", ".join(f"{w}x{h}" for w, h in sorted(sizes)))
         first = cells[0][2]
         for (name, _), (_, _, rows) in zip(builds[1:], cells[1:]):
             diffs = [abs(a - b) for ra, rb in zip(first, rows) for a, b in zip(ra, rb)]

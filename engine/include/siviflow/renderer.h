@@ -141,7 +141,8 @@ struct CreateInfo {
   // `river` points at and before it solves the flow and makes its buffers. The host may free the
   // river's arrays there, so a long river is not held twice at the peak of creation (a 100 km
   // river's mesh is about 60 MB). Not called for the built-in river, with share_river_with, or
-  // when create() fails before the copy is made.
+  // when create() fails before the copy is made; a create() that fails after it may have called
+  // it, so a host that frees there cannot retry with the same arrays.
   void (*river_copied)(void* user) = nullptr;
   void* river_copied_user = nullptr;
   // The water's starting look; null: WaterLook's defaults. Read by create() only; set_look()
