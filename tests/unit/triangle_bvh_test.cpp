@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "siviflow/sim/procedural_river.h"
+#include "river_test_meshes.h"
 #include "sim/triangle_bvh.h"
 
 namespace siviflow {
@@ -39,10 +39,7 @@ TEST(TriangleBvh, PositionsPastTheWorldLimitAreRefusedByIndexAndValue) {
 // Leaves of up to 16 triangles: under 10.5 bytes a triangle (nodes and the triangle order); 8 held
 // 14.8. Every vertex is still found where it lies.
 TEST(TriangleBvh, AStripRiversHierarchyHoldsUnderElevenBytesATriangle) {
-  ProceduralRiverParams params;
-  params.length = 2000.0f;
-  RiverMesh mesh;
-  ASSERT_TRUE(ProceduralRiver(params).generate_mesh(&mesh).ok());
+  const test::TestMesh mesh = test::straight_channel(12.0f, 2000.0f, 2001, 13);  // 2 km, as a strip's
   TriangleBvh bvh;
   ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok());
   EXPECT_LE(static_cast<double>(bvh.memory_bytes()) / static_cast<double>(bvh.triangle_count()),
