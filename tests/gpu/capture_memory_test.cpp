@@ -1,6 +1,6 @@
 // A capture's frames after the first reuse the memory the first ones faulted in: memory freed and
-// faulted in again every frame (the process's allocator handing blocks back to the kernel) costs a
-// capture a fifth of its time at 720p, and shows here as page faults that grow with the frames.
+// faulted in again every frame (the process's allocator handing blocks back to the kernel) cost a
+// 720p capture a tenth of its time, and shows here as page faults that grow with the frames.
 #include <sys/resource.h>
 
 #include <string>
