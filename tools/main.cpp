@@ -30,10 +30,8 @@ void print_usage() {
 // This process keeps them: the library itself never changes its host's allocator (docs/
 // embedding.md, "On lavapipe: keep freed memory in the process").
 constexpr int kKeptFreeBytes = 256 << 20;
-// Setting the trim threshold also fixes glibc's mmap threshold at its 128 KiB start (no more
-// growing with what is freed), so OpenEXR's Huffman coder's tables (512 KiB, per block it
-// compresses) were mapped, zeroed and unmapped every time: 12,000 page faults a 720p frame of a
-// capture. Just above them, they come from the heap and are used again.
+// The trim threshold freezes glibc's mmap threshold at 128 KiB; just above OpenEXR's 512 KiB
+// Huffman tables, they stay on the heap instead of being mapped afresh for every block.
 constexpr int kHeapBlockBytes = 640 << 10;
 
 }  // namespace

@@ -1,6 +1,6 @@
 // A capture's frames after the first reuse the memory the first ones faulted in: memory freed and
-// faulted in again every frame (the process's allocator handing blocks back to the kernel) cost a
-// 720p capture a tenth of its time, and shows here as page faults that grow with the frames.
+// faulted in again every frame (the process's allocator handing blocks back to the kernel) costs
+// a 720p capture a tenth of its time, and shows here as page faults that grow with the frames.
 #include <sys/resource.h>
 
 #include <string>
@@ -26,11 +26,13 @@ long capture_page_faults(int frames, const std::string& out) {
 
 TEST(CaptureMemory, LaterFramesFaultInNoFreshMemory) {
   const std::string out = fresh_test_dir("capture_memory").string();
-  const long short_run = capture_page_faults(3, out);
-  const long long_run = capture_page_faults(11, out);
+  constexpr int kShortFrames = 3, kLongFrames = 11;
+  const long short_run = capture_page_faults(kShortFrames, out);
+  const long long_run = capture_page_faults(kLongFrames, out);
   // About 25 a frame; 3000 when OpenEXR's Huffman tables were mapped afresh for every block.
-  const double per_frame = static_cast<double>(long_run - short_run) / 8.0;
-  EXPECT_LT(per_frame, 500.0) << short_run << " faults for 3 frames, " << long_run << " for 11";
+  const double per_frame = static_cast<double>(long_run - short_run) / (kLongFrames - kShortFrames);
+  EXPECT_LT(per_frame, 500.0) << short_run << " faults for " << kShortFrames << " frames, "
+                              << long_run << " for " << kLongFrames;
 }
 
 }  // namespace
