@@ -5,34 +5,16 @@ nothing, and a build that cannot run ends it with a message and no sheet. Its PN
 each of PNG's filters as worked out by hand here (the sheet's own writer and reader share the
 Paeth predictor, so a round trip alone would not tell).
 
-usage: contact_sheet_test.py SIVIFLOW SOURCE WORK [--env VAR=VALUE ...]
-  The script runs in this process; the --env variables reach only the siviflow it starts (a
-  sanitizer's preload is for siviflow, not for Python).
+usage: contact_sheet_test.py SIVIFLOW SOURCE WORK [--env VAR=VALUE ...]   (script_main.py)
 """
-import contextlib
-import io
-import os
-import pathlib
-import shutil
 import struct
 import subprocess
 import sys
 import zlib
 
+from script_main import run_main, test_setup
+
 WIDTH, HEIGHT, FRAMES = 64, 36, (0, 3)
-
-
-def run_sheet(contact_sheet, arguments):
-    """(exit status, what it printed) of the script's main() with these arguments."""
-    sys.argv = ["contact_sheet.py"] + arguments
-    printed = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(printed):
-            contact_sheet.main()
-    except SystemExit as end:
-        message = end.code if isinstance(end.code, str) else ""
-        return (1 if message else end.code or 0), printed.getvalue() + message
-    return 0, printed.getvalue()
 
 
 # A 2x4 RGB picture, and its scanlines filtered by hand with Sub, Up, Paeth and Average (the PNG
@@ -54,15 +36,7 @@ def hand_filtered_png(path):
 
 
 def main():
-    siviflow, source, work = sys.argv[1], pathlib.Path(sys.argv[2]), pathlib.Path(sys.argv[3])
-    for pair in sys.argv[5:] if sys.argv[4:5] == ["--env"] else []:
-        name, value = pair.split("=", 1)
-        os.environ[name] = value
-    shutil.rmtree(work, ignore_errors=True)
-    work.mkdir(parents=True)
-    sys.path.insert(0, str(source / "tools" / "scripts"))
-    sys.dont_write_bytecode = True  # nothing written into the source tree
-    import contact_sheet
+    siviflow, _, work, contact_sheet = test_setup("contact_sheet")
 
     failures = []
     hand_filtered_png(work / "filters.png")
@@ -70,7 +44,7 @@ def main():
     if decoded != (2, len(PIXELS), PIXELS):
         failures.append(f"the hand-filtered PNG reads as {decoded}")
     sheet = work / "sheet.png"
-    status, printed = run_sheet(contact_sheet, [
+    status, printed = run_main(contact_sheet, [
         "--out", str(sheet), "--size", f"{WIDTH}x{HEIGHT}", "--frames",
         ",".join(map(str, FRAMES)), "--validation", f"a={siviflow}", f"b={siviflow}"])
     if status != 0:
@@ -94,7 +68,7 @@ def main():
             if cell != alone:
                 failures.append(f"frame {frame}, column {column}: not the captured frame")
     missing = work / "no-such-siviflow"
-    status, printed = run_sheet(contact_sheet, ["--out", str(work / "bad.png"), f"a={missing}"])
+    status, printed = run_main(contact_sheet, ["--out", str(work / "bad.png"), f"a={missing}"])
     if status != 1 or str(missing) not in printed:
         failures.append(f"a missing binary: exit {status}, {printed!r}")
     if (work / "bad.png").exists():
