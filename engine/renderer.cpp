@@ -221,14 +221,18 @@ Status Renderer::Impl::create_river() {
     SIVIFLOW_TRY(procedural_river_input(procedural, &input));
     obstacles = default_scene_obstacles(procedural);
   } else {
-    SIVIFLOW_TRY(river_input_from(*info.river, &input));
     flow = info.river->flow;
     for (size_t i = 0; i < info.river->obstacles.size(); ++i) {
       const Status valid = check_obstacle(info.river->obstacles[i], i);
       if (!valid.ok()) return argument_error("CreateInfo::river->obstacles: " + valid.message());
       obstacles.push_back(flow_obstacle(info.river->obstacles[i]));
     }
-    if (info.river_copied != nullptr) info.river_copied(info.river_copied_user);
+    // Called as soon as the surface holds its own nodes and triangles: a long river's mesh is not
+    // held twice while its topology is found.
+    const auto copied = [this] {
+      if (info.river_copied != nullptr) info.river_copied(info.river_copied_user);
+    };
+    SIVIFLOW_TRY(river_input_from(*info.river, copied, &input));
   }
   const FlowParams params = river_flow_params(flow, input);
   return SharedRiver::create(table, info.allocation_callbacks, std::move(input), params,

@@ -34,16 +34,6 @@ Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh,
   return Status::success();
 }
 
-namespace {
-
-// Whether the surface's positions and triangles are the mesh's own: it welded nothing and kept
-// the winding (the procedural river's mesh).
-bool surface_is_mesh(const RiverSurface& surface, std::span<const uint32_t> indices) {
-  return !surface.welded() && std::ranges::equal(surface.triangles(), indices);
-}
-
-}  // namespace
-
 std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float discharge) {
   std::vector<WaterRiverEnd> ends;
   float inflow_width = 0.0f;
@@ -60,7 +50,7 @@ Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   RiverSurfaceOptions options;
   for (const RiverMeshEnd& end : input.mesh.ends) options.ends.push_back({end.vertex, end.inflow});
   SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, options, &input.surface));
-  if (surface_is_mesh(input.surface, input.mesh.indices)) {
+  if (!input.surface.welded()) {
     input.mesh.positions = {};
     input.mesh.indices = {};
   }
@@ -94,7 +84,8 @@ std::vector<float> surface_end_discharges(const RiverSurface& surface,
   return q;
 }
 
-Status river_input_from(const WaterRiver& river, RiverInput* out) {
+Status river_input_from(const WaterRiver& river, const std::function<void()>& copied,
+                        RiverInput* out) {
   const size_t count = river.positions.size();
   const auto per_vertex = [count](size_t size, const char* field) {
     if (size == count) return Status::success();
@@ -125,16 +116,22 @@ Status river_input_from(const WaterRiver& river, RiverInput* out) {
     }
   }
   RiverInput input;
-  const Status built = RiverSurface::build(river.positions, river.indices,
-                                           river_surface_options(river.ends), &input.surface);
-  if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
-  input.end_discharges = surface_end_discharges(input.surface, river.ends);
-  if (!surface_is_mesh(input.surface, river.indices)) {
-    input.mesh.positions.assign(river.positions.begin(), river.positions.end());
-    input.mesh.indices.assign(river.indices.begin(), river.indices.end());
-  }
   input.mesh.depth.assign(river.depth.begin(), river.depth.end());
   input.slope.assign(river.slope.begin(), river.slope.end());
+  RiverSurfaceOptions options = river_surface_options(river.ends);
+  // Past this the host's arrays are not read: a copy of the mesh only where vertices were
+  // welded (unwelded, the surface's nodes and triangles are the mesh), then the host frees.
+  options.inputs_read = [&](bool welded) {
+    if (welded) {
+      input.mesh.positions.assign(river.positions.begin(), river.positions.end());
+      input.mesh.indices.assign(river.indices.begin(), river.indices.end());
+    }
+    if (copied) copied();
+  };
+  const std::vector<WaterRiverEnd> ends(river.ends.begin(), river.ends.end());
+  const Status built = RiverSurface::build(river.positions, river.indices, options, &input.surface);
+  if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
+  input.end_discharges = surface_end_discharges(input.surface, ends);
   *out = std::move(input);
   return Status::success();
 }
@@ -199,16 +196,12 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
     field_.flow = velocity_copy_;
   }
   foam_.resize(count);
-  bank_distance_.resize(count);
-  for (size_t v = 0; v < count; ++v) {
-    const RiverVertex vertex = surface.vertex(v);
-    bank_distance_[v] = std::min(vertex.d_left, vertex.d_right);
-  }
   auto bvh = std::make_shared<TriangleBvh>();
-  SIVIFLOW_TRY(TriangleBvh::build(field_.positions, field_.indices, bvh.get()));
+  SIVIFLOW_TRY(TriangleBvh::build(field_.positions, field_.indices, bvh.get(), "RiverFlowField",
+                                  BvhLeaves::kMeshRuns));
   bvh_ = std::move(bvh);
-  VertexTriangles around;  // the surface's, when its nodes are the vertices
-  if (per_node_) around = {surface.node_triangle_start(), surface.node_triangle_list()};
+  // The surface's, when its nodes are the vertices.
+  const TrianglesAround* around = per_node_ ? &surface.triangles_around() : nullptr;
   SIVIFLOW_TRY(FoamField::create(field_.positions, field_.indices, section, bvh_.get(),
                                  FoamParams{}, &foam_field_, around));
   refresh_velocity();
@@ -242,7 +235,7 @@ void RiverFlow::refresh_velocity() {
       for (const uint32_t v : moved) velocity_copy_[v] = flow_.velocity(v);
     }
   }
-  foam_field_.update(field_.flow, bank_distance_, changed, foam_);
+  foam_field_.update(field_.flow, margin_distances(flow_.surface()), changed, foam_);
 }
 
 Status RiverFlow::set_time(double time_seconds) {

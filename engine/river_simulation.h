@@ -32,8 +32,9 @@ namespace siviflow {
 
 // What the simulation runs on: the river's mesh (positions, indices, depth), the riverbed slope
 // under each vertex (rise over run), and the surface built from the mesh (built once). The mesh
-// has no positions and indices when the surface's are the same (it welded nothing and kept the
-// winding): one copy of a long river, not two.
+// has no positions and indices when the surface welded nothing: its nodes and triangles are the
+// mesh then (the winding may differ; the water is drawn from both sides): one copy of a long
+// river, not two.
 struct RiverInput {
   RiverMesh mesh;
   std::vector<float> slope;
@@ -59,8 +60,11 @@ std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float di
 // procedural_river_mesh with its surface built.
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
 // A host's river (CreateInfo::river): its arrays checked (sizes, finite, non-negative depth and
-// slope) and copied, its surface built. Errors name the field and the vertex.
-Status river_input_from(const WaterRiver& river, RiverInput* out);
+// slope) and copied, its surface built. `copied` (may be empty) is called as soon as none of the
+// river's arrays is read any more, before the surface finds its sections. Errors name the field
+// and the vertex.
+Status river_input_from(const WaterRiver& river, const std::function<void()>& copied,
+                        RiverInput* out);
 
 // The flow's obstacle for a host's: the polygon turned about +Y (x' = x cos + z sin,
 // z' = -x sin + z cos, as glm::rotate turns +X towards -Z), the keys as they are.
@@ -138,8 +142,7 @@ class RiverFlow {
   RiverMesh mesh_;
   StreamFunction flow_;
   std::vector<glm::vec3> velocity_copy_;  // per vertex, m/s
-  std::vector<float> slope_;         // riverbed slope under the vertex (rise over run)
-  std::vector<float> bank_distance_;  // to the nearer margin along the section, metres
+  std::vector<float> slope_;              // riverbed slope under the vertex (rise over run)
   std::vector<uint32_t> section_copy_;
   std::vector<float> foam_;          // 0..1 per vertex (sim/foam.h)
   FoamField foam_field_;

@@ -55,9 +55,13 @@ float transported(float source, float decay, const float* weight, float a, float
 
 }  // namespace
 
+MarginDistances margin_distances(const RiverSurface& surface) {
+  return {surface.node_d_left(), surface.node_d_right(), surface.node_of_vertex()};
+}
+
 Status FoamField::create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                          std::span<const uint32_t> section, const TriangleBvh* bvh,
-                         const FoamParams& params, FoamField* out, VertexTriangles around) {
+                         const FoamParams& params, FoamField* out, const TrianglesAround* around) {
   if (bvh == nullptr) return Status::error("FoamField: no ray-cast structure");
   if (section.size() != positions.size()) return Status::error("FoamField: a section per vertex");
   if (!(params.gradient_full > params.gradient_onset) || !(params.lifetime_s > 0.0f) ||
@@ -105,41 +109,30 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
     }
   }
   field.indices_ = indices;
-  if (around.start.empty()) {
-    // Counted, then filled in triangle order.
-    field.own_start_.assign(count + 1, 0);
-    for (size_t i = 0; i < corners; ++i) ++field.own_start_[corner(i) + 1];
-    for (size_t v = 0; v < count; ++v) field.own_start_[v + 1] += field.own_start_[v];
-    field.own_list_.resize(corners);
-    std::vector<uint32_t> fill(field.own_start_.begin(), field.own_start_.end() - 1);
-    for (size_t i = 0; i < corners; ++i) {
-      field.own_list_[fill[corner(i)]++] = static_cast<uint32_t>(i / 3);
-    }
-  } else if (around.start.size() != count + 1 || around.start.back() != around.list.size()) {
+  if (around == nullptr) {
+    field.own_around_ = TrianglesAround::of_mesh(count, indices);
+  } else if (around->vertex_count() != count) {
     return Status::error("FoamField: the triangles around the vertices do not fit the mesh");
   }
+  field.shared_around_ = around;
   // update() finds vertices through the triangles: one in none would be left out.
-  const std::span<const uint32_t> start = around.start.empty() ? field.own_start_ : around.start;
   for (size_t v = 0; v < count; ++v) {
-    if (start[v + 1] == start[v]) {
+    if (field.around().of(static_cast<uint32_t>(v)).size() == 0) {
       return Status::error("FoamField: vertex " + std::to_string(v) +
                            " is a corner of no triangle");
     }
   }
   *out = std::move(field);
-  // Spans into the moved vectors: a vector's move keeps its storage.
-  out->around_ = around.start.empty() ? VertexTriangles{out->own_start_, out->own_list_} : around;
   return Status::success();
 }
 
 float FoamField::source_of(size_t v, std::span<const glm::vec3> velocity,
-                           std::span<const float> bank_distance,
+                           const MarginDistances& bank_distance,
                            std::vector<uint32_t>* ring) const {
   const FoamParams& p = params_;
   // The one-ring through the triangles, each neighbour once, ascending.
   ring->clear();
-  for (uint32_t k = around_.start[v]; k < around_.start[v + 1]; ++k) {
-    const size_t t = around_.list[k];
+  for (const size_t t : around().of(static_cast<uint32_t>(v))) {
     for (size_t c = 3 * t; c < 3 * t + 3; ++c) {
       if (corner(c) != v) ring->push_back(corner(c));
     }
@@ -184,7 +177,7 @@ float FoamField::source_of(size_t v, std::span<const glm::vec3> velocity,
   }
   const float lee = p.front_share + (1.0f - p.front_share) *
                                         smoothstep(-p.lee_acceleration, p.lee_acceleration, along);
-  const float bank = p.bank_strength * std::exp(-bank_distance[v] / p.bank_width_m) *
+  const float bank = p.bank_strength * std::exp(-bank_distance(v) / p.bank_width_m) *
                      std::min(section_speed / p.bank_speed_full, 1.0f);
   const float relative_gradient = gradient / std::max(section_speed, p.min_section_speed);
   return std::max({smoothstep(p.gradient_onset, p.gradient_full, relative_gradient),
@@ -211,7 +204,7 @@ FoamField::Upstream FoamField::upstream_of(size_t v, std::span<const glm::vec3> 
   return up;
 }
 
-void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+void FoamField::compute(std::span<const glm::vec3> velocity, const MarginDistances& bank_distance,
                         std::span<float> foam) {
   const size_t count = positions_.size();
   std::fill(section_speed_.begin(), section_speed_.end(), 0.0f);
@@ -250,7 +243,7 @@ void FoamField::compute(std::span<const glm::vec3> velocity, std::span<const flo
 // changed, and every vertex of a section whose mean speed changed), and those vertices' foam
 // reads nothing farther than n hops more: re-running the n steps on that window, whatever stands
 // outside it, gives the inner vertices their exact values.
-void FoamField::update(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+void FoamField::update(std::span<const glm::vec3> velocity, const MarginDistances& bank_distance,
                        std::span<const XzBox> changed, std::span<float> foam) {
   const bool bounded =
       std::all_of(changed.begin(), changed.end(), [](const XzBox& box) { return box.finite(); });
@@ -305,8 +298,8 @@ std::vector<XzBox> FoamField::resum_sections(std::span<const glm::vec3> velocity
 }
 
 void FoamField::rederive(std::span<const uint32_t> window, std::span<const XzBox> changed_foam,
-                         std::span<const glm::vec3> velocity,
-                         std::span<const float> bank_distance, std::span<float> foam) {
+                         std::span<const glm::vec3> velocity, const MarginDistances& bank_distance,
+                         std::span<float> foam) {
   last_rederived_ = window.size();
   // The window's vertices first, then the foam outside it that their upstream corners read
   // (held as it was: only the window's outer steps see it).

@@ -18,6 +18,7 @@
 // No Vulkan: the renderer hands the values to the GPU with the particles' data.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -25,6 +26,8 @@
 #include <glm/vec3.hpp>
 
 #include "sim/triangle_bvh.h"
+#include "siviflow/sim/river_surface.h"
+#include "siviflow/sim/triangles_around.h"
 #include "siviflow/sim/xz_box.h"
 #include "siviflow/status.h"
 
@@ -52,32 +55,42 @@ struct FoamParams {
   uint32_t steps = 30;           // transport steps: the wake is followed for steps * step_s
 };
 
-// The triangles around each vertex, in CSR form: vertex v's are list[start[v] .. start[v + 1]).
-struct VertexTriangles {
-  std::span<const uint32_t> start;  // one per vertex, and one past the last
-  std::span<const uint32_t> list;
+// Each vertex's distance along its section to the nearer margin: the smaller of its river
+// surface node's two, read when needed, so a long river keeps no copy a vertex.
+struct MarginDistances {
+  std::span<const float> left;        // per node (RiverSurface::node_d_left)
+  std::span<const float> right;       // per node
+  std::span<const uint32_t> node_of;  // per vertex; empty when the vertices are the nodes
+  float operator()(size_t v) const {
+    const size_t n = node_of.empty() ? v : node_of[v];
+    return std::min(left[n], right[n]);
+  }
 };
+// The surface's, for the vertices of the mesh it was built from.
+MarginDistances margin_distances(const RiverSurface& surface);
 
 class FoamField {
  public:
   // For the mesh (indices: 3 per triangle; empty, every 3 positions are one). `section`: each
   // vertex's cross-section (river_surface.h). `bvh` is built on the same positions and indices.
   // `around`: the triangles around each vertex where the caller keeps them (a river surface's,
-  // when its nodes are the vertices); empty, the field builds its own. The spans and `bvh`
-  // outlive this object. Every vertex must be a corner of a triangle.
+  // when its nodes are the vertices); null, the field builds its own. The spans, `bvh` and
+  // `around` outlive this object. Every vertex must be a corner of a triangle.
   static Status create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                        std::span<const uint32_t> section, const TriangleBvh* bvh,
-                       const FoamParams& params, FoamField* out, VertexTriangles around = {});
+                       const FoamParams& params, FoamField* out,
+                       const TrianglesAround* around = nullptr);
   FoamField() = default;
-  FoamField(FoamField&&) = default;  // around_ may point into own_*: moves keep, copies would not
+  FoamField(FoamField&&) = default;
   FoamField& operator=(FoamField&&) = default;
   FoamField(const FoamField&) = delete;
   FoamField& operator=(const FoamField&) = delete;
 
   // Foam per vertex in [0, 1] for the flow `velocity` (m/s per vertex); `bank_distance`: each
-  // vertex's distance to the nearer margin along its section (metres). Writes `foam` (sized to
-  // the vertices). Its scratch (32 bytes a vertex) lives only during the call.
-  void compute(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+  // vertex's distance to the nearer margin along its section (metres), read during the call
+  // only. Writes `foam` (sized to the vertices). Its scratch (32 bytes a vertex) lives only
+  // during the call.
+  void compute(std::span<const glm::vec3> velocity, const MarginDistances& bank_distance,
                std::span<float> foam);
   // The same, after the velocity changed only at vertices inside the `changed` boxes
   // (StreamFunction's FlowUpdateStats), `foam` holding what compute() or update() last wrote:
@@ -85,7 +98,7 @@ class FoamField {
   // ends equal to compute()'s bit for bit. Its scratch is sized by the vertices re-derived (and
   // a bit a vertex and a word a section of the river). Falls back to compute() where they are
   // most of the river, for a box that is not finite, and before the first compute().
-  void update(std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+  void update(std::span<const glm::vec3> velocity, const MarginDistances& bank_distance,
               std::span<const XzBox> changed, std::span<float> foam);
   // Vertices the last compute() or update() re-derived (all of them for compute()).
   size_t last_rederived() const { return last_rederived_; }
@@ -101,7 +114,7 @@ class FoamField {
   };
   // Vertex v's foam source and upstream point; `ring` is scratch.
   float source_of(size_t v, std::span<const glm::vec3> velocity,
-                  std::span<const float> bank_distance, std::vector<uint32_t>* ring) const;
+                  const MarginDistances& bank_distance, std::vector<uint32_t>* ring) const;
   Upstream upstream_of(size_t v, std::span<const glm::vec3> velocity) const;
   // Adds vertex v's share to its section's mean speed.
   void add_speed(size_t v, std::span<const glm::vec3> velocity);
@@ -111,7 +124,7 @@ class FoamField {
   std::vector<XzBox> resum_sections(std::span<const glm::vec3> velocity,
                                     std::span<const XzBox> changed);
   void rederive(std::span<const uint32_t> window, std::span<const XzBox> changed_foam,
-                std::span<const glm::vec3> velocity, std::span<const float> bank_distance,
+                std::span<const glm::vec3> velocity, const MarginDistances& bank_distance,
                 std::span<float> foam);
   // The vertices inside the boxes, each once, ascending.
   std::vector<uint32_t> vertices_in(std::span<const XzBox> boxes) const;
@@ -124,9 +137,11 @@ class FoamField {
   FoamParams params_;
   // The one-ring of a vertex is gathered from its triangles when needed: a long river keeps no
   // neighbour lists.
-  VertexTriangles around_;
-  std::vector<uint32_t> own_start_;  // around_, when the caller gave none
-  std::vector<uint32_t> own_list_;
+  const TrianglesAround& around() const {
+    return shared_around_ != nullptr ? *shared_around_ : own_around_;
+  }
+  const TrianglesAround* shared_around_ = nullptr;
+  TrianglesAround own_around_;        // when the caller gave none
   std::vector<float> section_speed_;  // per section: its vertices' mean speed
   std::vector<uint32_t> section_size_;
   float longest_edge_ = 0.0f;    // x/z: how far a triangle's corner lies from a point in it

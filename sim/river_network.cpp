@@ -416,8 +416,7 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
   w.pos.shrink_to_fit();
   s.node_positions_ = std::move(w.pos);
   s.triangles_ = std::move(w.tris);
-  s.node_tri_start_ = std::move(w.node_tris.start);
-  s.node_tri_list_ = std::move(w.node_tris.list);
+  s.node_triangles_ = std::move(w.node_tris);
   s.extent_ = static_cast<float>(extent);
   *out = std::move(s);
   return Status::success();

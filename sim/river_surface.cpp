@@ -142,10 +142,10 @@ size_t RiverSurface::memory_bytes() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return bytes(node_of_vertex_) + bytes(node_vertex_) + bytes(node_positions_) +
          bytes(node_section_) + bytes(node_bank_) + bytes(node_d_left_) + bytes(node_d_right_) +
-         bytes(triangles_) + bytes(node_tri_start_) + bytes(node_tri_list_) + bytes(sections_) +
+         bytes(triangles_) + node_triangles_.memory_bytes() + bytes(sections_) +
          bytes(section_nodes_) + bytes(node_left_border_) + bytes(node_right_border_) +
-         bytes(islands_) + bytes(island_nodes_) + bytes(ends_) + bytes(end_nodes_) +
-         bytes(banks_) + bytes(bank_nodes_);
+         bytes(islands_) + bytes(island_nodes_) + bytes(ends_) + bytes(end_nodes_) + bytes(banks_) +
+         bytes(bank_nodes_);
 }
 
 Status RiverSurface::share_mesh(std::span<const glm::vec3> positions,
@@ -343,21 +343,16 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     }
   }
 
+  // The input is not read past this point.
+  if (options.inputs_read) options.inputs_read(node_count != vertex_count);
+
   // --- Node -> triangles.
-  Csr node_tris;
-  node_tris.start.assign(node_count + 1, 0);
-  for (const uint32_t n : tris) ++node_tris.start[n + 1];
-  for (size_t n = 0; n < node_count; ++n) {
-    if (node_tris.start[n + 1] == 0) {
+  TrianglesAround node_tris = TrianglesAround::of_mesh(node_count, tris);
+  for (uint32_t n = 0; n < node_count; ++n) {
+    if (node_tris.of(n).size() == 0) {
       return Status::error(text_format("river vertex %u is not used by any triangle",
                                        node_vertex[n]));
     }
-    node_tris.start[n + 1] += node_tris.start[n];
-  }
-  node_tris.list.resize(tris.size());
-  {
-    std::vector<uint32_t> fill(node_tris.start.begin(), node_tris.start.end() - 1);
-    for (size_t i = 0; i < tris.size(); ++i) node_tris.list[fill[tris[i]]++] = static_cast<uint32_t>(i / 3);
   }
 
   // --- Node adjacency (sorted, unique), manifold edges and the border.
@@ -766,8 +761,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   pos.shrink_to_fit();  // a copy only where vertices were welded
   s.node_positions_ = std::move(pos);
   s.triangles_ = std::move(tris);
-  s.node_tri_start_ = std::move(node_tris.start);
-  s.node_tri_list_ = std::move(node_tris.list);
+  s.node_triangles_ = std::move(node_tris);
   s.extent_ = static_cast<float>(extent);
   *out = std::move(s);
   return Status::success();

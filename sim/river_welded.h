@@ -14,7 +14,7 @@ namespace siviflow {
 struct RiverSurface::Welded {
   std::vector<glm::vec3>& pos;
   std::vector<uint32_t>& tris;
-  Csr& node_tris;
+  TrianglesAround& node_tris;
   Csr& adj;
   std::vector<uint32_t>& node_vertex;
   std::vector<uint32_t>& node_of_vertex;

@@ -13,12 +13,18 @@ namespace siviflow {
 namespace {
 
 // Binned SAH, split down to leaves of 16 triangles: a 100 km river's hierarchy takes 26 MB (40
-// with 8, 64 with 4); the particles' ray casts of a frame take 2-3 % longer than with 8 (0.50
-// against 0.49 ms at 1280x720).
+// with 8, 64 with 4; 14.9 with kMeshRuns); the particles' ray casts of a frame take 2-3 % longer
+// than with 8 (0.50 against 0.49 ms at 1280x720).
 constexpr uint32_t kLeafTriangles = 16;
 // A node stays a leaf up to this size when splitting would not pay (SAH).
 constexpr uint32_t kMaxLeafTriangles = 32;
 constexpr int kBins = 16;
+// BvhLeaves::kMeshRuns: a run ends before the triangle that would grow its box past this many
+// times the area of its triangles' boxes (along a row of a river's quads it stays at 0.5 to 1.3
+// of it, the next row's first triangle takes it to 4 or 5); a mesh whose runs are shorter than
+// kMinMeanRun triangles on average is not laid out along itself.
+constexpr double kRunGrowth = 2.0;
+constexpr size_t kMinMeanRun = 8;
 // Below this depth splits fall back to the object median, so the traversal stack is bounded.
 constexpr int kMaxSahDepth = 40;
 constexpr int kStackSize = 128;  // > kMaxSahDepth + 32 median levels
@@ -40,11 +46,13 @@ struct Aabb {
   }
 };
 
-// A triangle during the build: the centre of its bounds travels with it, so partitioning stays
-// cache-local; the bounds themselves are read again from the mesh (16 bytes a triangle, not 28).
+// A triangle, or a run of consecutive ones, during the build: the centre of its bounds travels
+// with it, so partitioning stays cache-local; the bounds themselves are read again from the mesh
+// (20 bytes a reference, not 32).
 struct Ref {
   glm::vec3 centre;
-  uint32_t triangle;
+  uint32_t triangle;  // the first of the run
+  uint32_t count;     // triangles in the run
   float centroid(int axis) const { return centre[axis]; }
 };
 
@@ -74,7 +82,7 @@ float box_distance2(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& p
 }  // namespace
 
 Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                          TriangleBvh* out, std::string_view mesh_name) {
+                          TriangleBvh* out, std::string_view mesh_name, BvhLeaves leaves) {
   const std::string name(mesh_name);
   const size_t corner_count = indices.empty() ? positions.size() : indices.size();
   if (corner_count == 0) return Status::error(name + ": the mesh has no triangles");
@@ -103,25 +111,71 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
 
   TriangleBvh bvh;
   bvh.positions_ = positions;
+  bvh.triangle_count_ = tri_count;
   bvh.indices_ = indices;
-  std::vector<Ref> refs(tri_count);
-  const auto bounds = [&](uint32_t t) {
+  const auto triangle_bounds = [&](uint32_t t) {
     Aabb b;
     for (int k = 0; k < 3; ++k) b.grow(positions[bvh.triangle_vertex(t, k)]);
     return b;
   };
+  // kMeshRuns: the mesh's order cut into runs of up to kLeafTriangles, each ending where the
+  // next triangle would grow its box past twice the area of its triangles' own (where a row of
+  // a strip ends); each run is a leaf. Runs too short on average (an order with no locality) give
+  // spatial leaves.
+  std::vector<Ref> refs;
   Aabb root_box;
-  for (uint32_t t = 0; t < tri_count; ++t) {
-    const Aabb b = bounds(t);
-    refs[t] = {0.5f * (b.lo + b.hi), t};
-    root_box.grow(b);
+  if (leaves == BvhLeaves::kMeshRuns) {
+    Aabb box;
+    double area = 0.0;
+    uint32_t first = 0;
+    for (uint32_t t = 0; t <= tri_count; ++t) {
+      const Aabb b = t < tri_count ? triangle_bounds(t) : Aabb{};
+      Aabb grown = box;
+      grown.grow(b);
+      const bool full =
+          t - first == kLeafTriangles || grown.half_area() > kRunGrowth * (area + b.half_area());
+      if (t > first && (t == tri_count || full)) {
+        refs.push_back({0.5f * (box.lo + box.hi), first, t - first});
+        root_box.grow(box);
+        grown = b;
+        area = 0.0;
+        first = t;
+      }
+      box = grown;
+      area += b.half_area();
+    }
+    if (refs.size() * kMinMeanRun > tri_count) {
+      refs = std::vector<Ref>();
+      root_box = Aabb{};
+    }
   }
-  // A binary tree over n triangles has at most 2n - 1 nodes: reserved, it never reallocates (a
+  const bool runs = !refs.empty();
+  const auto bounds = [&](const Ref& ref) {
+    Aabb b;
+    for (uint32_t t = ref.triangle; t < ref.triangle + ref.count; ++t) b.grow(triangle_bounds(t));
+    return b;
+  };
+  if (!runs) {
+    refs.resize(tri_count);
+    for (uint32_t t = 0; t < tri_count; ++t) {
+      const Aabb b = triangle_bounds(t);
+      refs[t] = {0.5f * (b.lo + b.hi), t, 1};
+      root_box.grow(b);
+    }
+  }
+  // A leaf holds one run, or up to kLeafTriangles single triangles.
+  const uint32_t leaf_refs = runs ? 1 : kLeafTriangles;
+  const uint32_t max_leaf_refs = runs ? 1 : kMaxLeafTriangles;
+  const auto make_leaf = [&](Node& node, uint32_t begin, uint32_t count) {
+    node.first = runs ? refs[begin].triangle : begin;  // a run: its triangles themselves
+    node.count = runs ? refs[begin].count : count;
+  };
+  // A binary tree over n references has at most 2n - 1 nodes: reserved, it never reallocates (a
   // doubling held both copies at once); pages never written cost no memory.
-  bvh.nodes_.reserve(2 * tri_count - 1);
+  bvh.nodes_.reserve(2 * refs.size() - 1);
   bvh.nodes_.push_back({root_box.lo, 0, root_box.hi, 0});
 
-  std::vector<BuildTask> tasks{{0, 0, static_cast<uint32_t>(tri_count), 0}};
+  std::vector<BuildTask> tasks{{0, 0, static_cast<uint32_t>(refs.size()), 0}};
   struct Bin {
     Aabb box;
     uint32_t count = 0;
@@ -132,9 +186,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     const uint32_t count = task.end - task.begin;
     Node& node = bvh.nodes_[task.node];
     const Aabb node_box{node.lo, node.hi};
-    if (count <= kLeafTriangles) {
-      node.first = task.begin;
-      node.count = count;
+    if (count <= leaf_refs) {
+      make_leaf(node, task.begin, count);
       continue;
     }
     Aabb centroids;
@@ -149,7 +202,7 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     Bin axis_bins[3][kBins];
     if (task.depth < kMaxSahDepth) {
       for (uint32_t i = task.begin; i < task.end; ++i) {
-        const Aabb box = bounds(refs[i].triangle);
+        const Aabb box = bounds(refs[i]);
         for (int axis = 0; axis < 3; ++axis) {
           if (!binnable(extent[axis])) continue;
           const int b = bin_of(refs[i].centroid(axis), centroids.lo[axis], extent[axis]);
@@ -186,9 +239,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
         }
       }
       const float leaf_cost = node_box.half_area() * static_cast<float>(count);
-      if (count <= kMaxLeafTriangles && !(best_cost < leaf_cost)) {
-        node.first = task.begin;
-        node.count = count;
+      if (count <= max_leaf_refs && !(best_cost < leaf_cost)) {
+        make_leaf(node, task.begin, count);
         continue;
       }
     }
@@ -218,8 +270,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
                                 (a.centroid(axis) == b.centroid(axis) && a.triangle < b.triangle);
                        });
       left_box = right_box = Aabb{};
-      for (uint32_t i = task.begin; i < mid; ++i) left_box.grow(bounds(refs[i].triangle));
-      for (uint32_t i = mid; i < task.end; ++i) right_box.grow(bounds(refs[i].triangle));
+      for (uint32_t i = task.begin; i < mid; ++i) left_box.grow(bounds(refs[i]));
+      for (uint32_t i = mid; i < task.end; ++i) right_box.grow(bounds(refs[i]));
     }
     const uint32_t left = static_cast<uint32_t>(bvh.nodes_.size());
     bvh.nodes_[task.node].first = left;  // `node` may dangle once the vector grows
@@ -229,8 +281,10 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     tasks.push_back({left + 1, mid, task.end, task.depth + 1});
     tasks.push_back({left, task.begin, mid, task.depth + 1});
   }
-  bvh.order_.resize(tri_count);
-  for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
+  if (!runs) {
+    bvh.order_.resize(tri_count);
+    for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
+  }
   refs = std::vector<Ref>();  // before the nodes' copy to their size
   bvh.nodes_.shrink_to_fit();
   *out = std::move(bvh);
@@ -261,7 +315,7 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
       continue;
     }
     for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-      const uint32_t tri = order_[i];
+      const uint32_t tri = leaf_triangle(i);
       const glm::vec3& a = positions_[triangle_vertex(tri, 0)];
       const glm::vec3& b = positions_[triangle_vertex(tri, 1)];
       const glm::vec3& c = positions_[triangle_vertex(tri, 2)];
@@ -312,7 +366,7 @@ bool TriangleBvh::trace(const glm::vec3& origin, const glm::vec3& direction, flo
     const Node& n = nodes_[stack[--top]];
     if (n.count > 0) {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-        const uint32_t tri = order_[i];
+        const uint32_t tri = leaf_triangle(i);
         const glm::vec3& v0 = positions_[triangle_vertex(tri, 0)];
         const glm::vec3 e1 = positions_[triangle_vertex(tri, 1)] - v0;
         const glm::vec3 e2 = positions_[triangle_vertex(tri, 2)] - v0;
@@ -382,7 +436,7 @@ void TriangleBvh::append_vertices_in(const XzBox& box, std::vector<uint32_t>* ou
     }
     for (uint32_t i = n.first; i < n.first + n.count; ++i) {
       for (int k = 0; k < 3; ++k) {
-        const uint32_t v = triangle_vertex(order_[i], k);
+        const uint32_t v = triangle_vertex(leaf_triangle(i), k);
         if (box.holds(positions_[v])) out->push_back(v);
       }
     }
@@ -412,7 +466,7 @@ uint32_t TriangleBvh::nearest_vertex(const glm::vec3& p, float radius,
     if (n.count > 0) {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
         for (int k = 0; k < 3; ++k) {
-          const uint32_t v = triangle_vertex(order_[i], k);
+          const uint32_t v = triangle_vertex(leaf_triangle(i), k);
           const float d2 = distance2(p, positions_[v]);
           if (d2 <= r2 && (d2 < best_d2 || (d2 == best_d2 && v < best_v))) {
             best_d2 = d2;

@@ -170,7 +170,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   host.ends = ends;
   // As Renderer::create takes it.
   siviflow::RiverInput input;
-  if (!siviflow::river_input_from(host, &input).ok()) return 0;
+  if (!siviflow::river_input_from(host, {}, &input).ok()) return 0;
   std::vector<siviflow::Obstacle> flow_obstacles;
   for (size_t i = 0; i < obstacles.size(); ++i) {
     if (!siviflow::check_obstacle(obstacles[i], i).ok()) return 0;

@@ -37,7 +37,7 @@ void build_scene(const siviflow::SceneFile& scene) {
     if (!siviflow::scene_river_data(&scene, i, &data).ok()) return;
     const siviflow::WaterRiver river = data.river();
     siviflow::RiverInput input;
-    if (!siviflow::river_input_from(river, &input).ok()) return;
+    if (!siviflow::river_input_from(river, {}, &input).ok()) return;
     std::vector<siviflow::Obstacle> obstacles;
     for (size_t k = 0; k < river.obstacles.size(); ++k) {
       if (!siviflow::check_obstacle(river.obstacles[k], k).ok()) return;

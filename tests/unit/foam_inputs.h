@@ -6,21 +6,21 @@
 #include <cstdint>
 #include <vector>
 
+#include "sim/foam.h"
 #include "siviflow/sim/river_surface.h"
 
 namespace siviflow::test {
 
 struct FoamInputs {
-  std::vector<float> bank;
+  MarginDistances bank;
   std::vector<uint32_t> section;
 };
 
 inline FoamInputs foam_inputs(const RiverSurface& surface, size_t vertex_count) {
   FoamInputs in;
+  in.bank = margin_distances(surface);
   for (size_t v = 0; v < vertex_count; ++v) {
-    const RiverVertex vertex = surface.vertex(v);
-    in.bank.push_back(std::min(vertex.d_left, vertex.d_right));
-    in.section.push_back(vertex.section);
+    in.section.push_back(surface.vertex(v).section);
   }
   return in;
 }

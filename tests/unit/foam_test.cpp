@@ -64,7 +64,7 @@ class FoamTest : public ::testing::Test {
   StreamFunction flow_;
   TriangleBvh bvh_;
   FoamField field_;
-  std::vector<float> bank_;
+  MarginDistances bank_;
   std::vector<uint32_t> section_;
 };
 
@@ -122,15 +122,16 @@ TEST_F(FoamTest, SharedAdjacencyGivesTheSameFoam) {
   const std::vector<float> own = foam();
   const RiverSurface& surface = flow_.surface();
   ASSERT_FALSE(surface.welded());
-  const VertexTriangles around{surface.node_triangle_start(), surface.node_triangle_list()};
   ASSERT_TRUE(FoamField::create(mesh_.positions, mesh_.indices, section_, &bvh_, FoamParams{},
-                                &field_, around)
+                                &field_, &surface.triangles_around())
                   .ok());
   EXPECT_EQ(foam(), own);
   FoamField field;
-  const VertexTriangles short_start{around.start.first(around.start.size() - 1), around.list};
+  // One vertex more than the mesh has.
+  const TrianglesAround too_many =
+      TrianglesAround::of_mesh(mesh_.positions.size() + 1, mesh_.indices);
   const Status status = FoamField::create(mesh_.positions, mesh_.indices, section_, &bvh_,
-                                          FoamParams{}, &field, short_start);
+                                          FoamParams{}, &field, &too_many);
   EXPECT_FALSE(status.ok());
   EXPECT_NE(status.message().find("around"), std::string::npos) << status.message();
 }

@@ -192,6 +192,48 @@ TEST(RiverSurface, Deterministic) {
   EXPECT_TRUE(std::equal(a.triangles().begin(), a.triangles().end(), b.triangles().begin()));
 }
 
+// The input is read no more once inputs_read is called: spoiled there (every position NaN, every
+// index out of range), the build gives the same surface, and says whether it welded.
+TEST(RiverSurface, InputsAreNotReadAfterInputsRead) {
+  const TestMesh m = test::bend(5.0f, 9.0f, 2.0f, 40, 7);
+  TestMesh soup;
+  for (const uint32_t i : m.indices) soup.positions.push_back(m.positions[i]);
+  for (const TestMesh* mesh : std::initializer_list<const TestMesh*>{&m, &soup}) {
+    RiverSurface plain, spoiled;
+    ASSERT_TRUE(build(*mesh, &plain).ok());
+    TestMesh copy = *mesh;
+    int calls = 0;
+    bool welded = false;
+    RiverSurfaceOptions options;
+    options.inputs_read = [&](bool w) {
+      ++calls;
+      welded = w;
+      std::fill(copy.positions.begin(), copy.positions.end(),
+                glm::vec3(std::numeric_limits<float>::quiet_NaN()));
+      std::fill(copy.indices.begin(), copy.indices.end(), 0xffffffffu);
+    };
+    ASSERT_TRUE(build(copy, &spoiled, options).ok());
+    EXPECT_EQ(calls, 1);
+    EXPECT_EQ(welded, mesh == &soup);
+    ASSERT_EQ(spoiled.node_count(), plain.node_count());
+    EXPECT_TRUE(std::ranges::equal(spoiled.node_positions(), plain.node_positions()));
+    EXPECT_TRUE(std::ranges::equal(spoiled.triangles(), plain.triangles()));
+    for (uint32_t n = 0; n < plain.node_count(); ++n) {
+      EXPECT_EQ(spoiled.node_d_left()[n], plain.node_d_left()[n]);
+      EXPECT_EQ(spoiled.node_section()[n], plain.node_section()[n]);
+    }
+  }
+  // Not called when the build fails before.
+  TestMesh bad = m;
+  bad.indices.pop_back();
+  int calls = 0;
+  RiverSurfaceOptions options;
+  options.inputs_read = [&](bool) { ++calls; };
+  RiverSurface s;
+  EXPECT_FALSE(build(bad, &s, options).ok());
+  EXPECT_EQ(calls, 0);
+}
+
 TEST(RiverSurface, SharedMeshIsReadFromTheSharerAndFreesItsOwn) {
   const TestMesh m = test::bend(5.0f, 9.0f, 2.0f, 40, 7);
   RiverSurface s;

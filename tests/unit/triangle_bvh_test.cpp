@@ -2,6 +2,7 @@
 // and positions past the world limit (siviflow/sim/world_limits.h). Bugs found by fuzzing and by
 // mutants of real glTF files (issue 28), each failing on the code before its fix. And what a long
 // river's hierarchy holds.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -49,6 +50,65 @@ TEST(TriangleBvh, AStripRiversHierarchyHoldsUnderElevenBytesATriangle) {
     glm::dvec3 weights;
     EXPECT_NE(bvh.locate_xz(p.x, p.z, &weights), UINT32_MAX) << "vertex " << v;
   }
+}
+
+// A river's hierarchy with leaves of its own runs of triangles holds no order (under 6 bytes a
+// triangle, against 10.5) and answers every query as the spatial one does: the nearest hit of a
+// ray, the triangle under a point, the nearest vertex and the vertices in a box.
+TEST(TriangleBvh, LeavesOfTheMeshsRunsAnswerAsSpatialLeavesDo) {
+  // Sections a metre apart, as wide as its quads are long: where each run's box grows diagonal
+  // and long (a sharp bend of thin quads), the build falls back to spatial leaves.
+  const test::TestMesh mesh = test::straight_channel(12.0f, 2000.0f, 2001, 13);
+  TriangleBvh spatial, runs;
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &spatial).ok());
+  ASSERT_TRUE(
+      TriangleBvh::build(mesh.positions, mesh.indices, &runs, "River", BvhLeaves::kMeshRuns).ok());
+  EXPECT_EQ(runs.triangle_count(), spatial.triangle_count());
+  EXPECT_LE(static_cast<double>(runs.memory_bytes()) / static_cast<double>(runs.triangle_count()),
+            6.0);
+  for (uint32_t t = 0; t < runs.triangle_count(); t += 37) {
+    // The centre of triangle t: on no edge, so no two triangles tie for it.
+    const glm::vec3 p =
+        (mesh.positions[mesh.indices[3 * t]] + mesh.positions[mesh.indices[3 * t + 1]] +
+         mesh.positions[mesh.indices[3 * t + 2]]) /
+        3.0f;
+    RayHit a, b;
+    const glm::vec3 origin = p + glm::vec3(3.0f, 20.0f, -2.0f);
+    const glm::vec3 direction = p - origin;
+    ASSERT_EQ(spatial.intersect(origin, direction, 2.0f, &a),
+              runs.intersect(origin, direction, 2.0f, &b))
+        << "triangle " << t;
+    EXPECT_EQ(a.triangle, b.triangle) << "triangle " << t;
+    EXPECT_EQ(a.t, b.t) << "triangle " << t;
+    glm::dvec3 wa, wb;
+    EXPECT_EQ(spatial.locate_xz(p.x, p.z, &wa), runs.locate_xz(p.x, p.z, &wb)) << "triangle " << t;
+    EXPECT_EQ(wa, wb) << "triangle " << t;
+    EXPECT_EQ(spatial.nearest_vertex(p, 5.0f, a.triangle), runs.nearest_vertex(p, 5.0f, a.triangle))
+        << "triangle " << t;
+    EXPECT_TRUE(runs.any_hit(origin, direction, 0.0f, 2.0f)) << "triangle " << t;
+    EXPECT_EQ(b.triangle, t);
+    std::vector<uint32_t> in_a, in_b;
+    const XzBox box{glm::dvec2(p.x, p.z) - 3.0, glm::dvec2(p.x, p.z) + 3.0};
+    spatial.append_vertices_in(box, &in_a);
+    runs.append_vertices_in(box, &in_b);
+    std::sort(in_a.begin(), in_a.end());
+    std::sort(in_b.begin(), in_b.end());
+    EXPECT_EQ(in_a, in_b) << "triangle " << t;
+    EXPECT_FALSE(in_a.empty());
+  }
+}
+
+// A mesh whose order has no locality gets spatial leaves whatever was asked: runs of shuffled
+// triangles would each span the river.
+TEST(TriangleBvh, AShuffledMeshGetsSpatialLeaves) {
+  std::vector<uint32_t> new_of_old;
+  const test::TestMesh mesh =
+      test::shuffled(test::straight_channel(12.0f, 2000.0f, 2001, 13), 3, &new_of_old);
+  TriangleBvh spatial, runs;
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &spatial).ok());
+  ASSERT_TRUE(
+      TriangleBvh::build(mesh.positions, mesh.indices, &runs, "River", BvhLeaves::kMeshRuns).ok());
+  EXPECT_EQ(runs.memory_bytes(), spatial.memory_bytes());
 }
 
 }  // namespace

@@ -138,9 +138,10 @@ struct CreateInfo {
   // boulders. Read by create() only: the renderer copies what it needs.
   const WaterRiver* river = nullptr;
   // Optional: called once by create(), as soon as the renderer holds its own copy of everything
-  // `river` points at and before it solves the flow and makes its buffers. The host may free the
-  // river's arrays there, so a long river is not held twice at the peak of creation (a 100 km
-  // river's mesh is about 60 MB). Not called for the built-in river, with share_river_with, or
+  // `river` points at (the surface's nodes and triangles made, before it finds their sections),
+  // and before it solves the flow and makes its buffers. The host may free the river's arrays
+  // there, so a long river is not held twice at the peak of creation (a 100 km river's mesh is
+  // about 60 MB). Not called for the built-in river, with share_river_with, or
   // when create() fails before the copy is made; a create() that fails after it may have called
   // it, so a host that frees there cannot retry with the same arrays.
   void (*river_copied)(void* user) = nullptr;

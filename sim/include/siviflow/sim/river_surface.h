@@ -23,11 +23,13 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
+#include "siviflow/sim/triangles_around.h"
 #include "siviflow/status.h"
 
 namespace siviflow {
@@ -52,6 +54,11 @@ struct RiverSurfaceOptions {
   // strip). Given, upstream_vertex is not read. A network takes a single inflow or a single
   // outflow.
   std::vector<RiverEndMark> ends;
+  // Called once, as soon as build() has read `positions` and `indices` for the last time (it
+  // holds its own nodes and triangles then, before it finds sections and banks), with whether
+  // it welded vertices: a caller may free the arrays there, or copy what it keeps of them. Not
+  // called when build() fails before. May be empty.
+  std::function<void(bool welded)> inputs_read;
 };
 
 // One cross-section of the river, from the left shore to the right shore.
@@ -133,6 +140,8 @@ class RiverSurface {
   RiverVertex vertex(size_t vertex) const { return node(node_of(vertex)); }
   // Whether some input vertices were welded; if not, node n is input vertex n.
   bool welded() const { return !node_of_vertex_.empty(); }
+  // Every input vertex's node; empty when nothing was welded.
+  std::span<const uint32_t> node_of_vertex() const { return node_of_vertex_; }
 
   // --- Per node (welded vertex); every index below is a node index ---
   size_t node_count() const { return node_positions().size(); }
@@ -181,12 +190,9 @@ class RiverSurface {
   }
   size_t triangle_count() const { return triangles().size() / 3; }
   // Triangles around node n, ascending.
-  std::span<const uint32_t> node_triangles(uint32_t n) const {
-    return {node_tri_list_.data() + node_tri_start_[n], node_tri_start_[n + 1] - node_tri_start_[n]};
-  }
-  // The same for every node at once: node n's are list[start[n] .. start[n + 1]).
-  std::span<const uint32_t> node_triangle_start() const { return node_tri_start_; }
-  std::span<const uint32_t> node_triangle_list() const { return node_tri_list_; }
+  TrianglesAround::Range node_triangles(uint32_t n) const { return node_triangles_.of(n); }
+  // The same for every node at once.
+  const TrianglesAround& triangles_around() const { return node_triangles_; }
 
   // The ends: the upstream end first, then the rest in border order (a strip's second is its
   // downstream end). A network has more than two.
@@ -239,8 +245,7 @@ class RiverSurface {
   std::vector<float> node_d_left_;
   std::vector<float> node_d_right_;
   std::vector<uint32_t> triangles_;
-  std::vector<uint32_t> node_tri_start_;
-  std::vector<uint32_t> node_tri_list_;
+  TrianglesAround node_triangles_;
   std::vector<RiverSection> sections_;
   std::vector<uint32_t> section_nodes_;
   // Only with islands: the border on each side of every node, and the islands' shores.

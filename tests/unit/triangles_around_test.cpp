@@ -1,0 +1,70 @@
+// The triangles around each vertex, as a long river keeps them: the same lists as a plain count
+// would give, in 2 bytes a triangle for a mesh laid out section after section, and in 4 for one
+// whose order is shuffled.
+#include "siviflow/sim/triangles_around.h"
+
+#include <cstdint>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "river_test_meshes.h"
+#include "siviflow/sim/river_surface.h"
+
+namespace siviflow {
+namespace {
+
+// Each vertex's triangles, ascending, counted the plain way.
+std::vector<std::vector<uint32_t>> plain_lists(size_t vertex_count,
+                                               const std::vector<uint32_t>& indices) {
+  std::vector<std::vector<uint32_t>> lists(vertex_count);
+  for (size_t i = 0; i < indices.size(); ++i)
+    lists[indices[i]].push_back(static_cast<uint32_t>(i / 3));
+  return lists;
+}
+
+void expect_lists(const TrianglesAround& around, const std::vector<std::vector<uint32_t>>& want) {
+  ASSERT_EQ(around.vertex_count(), want.size());
+  for (uint32_t v = 0; v < want.size(); ++v) {
+    const std::vector<uint32_t> got(around.of(v).begin(), around.of(v).end());
+    ASSERT_EQ(got, want[v]) << "vertex " << v;
+  }
+}
+
+// 4 km of a 13-vertex strip: 104k triangles, far more than a 16-bit offset reaches from vertex 0.
+TEST(TrianglesAround, AStripHoldsItsListsInTwoBytesATriangle) {
+  const test::TestMesh mesh = test::straight_channel(12.0f, 4000.0f, 4001, 13);
+  const TrianglesAround around = TrianglesAround::of_mesh(mesh.positions.size(), mesh.indices);
+  EXPECT_TRUE(around.compact());
+  expect_lists(around, plain_lists(mesh.positions.size(), mesh.indices));
+  EXPECT_LE(around.memory_bytes(), 4 * (mesh.positions.size() + 1) + 2 * mesh.indices.size());
+}
+
+TEST(TrianglesAround, AShuffledMeshKeepsFourBytesATriangleAndTheSameLists) {
+  std::vector<uint32_t> new_of_old;
+  const test::TestMesh mesh =
+      test::shuffled(test::straight_channel(12.0f, 4000.0f, 4001, 13), 7, &new_of_old);
+  const TrianglesAround around = TrianglesAround::of_mesh(mesh.positions.size(), mesh.indices);
+  EXPECT_FALSE(around.compact());
+  expect_lists(around, plain_lists(mesh.positions.size(), mesh.indices));
+}
+
+TEST(TrianglesAround, ANonIndexedMeshCountsEveryThreeVertices) {
+  const std::vector<uint32_t> none;
+  const TrianglesAround around = TrianglesAround::of_mesh(6, none);
+  expect_lists(around, {{0}, {0}, {0}, {1}, {1}, {1}});
+}
+
+// The river surface keeps its nodes' triangles so: a procedural river's are compact, and equal
+// to a plain count over its triangles.
+TEST(TrianglesAround, ARiverSurfacesNodesTrianglesAreCompact) {
+  const test::TestMesh mesh = test::bend(40.0f, 52.0f, 3.0f, 600, 9);
+  RiverSurface surface;
+  ASSERT_TRUE(RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok());
+  EXPECT_TRUE(surface.triangles_around().compact());
+  const std::vector<uint32_t> triangles(surface.triangles().begin(), surface.triangles().end());
+  expect_lists(surface.triangles_around(), plain_lists(surface.node_count(), triangles));
+}
+
+}  // namespace
+}  // namespace siviflow
