@@ -50,9 +50,10 @@ Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   RiverSurfaceOptions options;
   for (const RiverMeshEnd& end : input.mesh.ends) options.ends.push_back({end.vertex, end.inflow});
   SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, options, &input.surface));
-  if (!input.surface.welded()) {
-    input.mesh.positions = {};
-    input.mesh.indices = {};
+  if (!input.surface.welded() &&
+      std::ranges::equal(input.surface.triangles(), input.mesh.indices)) {
+    input.mesh.positions = std::vector<glm::vec3>();  // freed: `= {}` would keep the capacity
+    input.mesh.indices = std::vector<uint32_t>();
   }
   *out = std::move(input);
   return Status::success();
@@ -119,19 +120,26 @@ Status river_input_from(const WaterRiver& river, const std::function<void()>& co
   input.mesh.depth.assign(river.depth.begin(), river.depth.end());
   input.slope.assign(river.slope.begin(), river.slope.end());
   RiverSurfaceOptions options = river_surface_options(river.ends);
-  // Past this the host's arrays are not read: a copy of the mesh only where vertices were
-  // welded (unwelded, the surface's nodes and triangles are the mesh), then the host frees.
+  // Past this the host's arrays are not read, and the host frees them: the mesh is copied where
+  // vertices were welded, and its indices where the surface may wind them otherwise (unwelded,
+  // its positions are the surface's nodes).
   options.inputs_read = [&](bool welded) {
-    if (welded) {
-      input.mesh.positions.assign(river.positions.begin(), river.positions.end());
-      input.mesh.indices.assign(river.indices.begin(), river.indices.end());
-    }
+    if (welded) input.mesh.positions.assign(river.positions.begin(), river.positions.end());
+    input.mesh.indices.assign(river.indices.begin(), river.indices.end());
     if (copied) copied();
   };
   const std::vector<WaterRiverEnd> ends(river.ends.begin(), river.ends.end());
   const Status built = RiverSurface::build(river.positions, river.indices, options, &input.surface);
   if (!built.ok()) return Status::error("CreateInfo::river: " + built.message(), built.code());
   input.end_discharges = surface_end_discharges(input.surface, ends);
+  if (!input.surface.welded()) {
+    if (std::ranges::equal(input.surface.triangles(), input.mesh.indices)) {
+      input.mesh.indices = std::vector<uint32_t>();  // the surface's: one copy, not two
+    } else {  // rewound: the host's winding is kept, as the foam and queries add its corners
+      const auto nodes = input.surface.node_positions();
+      input.mesh.positions.assign(nodes.begin(), nodes.end());
+    }
+  }
   *out = std::move(input);
   return Status::success();
 }

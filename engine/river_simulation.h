@@ -32,9 +32,8 @@ namespace siviflow {
 
 // What the simulation runs on: the river's mesh (positions, indices, depth), the riverbed slope
 // under each vertex (rise over run), and the surface built from the mesh (built once). The mesh
-// has no positions and indices when the surface welded nothing: its nodes and triangles are the
-// mesh then (the winding may differ; the water is drawn from both sides): one copy of a long
-// river, not two.
+// has no positions and indices when the surface's are the same (it welded nothing and kept the
+// winding): one copy of a long river, not two.
 struct RiverInput {
   RiverMesh mesh;
   std::vector<float> slope;
@@ -90,7 +89,8 @@ class RiverFlow {
   // Solves the flow of `river` with the obstacles, and hands the mesh to `home` (if any) before
   // anything reads it: a mesh placed there, alive while anything reads this flow, is then read
   // from there and the flow's own copy freed (only a mesh read from the surface, see per_node_).
-  // Must not be moved after create(): the views keep spans into its per-vertex arrays.
+  // Must not be moved after create(): the views keep spans into its per-vertex arrays, and the
+  // foam the address of its surface's triangles around each node.
   Status create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
                 const MeshHome& home = {});
 

@@ -111,7 +111,7 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   field.indices_ = indices;
   if (around == nullptr) {
     field.own_around_ = TrianglesAround::of_mesh(count, indices);
-  } else if (around->vertex_count() != count) {
+  } else if (around->vertex_count() != count || around->triangle_count() != corners / 3) {
     return Status::error("FoamField: the triangles around the vertices do not fit the mesh");
   }
   field.shared_around_ = around;

@@ -75,7 +75,8 @@ class FoamField {
   // vertex's cross-section (river_surface.h). `bvh` is built on the same positions and indices.
   // `around`: the triangles around each vertex where the caller keeps them (a river surface's,
   // when its nodes are the vertices); null, the field builds its own. The spans, `bvh` and
-  // `around` outlive this object. Every vertex must be a corner of a triangle.
+  // `around` outlive this object, and `around` stays where it is (the field keeps its address).
+  // Every vertex must be a corner of a triangle.
   static Status create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                        std::span<const uint32_t> section, const TriangleBvh* bvh,
                        const FoamParams& params, FoamField* out,

@@ -48,11 +48,10 @@ struct Aabb {
 
 // A triangle, or a run of consecutive ones, during the build: the centre of its bounds travels
 // with it, so partitioning stays cache-local; the bounds themselves are read again from the mesh
-// (20 bytes a reference, not 32).
+// (16 bytes a reference, not 28).
 struct Ref {
   glm::vec3 centre;
-  uint32_t triangle;  // the first of the run
-  uint32_t count;     // triangles in the run
+  uint32_t item;  // the triangle, or the run
   float centroid(int axis) const { return centre[axis]; }
 };
 
@@ -123,43 +122,49 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
   // a strip ends); each run is a leaf. Runs too short on average (an order with no locality) give
   // spatial leaves.
   std::vector<Ref> refs;
+  std::vector<uint32_t> run_first;  // run r is triangles [run_first[r], run_first[r + 1])
   Aabb root_box;
   if (leaves == BvhLeaves::kMeshRuns) {
     Aabb box;
     double area = 0.0;
-    uint32_t first = 0;
     for (uint32_t t = 0; t <= tri_count; ++t) {
       const Aabb b = t < tri_count ? triangle_bounds(t) : Aabb{};
+      const uint32_t first = run_first.empty() ? 0 : run_first.back();
       Aabb grown = box;
       grown.grow(b);
       const bool full =
           t - first == kLeafTriangles || grown.half_area() > kRunGrowth * (area + b.half_area());
+      if (run_first.empty()) run_first.push_back(0);
       if (t > first && (t == tri_count || full)) {
-        refs.push_back({0.5f * (box.lo + box.hi), first, t - first});
+        refs.push_back({0.5f * (box.lo + box.hi), static_cast<uint32_t>(refs.size())});
+        run_first.push_back(t);
         root_box.grow(box);
         grown = b;
         area = 0.0;
-        first = t;
       }
       box = grown;
       area += b.half_area();
     }
     if (refs.size() * kMinMeanRun > tri_count) {
       refs = std::vector<Ref>();
+      run_first = std::vector<uint32_t>();
       root_box = Aabb{};
     }
   }
   const bool runs = !refs.empty();
   const auto bounds = [&](const Ref& ref) {
+    if (!runs) return triangle_bounds(ref.item);
     Aabb b;
-    for (uint32_t t = ref.triangle; t < ref.triangle + ref.count; ++t) b.grow(triangle_bounds(t));
+    for (uint32_t t = run_first[ref.item]; t < run_first[ref.item + 1]; ++t) {
+      b.grow(triangle_bounds(t));
+    }
     return b;
   };
   if (!runs) {
     refs.resize(tri_count);
     for (uint32_t t = 0; t < tri_count; ++t) {
       const Aabb b = triangle_bounds(t);
-      refs[t] = {0.5f * (b.lo + b.hi), t, 1};
+      refs[t] = {0.5f * (b.lo + b.hi), t};
       root_box.grow(b);
     }
   }
@@ -167,8 +172,14 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
   const uint32_t leaf_refs = runs ? 1 : kLeafTriangles;
   const uint32_t max_leaf_refs = runs ? 1 : kMaxLeafTriangles;
   const auto make_leaf = [&](Node& node, uint32_t begin, uint32_t count) {
-    node.first = runs ? refs[begin].triangle : begin;  // a run: its triangles themselves
-    node.count = runs ? refs[begin].count : count;
+    if (runs) {  // the run's triangles themselves
+      const uint32_t r = refs[begin].item;
+      node.first = run_first[r];
+      node.count = run_first[r + 1] - run_first[r];
+    } else {
+      node.first = begin;
+      node.count = count;
+    }
   };
   // A binary tree over n references has at most 2n - 1 nodes: reserved, it never reallocates (a
   // doubling held both copies at once); pages never written cost no memory.
@@ -267,7 +278,7 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
       std::nth_element(refs.data() + task.begin, refs.data() + mid, refs.data() + task.end,
                        [axis](const Ref& a, const Ref& b) {
                          return a.centroid(axis) < b.centroid(axis) ||
-                                (a.centroid(axis) == b.centroid(axis) && a.triangle < b.triangle);
+                                (a.centroid(axis) == b.centroid(axis) && a.item < b.item);
                        });
       left_box = right_box = Aabb{};
       for (uint32_t i = task.begin; i < mid; ++i) left_box.grow(bounds(refs[i]));
@@ -283,7 +294,7 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
   }
   if (!runs) {
     bvh.order_.resize(tri_count);
-    for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
+    for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].item;
   }
   refs = std::vector<Ref>();  // before the nodes' copy to their size
   bvh.nodes_.shrink_to_fit();
@@ -303,6 +314,9 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
   const auto holds = [&](const Node& n) {
     return x >= n.lo.x && x <= n.hi.x && z >= n.lo.z && z <= n.hi.z;
   };
+  // Every leaf that may hold the point is searched: where several triangles do (on their shared
+  // edge), the lowest index is the answer, whatever the leaves.
+  uint32_t found = UINT32_MAX;
   uint32_t stack[kStackSize];
   int top = 0;
   if (!holds(nodes_[0])) return UINT32_MAX;
@@ -327,13 +341,13 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
       const double v = (px * e1z - e1x * pz) / det;
       const double w = (e0x * pz - px * e0z) / det;
       const double u = 1.0 - v - w;
-      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance) {
+      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance && tri < found) {
+        found = tri;
         *weights = glm::clamp(glm::dvec3(u, v, w), 0.0, 1.0);
-        return tri;
       }
     }
   }
-  return UINT32_MAX;
+  return found;
 }
 
 template <bool kAnyHit>

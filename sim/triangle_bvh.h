@@ -44,8 +44,7 @@ class TriangleBvh {
   // position outside the world (siviflow/sim/world_limits.h), or more triangles than 32-bit
   // indices address.
   // Messages name the fields after `mesh_name` ("RiverFlowField::positions[3] is not finite").
-  // `leaves`: what a leaf holds. The queries answer the same with either, but for which of two
-  // triangles a point or ray on their shared edge is given to.
+  // `leaves`: what a leaf holds; the queries answer the same with either.
   static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                       TriangleBvh* out, std::string_view mesh_name = "RiverFlowField",
                       BvhLeaves leaves = BvhLeaves::kSpatial);
@@ -69,9 +68,10 @@ class TriangleBvh {
   bool any_hit(const glm::vec3& origin, const glm::vec3& direction, float t_min,
                float t_max) const;
 
-  // The triangle whose projection on the XZ plane holds (x, z) (the first the traversal meets
-  // where several do: the same every time), with its barycentric weights; UINT32_MAX when none
-  // does. In doubles: far from the origin a float difference would lose the centimetres.
+  // The triangle whose projection on the XZ plane holds (x, z) (the lowest index where several
+  // do, on their shared edge: the same whatever the leaves), with its barycentric weights;
+  // UINT32_MAX when none does. In doubles: far from the origin a float difference would lose the
+  // centimetres.
   uint32_t locate_xz(double x, double z, glm::dvec3* weights) const;
 
   // The vertex nearest to `p` (ties: the lower index) among the vertices within `radius` of it;
@@ -93,12 +93,11 @@ class TriangleBvh {
   template <bool kAnyHit>
   bool trace(const glm::vec3& origin, const glm::vec3& direction, float t_min, float t_max,
              RayHit* hit) const;
-
-  std::span<const glm::vec3> positions_;
-  std::span<const uint32_t> indices_;
   // The triangle at entry i of a leaf.
   uint32_t leaf_triangle(uint32_t i) const { return order_.empty() ? i : order_[i]; }
 
+  std::span<const glm::vec3> positions_;
+  std::span<const uint32_t> indices_;
   std::vector<Node> nodes_;
   // Triangle indices, leaf by leaf; empty when the leaves are runs of the mesh's own order.
   std::vector<uint32_t> order_;

@@ -3,6 +3,7 @@
 // obstacles where they now stand, bit for bit.
 #include <algorithm>
 #include <span>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -100,6 +101,45 @@ TEST(RiverFlowTest, AKeyedObstacleAddedAtRuntimeMovesWithTheTime) {
   EXPECT_EQ(flow->obstacle_centre(0), glm::vec3(0.0f, 0.0f, 180.0f));
   auto fresh = test::river_flow(mesh, params, standing_at({boat}, 8.0));
   expect_same_foam(*flow, *fresh, "the added boat at t 8");
+}
+
+// What a host's river keeps of the host's arrays once river_input_from calls back (the host
+// frees them there): none of its mesh where the surface's nodes and triangles are the mesh, the
+// indices as the host wound them where the surface wound them otherwise (the foam and the
+// queries add a triangle's corners in that order), the whole mesh where vertices were welded.
+TEST(RiverFlowTest, AHostsRiverKeepsACopyOfItsMeshOnlyWhereTheSurfaceDiffers) {
+  const test::TestMesh wound = test::straight_channel(6.0f, 40.0f, 21, 5);
+  test::TestMesh rewound = wound;
+  for (size_t t = 0; t < rewound.indices.size(); t += 6) {
+    std::swap(rewound.indices[t + 1], rewound.indices[t + 2]);
+  }
+  test::TestMesh soup;
+  for (const uint32_t i : wound.indices) soup.positions.push_back(wound.positions[i]);
+  using Case = std::tuple<const test::TestMesh*, bool, bool>;  // keeps positions, indices
+  for (const auto& [mesh, keeps_positions, keeps_indices] :
+       {Case{&wound, false, false}, Case{&rewound, true, true}, Case{&soup, true, false}}) {
+    const std::vector<float> depth(mesh->positions.size(), 1.0f),
+        slope(mesh->positions.size(), 0.0f);
+    WaterRiver river;
+    river.positions = mesh->positions;
+    river.indices = mesh->indices;
+    river.depth = depth;
+    river.slope = slope;
+    int calls = 0;
+    RiverInput input;
+    ASSERT_TRUE(river_input_from(
+                    river, [&] { ++calls; }, &input)
+                    .ok());
+    EXPECT_EQ(calls, 1);
+    EXPECT_EQ(input.mesh.positions.empty(), !keeps_positions);
+    if (keeps_positions) {
+      EXPECT_TRUE(std::ranges::equal(input.mesh.positions, mesh->positions));
+    }
+    EXPECT_EQ(input.mesh.indices.empty(), !keeps_indices);
+    if (keeps_indices) {
+      EXPECT_TRUE(std::ranges::equal(input.mesh.indices, mesh->indices));
+    }
+  }
 }
 
 }  // namespace

@@ -54,10 +54,10 @@ TEST(TriangleBvh, AStripRiversHierarchyHoldsUnderElevenBytesATriangle) {
 
 // A river's hierarchy with leaves of its own runs of triangles holds no order (under 6 bytes a
 // triangle, against 10.5) and answers every query as the spatial one does: the nearest hit of a
-// ray, the triangle under a point, the nearest vertex and the vertices in a box.
+// ray and the triangle under a point for every triangle (so each is in a leaf), the nearest
+// vertex and the vertices in a box; and a point on an edge goes to the same triangle.
 TEST(TriangleBvh, LeavesOfTheMeshsRunsAnswerAsSpatialLeavesDo) {
-  // Sections a metre apart, as wide as its quads are long: where each run's box grows diagonal
-  // and long (a sharp bend of thin quads), the build falls back to spatial leaves.
+  // Quads a metre square, rows of 24 triangles: runs of 16 and 8.
   const test::TestMesh mesh = test::straight_channel(12.0f, 2000.0f, 2001, 13);
   TriangleBvh spatial, runs;
   ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &spatial).ok());
@@ -66,27 +66,31 @@ TEST(TriangleBvh, LeavesOfTheMeshsRunsAnswerAsSpatialLeavesDo) {
   EXPECT_EQ(runs.triangle_count(), spatial.triangle_count());
   EXPECT_LE(static_cast<double>(runs.memory_bytes()) / static_cast<double>(runs.triangle_count()),
             6.0);
-  for (uint32_t t = 0; t < runs.triangle_count(); t += 37) {
+  const auto corner = [&](uint32_t t, int k) { return mesh.positions[mesh.indices[3 * t + k]]; };
+  for (uint32_t t = 0; t < runs.triangle_count(); ++t) {
     // The centre of triangle t: on no edge, so no two triangles tie for it.
-    const glm::vec3 p =
-        (mesh.positions[mesh.indices[3 * t]] + mesh.positions[mesh.indices[3 * t + 1]] +
-         mesh.positions[mesh.indices[3 * t + 2]]) /
-        3.0f;
+    const glm::vec3 p = (corner(t, 0) + corner(t, 1) + corner(t, 2)) / 3.0f;
     RayHit a, b;
     const glm::vec3 origin = p + glm::vec3(3.0f, 20.0f, -2.0f);
     const glm::vec3 direction = p - origin;
-    ASSERT_EQ(spatial.intersect(origin, direction, 2.0f, &a),
-              runs.intersect(origin, direction, 2.0f, &b))
-        << "triangle " << t;
-    EXPECT_EQ(a.triangle, b.triangle) << "triangle " << t;
-    EXPECT_EQ(a.t, b.t) << "triangle " << t;
+    ASSERT_TRUE(spatial.intersect(origin, direction, 2.0f, &a)) << "triangle " << t;
+    ASSERT_TRUE(runs.intersect(origin, direction, 2.0f, &b)) << "triangle " << t;
+    ASSERT_EQ(b.triangle, t);
+    ASSERT_EQ(a.triangle, b.triangle);
+    ASSERT_EQ(a.t, b.t) << "triangle " << t;
     glm::dvec3 wa, wb;
-    EXPECT_EQ(spatial.locate_xz(p.x, p.z, &wa), runs.locate_xz(p.x, p.z, &wb)) << "triangle " << t;
-    EXPECT_EQ(wa, wb) << "triangle " << t;
-    EXPECT_EQ(spatial.nearest_vertex(p, 5.0f, a.triangle), runs.nearest_vertex(p, 5.0f, a.triangle))
+    ASSERT_EQ(runs.locate_xz(p.x, p.z, &wb), t);
+    ASSERT_EQ(spatial.locate_xz(p.x, p.z, &wa), t);
+    ASSERT_EQ(wa, wb) << "triangle " << t;
+    // Halfway along its first edge, which it shares with a neighbour (but on the banks).
+    const glm::vec3 edge = 0.5f * (corner(t, 0) + corner(t, 1));
+    ASSERT_EQ(spatial.locate_xz(edge.x, edge.z, &wa), runs.locate_xz(edge.x, edge.z, &wb))
+        << "triangle " << t;
+    ASSERT_EQ(wa, wb) << "triangle " << t;
+    if (t % 37 != 0) continue;
+    EXPECT_EQ(spatial.nearest_vertex(p, 5.0f, t), runs.nearest_vertex(p, 5.0f, t))
         << "triangle " << t;
     EXPECT_TRUE(runs.any_hit(origin, direction, 0.0f, 2.0f)) << "triangle " << t;
-    EXPECT_EQ(b.triangle, t);
     std::vector<uint32_t> in_a, in_b;
     const XzBox box{glm::dvec2(p.x, p.z) - 3.0, glm::dvec2(p.x, p.z) + 3.0};
     spatial.append_vertices_in(box, &in_a);

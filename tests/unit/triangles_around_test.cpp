@@ -4,6 +4,7 @@
 #include "siviflow/sim/triangles_around.h"
 
 #include <cstdint>
+#include <ranges>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -13,6 +14,8 @@
 
 namespace siviflow {
 namespace {
+
+static_assert(std::ranges::forward_range<TrianglesAround::Range>);
 
 // Each vertex's triangles, ascending, counted the plain way.
 std::vector<std::vector<uint32_t>> plain_lists(size_t vertex_count,
@@ -26,7 +29,9 @@ std::vector<std::vector<uint32_t>> plain_lists(size_t vertex_count,
 void expect_lists(const TrianglesAround& around, const std::vector<std::vector<uint32_t>>& want) {
   ASSERT_EQ(around.vertex_count(), want.size());
   for (uint32_t v = 0; v < want.size(); ++v) {
-    const std::vector<uint32_t> got(around.of(v).begin(), around.of(v).end());
+    const TrianglesAround::Range range = around.of(v);
+    const std::vector<uint32_t> got(range.begin(), range.end());
+    ASSERT_EQ(range.size(), got.size());
     ASSERT_EQ(got, want[v]) << "vertex " << v;
   }
 }

@@ -16,33 +16,42 @@ namespace siviflow {
 
 class TrianglesAround {
  public:
-  // One vertex's triangles, ascending.
+  // One vertex's triangles, ascending. Its iterators stay valid while the TrianglesAround does.
   class Range {
    public:
     class Iterator {
      public:
-      using iterator_category = std::input_iterator_tag;
+      using iterator_category = std::forward_iterator_tag;
       using value_type = uint32_t;
       using difference_type = std::ptrdiff_t;
       using pointer = void;
       using reference = uint32_t;
 
-      Iterator(const Range* range, size_t i) : range_(range), i_(i) {}
-      uint32_t operator*() const { return (*range_)[i_]; }
+      Iterator() = default;
+      Iterator(const int16_t* offset, const uint32_t* triangle, int64_t anchor)
+          : offset_(offset), triangle_(triangle), anchor_(anchor) {}
+      uint32_t operator*() const {
+        return offset_ != nullptr ? static_cast<uint32_t>(anchor_ + *offset_) : *triangle_;
+      }
       Iterator& operator++() {
-        ++i_;
+        if (offset_ != nullptr) {
+          ++offset_;
+        } else {
+          ++triangle_;
+        }
         return *this;
       }
       Iterator operator++(int) {
         const Iterator before = *this;
-        ++i_;
+        ++*this;
         return before;
       }
-      bool operator==(const Iterator& other) const { return i_ == other.i_; }
+      bool operator==(const Iterator& other) const = default;
 
      private:
-      const Range* range_;
-      size_t i_;
+      const int16_t* offset_ = nullptr;     // compact: triangle = anchor + offset
+      const uint32_t* triangle_ = nullptr;  // else the triangle itself
+      int64_t anchor_ = 0;
     };
 
     Range(const int16_t* offsets, const uint32_t* triangles, size_t size, int64_t anchor)
@@ -51,8 +60,11 @@ class TrianglesAround {
       return offsets_ != nullptr ? static_cast<uint32_t>(anchor_ + offsets_[i]) : triangles_[i];
     }
     size_t size() const { return size_; }
-    Iterator begin() const { return {this, 0}; }
-    Iterator end() const { return {this, size_}; }
+    Iterator begin() const { return {offsets_, triangles_, anchor_}; }
+    Iterator end() const {
+      return offsets_ != nullptr ? Iterator(offsets_ + size_, nullptr, anchor_)
+                                 : Iterator(nullptr, triangles_ + size_, anchor_);
+    }
 
    private:
     const int16_t* offsets_;     // compact: triangle = anchor + offset
@@ -66,6 +78,7 @@ class TrianglesAround {
   static TrianglesAround of_mesh(size_t vertex_count, std::span<const uint32_t> indices);
 
   size_t vertex_count() const { return start_.empty() ? 0 : start_.size() - 1; }
+  size_t triangle_count() const { return triangle_count_; }
   Range of(uint32_t v) const {
     const size_t first = start_[v], size = start_[v + 1] - first;
     return offsets_.empty() ? Range(nullptr, triangles_.data() + first, size, 0)
