@@ -205,8 +205,7 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   }
   foam_.resize(count);
   auto bvh = std::make_shared<TriangleBvh>();
-  SIVIFLOW_TRY(TriangleBvh::build(field_.positions, field_.indices, bvh.get(), "RiverFlowField",
-                                  BvhLeaves::kMeshRuns));
+  SIVIFLOW_TRY(TriangleBvh::build(field_.positions, field_.indices, bvh.get()));
   bvh_ = std::move(bvh);
   // The surface's, when its nodes are the vertices.
   const TrianglesAround* around = per_node_ ? &surface.triangles_around() : nullptr;

@@ -13,18 +13,12 @@ namespace siviflow {
 namespace {
 
 // Binned SAH, split down to leaves of 16 triangles: a 100 km river's hierarchy takes 26 MB (40
-// with 8, 64 with 4; 14.9 with kMeshRuns); the particles' ray casts of a frame take 2-3 % longer
-// than with 8 (0.50 against 0.49 ms at 1280x720).
+// with 8, 64 with 4); the particles' ray casts of a frame take 2-3 % longer than with 8 (0.50
+// against 0.49 ms at 1280x720).
 constexpr uint32_t kLeafTriangles = 16;
 // A node stays a leaf up to this size when splitting would not pay (SAH).
 constexpr uint32_t kMaxLeafTriangles = 32;
 constexpr int kBins = 16;
-// BvhLeaves::kMeshRuns: a run ends before the triangle that would grow its box past this many
-// times the area of its triangles' boxes (along a row of a river's quads it stays at 0.5 to 1.3
-// of it, the next row's first triangle takes it to 4 or 5); a mesh whose runs are shorter than
-// kMinMeanRun triangles on average is not laid out along itself.
-constexpr double kRunGrowth = 2.0;
-constexpr size_t kMinMeanRun = 8;
 // Below this depth splits fall back to the object median, so the traversal stack is bounded.
 constexpr int kMaxSahDepth = 40;
 constexpr int kStackSize = 128;  // > kMaxSahDepth + 32 median levels
@@ -46,12 +40,11 @@ struct Aabb {
   }
 };
 
-// A triangle, or a run of consecutive ones, during the build: the centre of its bounds travels
-// with it, so partitioning stays cache-local; the bounds themselves are read again from the mesh
-// (16 bytes a reference, not 28).
+// A triangle during the build: the centre of its bounds travels with it, so partitioning stays
+// cache-local; the bounds themselves are read again from the mesh (16 bytes a triangle, not 28).
 struct Ref {
   glm::vec3 centre;
-  uint32_t item;  // the triangle, or the run
+  uint32_t triangle;
   float centroid(int axis) const { return centre[axis]; }
 };
 
@@ -81,7 +74,7 @@ float box_distance2(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& p
 }  // namespace
 
 Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                          TriangleBvh* out, std::string_view mesh_name, BvhLeaves leaves) {
+                          TriangleBvh* out, std::string_view mesh_name) {
   const std::string name(mesh_name);
   const size_t corner_count = indices.empty() ? positions.size() : indices.size();
   if (corner_count == 0) return Status::error(name + ": the mesh has no triangles");
@@ -110,83 +103,25 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
 
   TriangleBvh bvh;
   bvh.positions_ = positions;
-  bvh.triangle_count_ = tri_count;
   bvh.indices_ = indices;
-  const auto triangle_bounds = [&](uint32_t t) {
+  std::vector<Ref> refs(tri_count);
+  const auto bounds = [&](uint32_t t) {
     Aabb b;
     for (int k = 0; k < 3; ++k) b.grow(positions[bvh.triangle_vertex(t, k)]);
     return b;
   };
-  // kMeshRuns: the mesh's order cut into runs of up to kLeafTriangles, each ending where the
-  // next triangle would grow its box past twice the area of its triangles' own (where a row of
-  // a strip ends); each run is a leaf. Runs too short on average (an order with no locality) give
-  // spatial leaves.
-  std::vector<Ref> refs;
-  std::vector<uint32_t> run_first;  // run r is triangles [run_first[r], run_first[r + 1])
   Aabb root_box;
-  if (leaves == BvhLeaves::kMeshRuns) {
-    Aabb box;
-    double area = 0.0;
-    for (uint32_t t = 0; t <= tri_count; ++t) {
-      const Aabb b = t < tri_count ? triangle_bounds(t) : Aabb{};
-      const uint32_t first = run_first.empty() ? 0 : run_first.back();
-      Aabb grown = box;
-      grown.grow(b);
-      const bool full =
-          t - first == kLeafTriangles || grown.half_area() > kRunGrowth * (area + b.half_area());
-      if (run_first.empty()) run_first.push_back(0);
-      if (t > first && (t == tri_count || full)) {
-        refs.push_back({0.5f * (box.lo + box.hi), static_cast<uint32_t>(refs.size())});
-        run_first.push_back(t);
-        root_box.grow(box);
-        grown = b;
-        area = 0.0;
-      }
-      box = grown;
-      area += b.half_area();
-    }
-    if (refs.size() * kMinMeanRun > tri_count) {
-      refs = std::vector<Ref>();
-      run_first = std::vector<uint32_t>();
-      root_box = Aabb{};
-    }
+  for (uint32_t t = 0; t < tri_count; ++t) {
+    const Aabb b = bounds(t);
+    refs[t] = {0.5f * (b.lo + b.hi), t};
+    root_box.grow(b);
   }
-  const bool runs = !refs.empty();
-  const auto bounds = [&](const Ref& ref) {
-    if (!runs) return triangle_bounds(ref.item);
-    Aabb b;
-    for (uint32_t t = run_first[ref.item]; t < run_first[ref.item + 1]; ++t) {
-      b.grow(triangle_bounds(t));
-    }
-    return b;
-  };
-  if (!runs) {
-    refs.resize(tri_count);
-    for (uint32_t t = 0; t < tri_count; ++t) {
-      const Aabb b = triangle_bounds(t);
-      refs[t] = {0.5f * (b.lo + b.hi), t};
-      root_box.grow(b);
-    }
-  }
-  // A leaf holds one run, or up to kLeafTriangles single triangles.
-  const uint32_t leaf_refs = runs ? 1 : kLeafTriangles;
-  const uint32_t max_leaf_refs = runs ? 1 : kMaxLeafTriangles;
-  const auto make_leaf = [&](Node& node, uint32_t begin, uint32_t count) {
-    if (runs) {  // the run's triangles themselves
-      const uint32_t r = refs[begin].item;
-      node.first = run_first[r];
-      node.count = run_first[r + 1] - run_first[r];
-    } else {
-      node.first = begin;
-      node.count = count;
-    }
-  };
-  // A binary tree over n references has at most 2n - 1 nodes: reserved, it never reallocates (a
+  // A binary tree over n triangles has at most 2n - 1 nodes: reserved, it never reallocates (a
   // doubling held both copies at once); pages never written cost no memory.
-  bvh.nodes_.reserve(2 * refs.size() - 1);
+  bvh.nodes_.reserve(2 * tri_count - 1);
   bvh.nodes_.push_back({root_box.lo, 0, root_box.hi, 0});
 
-  std::vector<BuildTask> tasks{{0, 0, static_cast<uint32_t>(refs.size()), 0}};
+  std::vector<BuildTask> tasks{{0, 0, static_cast<uint32_t>(tri_count), 0}};
   struct Bin {
     Aabb box;
     uint32_t count = 0;
@@ -197,8 +132,9 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     const uint32_t count = task.end - task.begin;
     Node& node = bvh.nodes_[task.node];
     const Aabb node_box{node.lo, node.hi};
-    if (count <= leaf_refs) {
-      make_leaf(node, task.begin, count);
+    if (count <= kLeafTriangles) {
+      node.first = task.begin;
+      node.count = count;
       continue;
     }
     Aabb centroids;
@@ -213,7 +149,7 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     Bin axis_bins[3][kBins];
     if (task.depth < kMaxSahDepth) {
       for (uint32_t i = task.begin; i < task.end; ++i) {
-        const Aabb box = bounds(refs[i]);
+        const Aabb box = bounds(refs[i].triangle);
         for (int axis = 0; axis < 3; ++axis) {
           if (!binnable(extent[axis])) continue;
           const int b = bin_of(refs[i].centroid(axis), centroids.lo[axis], extent[axis]);
@@ -250,8 +186,9 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
         }
       }
       const float leaf_cost = node_box.half_area() * static_cast<float>(count);
-      if (count <= max_leaf_refs && !(best_cost < leaf_cost)) {
-        make_leaf(node, task.begin, count);
+      if (count <= kMaxLeafTriangles && !(best_cost < leaf_cost)) {
+        node.first = task.begin;
+        node.count = count;
         continue;
       }
     }
@@ -278,11 +215,11 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
       std::nth_element(refs.data() + task.begin, refs.data() + mid, refs.data() + task.end,
                        [axis](const Ref& a, const Ref& b) {
                          return a.centroid(axis) < b.centroid(axis) ||
-                                (a.centroid(axis) == b.centroid(axis) && a.item < b.item);
+                                (a.centroid(axis) == b.centroid(axis) && a.triangle < b.triangle);
                        });
       left_box = right_box = Aabb{};
-      for (uint32_t i = task.begin; i < mid; ++i) left_box.grow(bounds(refs[i]));
-      for (uint32_t i = mid; i < task.end; ++i) right_box.grow(bounds(refs[i]));
+      for (uint32_t i = task.begin; i < mid; ++i) left_box.grow(bounds(refs[i].triangle));
+      for (uint32_t i = mid; i < task.end; ++i) right_box.grow(bounds(refs[i].triangle));
     }
     const uint32_t left = static_cast<uint32_t>(bvh.nodes_.size());
     bvh.nodes_[task.node].first = left;  // `node` may dangle once the vector grows
@@ -292,10 +229,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     tasks.push_back({left + 1, mid, task.end, task.depth + 1});
     tasks.push_back({left, task.begin, mid, task.depth + 1});
   }
-  if (!runs) {
-    bvh.order_.resize(tri_count);
-    for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].item;
-  }
+  bvh.order_.resize(tri_count);
+  for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
   refs = std::vector<Ref>();  // before the nodes' copy to their size
   bvh.nodes_.shrink_to_fit();
   *out = std::move(bvh);
@@ -314,9 +249,6 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
   const auto holds = [&](const Node& n) {
     return x >= n.lo.x && x <= n.hi.x && z >= n.lo.z && z <= n.hi.z;
   };
-  // Every leaf that may hold the point is searched: where several triangles do (on their shared
-  // edge), the lowest index is the answer, whatever the leaves.
-  uint32_t found = UINT32_MAX;
   uint32_t stack[kStackSize];
   int top = 0;
   if (!holds(nodes_[0])) return UINT32_MAX;
@@ -329,7 +261,7 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
       continue;
     }
     for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-      const uint32_t tri = leaf_triangle(i);
+      const uint32_t tri = order_[i];
       const glm::vec3& a = positions_[triangle_vertex(tri, 0)];
       const glm::vec3& b = positions_[triangle_vertex(tri, 1)];
       const glm::vec3& c = positions_[triangle_vertex(tri, 2)];
@@ -341,13 +273,13 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
       const double v = (px * e1z - e1x * pz) / det;
       const double w = (e0x * pz - px * e0z) / det;
       const double u = 1.0 - v - w;
-      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance && tri < found) {
-        found = tri;
+      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance) {
         *weights = glm::clamp(glm::dvec3(u, v, w), 0.0, 1.0);
+        return tri;
       }
     }
   }
-  return found;
+  return UINT32_MAX;
 }
 
 template <bool kAnyHit>
@@ -380,7 +312,7 @@ bool TriangleBvh::trace(const glm::vec3& origin, const glm::vec3& direction, flo
     const Node& n = nodes_[stack[--top]];
     if (n.count > 0) {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-        const uint32_t tri = leaf_triangle(i);
+        const uint32_t tri = order_[i];
         const glm::vec3& v0 = positions_[triangle_vertex(tri, 0)];
         const glm::vec3 e1 = positions_[triangle_vertex(tri, 1)] - v0;
         const glm::vec3 e2 = positions_[triangle_vertex(tri, 2)] - v0;
@@ -450,7 +382,7 @@ void TriangleBvh::append_vertices_in(const XzBox& box, std::vector<uint32_t>* ou
     }
     for (uint32_t i = n.first; i < n.first + n.count; ++i) {
       for (int k = 0; k < 3; ++k) {
-        const uint32_t v = triangle_vertex(leaf_triangle(i), k);
+        const uint32_t v = triangle_vertex(order_[i], k);
         if (box.holds(positions_[v])) out->push_back(v);
       }
     }
@@ -480,7 +412,7 @@ uint32_t TriangleBvh::nearest_vertex(const glm::vec3& p, float radius,
     if (n.count > 0) {
       for (uint32_t i = n.first; i < n.first + n.count; ++i) {
         for (int k = 0; k < 3; ++k) {
-          const uint32_t v = triangle_vertex(leaf_triangle(i), k);
+          const uint32_t v = triangle_vertex(order_[i], k);
           const float d2 = distance2(p, positions_[v]);
           if (d2 <= r2 && (d2 < best_d2 || (d2 == best_d2 && v < best_v))) {
             best_d2 = d2;

@@ -22,20 +22,6 @@ struct RayHit {
   glm::vec3 position{0.0f};
 };
 
-// What a leaf of the hierarchy holds.
-enum class BvhLeaves {
-  // Up to 16 triangles near each other, found by the build (an order of its own, 4 bytes a
-  // triangle).
-  kSpatial,
-  // A run of up to 16 consecutive triangles of the mesh, ending where a row of its quads does,
-  // where the mesh is laid out along itself (a river's sections one after the other): no order
-  // to keep (a 100 km river's hierarchy takes 14.9 MB against 26), and the build sorts a
-  // twelfth of the references. A mesh whose runs are short (shuffled, or thin quads across a
-  // sharp bend) gets kSpatial leaves. A row's runs slow the sight lines over a terrain: this is
-  // for a river's surface.
-  kMeshRuns,
-};
-
 class TriangleBvh {
  public:
   // `indices` holds 3 vertex indices per triangle; when empty, every 3 positions are a triangle.
@@ -44,12 +30,10 @@ class TriangleBvh {
   // position outside the world (siviflow/sim/world_limits.h), or more triangles than 32-bit
   // indices address.
   // Messages name the fields after `mesh_name` ("RiverFlowField::positions[3] is not finite").
-  // `leaves`: what a leaf holds; the queries answer the same with either.
   static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                      TriangleBvh* out, std::string_view mesh_name = "RiverFlowField",
-                      BvhLeaves leaves = BvhLeaves::kSpatial);
+                      TriangleBvh* out, std::string_view mesh_name = "RiverFlowField");
 
-  size_t triangle_count() const { return triangle_count_; }
+  size_t triangle_count() const { return order_.size(); }
   std::span<const glm::vec3> positions() const { return positions_; }
   std::span<const uint32_t> indices() const { return indices_; }
   uint32_t triangle_vertex(uint32_t triangle, int corner) const {
@@ -68,10 +52,9 @@ class TriangleBvh {
   bool any_hit(const glm::vec3& origin, const glm::vec3& direction, float t_min,
                float t_max) const;
 
-  // The triangle whose projection on the XZ plane holds (x, z) (the lowest index where several
-  // do, on their shared edge: the same whatever the leaves), with its barycentric weights;
-  // UINT32_MAX when none does. In doubles: far from the origin a float difference would lose the
-  // centimetres.
+  // The triangle whose projection on the XZ plane holds (x, z) (the first the traversal meets
+  // where several do: the same every time), with its barycentric weights; UINT32_MAX when none
+  // does. In doubles: far from the origin a float difference would lose the centimetres.
   uint32_t locate_xz(double x, double z, glm::dvec3* weights) const;
 
   // The vertex nearest to `p` (ties: the lower index) among the vertices within `radius` of it;
@@ -85,7 +68,7 @@ class TriangleBvh {
  private:
   struct Node {
     glm::vec3 lo;
-    uint32_t first;  // leaf: first entry of order_ (or triangle); inner: the left child (right +1)
+    uint32_t first;  // leaf: first entry of order_; inner: index of the left child (right = +1)
     glm::vec3 hi;
     uint32_t count;  // leaf: triangle count (> 0); inner: 0
   };
@@ -93,15 +76,11 @@ class TriangleBvh {
   template <bool kAnyHit>
   bool trace(const glm::vec3& origin, const glm::vec3& direction, float t_min, float t_max,
              RayHit* hit) const;
-  // The triangle at entry i of a leaf.
-  uint32_t leaf_triangle(uint32_t i) const { return order_.empty() ? i : order_[i]; }
 
   std::span<const glm::vec3> positions_;
   std::span<const uint32_t> indices_;
   std::vector<Node> nodes_;
-  // Triangle indices, leaf by leaf; empty when the leaves are runs of the mesh's own order.
-  std::vector<uint32_t> order_;
-  size_t triangle_count_ = 0;
+  std::vector<uint32_t> order_;  // triangle indices, leaf by leaf
 };
 
 // Squared distance, written once so every caller (and test) rounds the same way.
