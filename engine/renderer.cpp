@@ -258,6 +258,7 @@ Status Renderer::Impl::create_view_resources() {
   config.with_aovs = (info.readback_images & kAovReadbackImages) != 0;
   config.with_floor = info.enable_timing && info.measure_flow_floor;
   config.with_depth = info.write_depth;
+  config.material = look.material;
   return flow_pass.create(gpu, info.pipeline_cache, config);
 }
 

@@ -76,12 +76,11 @@ Status FlowPass::create(const GpuContext& gpu, VkPipelineCache cache, const Conf
   desc.alpha_blend = true;
   desc.bindings = {{0, sizeof(float) * 3, VK_VERTEX_INPUT_RATE_VERTEX}};
   desc.attributes = {{SIVIFLOW_ATTR_POSITION, 0, VK_FORMAT_R32G32B32_SFLOAT, 0}};
-  for (uint32_t material = 0; material < kWaterMaterialCount; ++material) {
-    for (uint32_t debug_views = 0; debug_views < 2; ++debug_views) {
-      desc.fragment_constants = {material, debug_views};
-      SIVIFLOW_TRY(create_graphics_pipeline(gpu, cache, desc, &pipelines_[material][debug_views]));
-    }
-  }
+  cache_ = cache;
+  material_desc_ = desc;
+  // Each pipeline holds its compiled shaders (on lavapipe about 2 MB): the first frame's is made
+  // now, a material or debug view switched to later when a frame first draws with it.
+  SIVIFLOW_TRY(ensure_material_pipeline(gpu, config.material, false));
   SIVIFLOW_TRY(create_layouts(gpu, kTileBindings, VK_SHADER_STAGE_COMPUTE_BIT,
                               sizeof(gpu::FlowTileConstants), &tiles_set_layout_, &tiles_layout_));
   SIVIFLOW_TRY(
@@ -209,7 +208,18 @@ Status FlowPass::bind_textures(const GpuContext& gpu, const Textures& textures,
   return Status::success();
 }
 
-void FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
+Status FlowPass::ensure_material_pipeline(const GpuContext& gpu, WaterMaterial material,
+                                          bool debug_views) {
+  const auto m = static_cast<uint32_t>(material);
+  VkPipeline* pipeline = &pipelines_[m][debug_views ? 1 : 0];
+  if (*pipeline != VK_NULL_HANDLE) return Status::success();
+  GraphicsPipelineDesc desc = material_desc_;
+  desc.fragment_constants = {m, debug_views ? 1u : 0u};
+  return create_graphics_pipeline(gpu, cache_, desc, pipeline);
+}
+
+Status FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
+  SIVIFLOW_TRY(ensure_material_pipeline(gpu, frame.material, frame.debug_view != DebugView::kNone));
   // The slot's previous frame is done (the host waited on it), so its set and its look block
   // may change; host-coherent writes are visible to the commands submitted after them.
   std::memcpy(static_cast<std::byte*>(look_buffer_.mapped) + kLookStride * frame.slot, &frame.look,
@@ -223,6 +233,7 @@ void FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
   w.descriptorType = kMaterialBindings[kHostDepthBinding];
   w.pImageInfo = &image;
   gpu.table->vkUpdateDescriptorSets(gpu.table->device, 1, &w, 0, nullptr);
+  return Status::success();
 }
 
 void FlowPass::declare(FrameGraph& graph, Handles* handles) {

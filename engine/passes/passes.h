@@ -15,6 +15,7 @@
 #include "vk/frame_graph.h"
 #include "vk/frame_ring.h"
 #include "vk/gpu_resources.h"
+#include "vk/pipeline.h"
 
 namespace siviflow {
 
@@ -104,6 +105,9 @@ class FlowPass {
     bool with_aovs = false;
     bool with_floor = false;  // the bench's floor pipeline (declare_floor)
     bool with_depth = false;  // the surface's depth pipeline (declare_depth)
+    // The material whose pipeline is compiled at create; the others, and the debug views', when
+    // a frame first draws with them (prepare_frame).
+    WaterMaterial material = WaterMaterial::kTiledDirectionalFlow;
   };
   // One material descriptor set per frame slot (the host's depth changes per frame).
   Status create(const GpuContext& gpu, VkPipelineCache cache, const Config& config);
@@ -141,9 +145,10 @@ class FlowPass {
     // The runs of the river's indices the view can see: the water, depth and floor draw them.
     const std::vector<IndexRange>* draws = nullptr;
   };
-  // Before recording a frame: points the slot's descriptor set at the frame's host depth and
+  // Before recording a frame: compiles the pipeline of the frame's material and debug view if no
+  // frame drew with them yet, points the slot's descriptor set at the frame's host depth and
   // writes its look block.
-  void prepare_frame(const GpuContext& gpu, const Frame& frame);
+  Status prepare_frame(const GpuContext& gpu, const Frame& frame);
   // Where the declared passes read the frame when the graph executes (bind it every execute).
   DataHandle<Frame> frame_data() const { return frame_data_; }
 
@@ -180,6 +185,7 @@ class FlowPass {
 
  private:
   void draw_river(const PassContext& ctx, VkPipeline pipeline, const Handles& h) const;
+  Status ensure_material_pipeline(const GpuContext& gpu, WaterMaterial material, bool debug_views);
 
   Config config_;
   DataHandle<Frame> frame_data_;  // declared by declare_tiles, in the graph of the passes
@@ -187,8 +193,11 @@ class FlowPass {
   VkPipeline depth_pipeline_ = VK_NULL_HANDLE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  // The material's pipelines: per WaterMaterial, without and with the debug views.
+  // The material's pipelines: per WaterMaterial, without and with the debug views (null until
+  // a frame needs one), and what they are made from.
   VkPipeline pipelines_[kWaterMaterialCount][2] = {};
+  GraphicsPipelineDesc material_desc_;
+  VkPipelineCache cache_ = VK_NULL_HANDLE;
   VkPipeline tiles_pipeline_ = VK_NULL_HANDLE;  // compute, with a layout and set of its own
   VkDescriptorSetLayout tiles_set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout tiles_layout_ = VK_NULL_HANDLE;

@@ -407,10 +407,12 @@ class Renderer {
   Status set_occluders(const OccluderMesh& mesh);
 
   // The water's look from the next update() on. A field out of its range (water_look.h) is an
-  // error naming it and its value, and the look stays as it was.
+  // error naming it and its value, and the look stays as it was. A material no frame drew with
+  // yet has its pipeline compiled by the next record() (create() compiles the starting one's).
   Status set_look(const WaterLook& look);
   const WaterLook& look() const;
-  // The debug view from the next update() on; a value out of the enum is an error.
+  // The debug view from the next update() on; a value out of the enum is an error. The first
+  // frame with a debug view compiles its pipeline in record().
   Status set_debug_view(DebugView view);
   DebugView debug_view() const;
 
