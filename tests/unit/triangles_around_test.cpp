@@ -42,7 +42,21 @@ TEST(TrianglesAround, AStripHoldsItsListsInTwoBytesATriangle) {
   const TrianglesAround around = TrianglesAround::of_mesh(mesh.positions.size(), mesh.indices);
   EXPECT_TRUE(around.compact());
   expect_lists(around, plain_lists(mesh.positions.size(), mesh.indices));
-  EXPECT_LE(around.memory_bytes(), 4 * (mesh.positions.size() + 1) + 2 * mesh.indices.size());
+  // And each vertex's start in 2 bytes, from its block of 256 vertices' start.
+  const size_t blocks = mesh.positions.size() / 256 + 1;
+  EXPECT_LE(around.memory_bytes(),
+            2 * (mesh.positions.size() + 1) + 4 * blocks + 2 * mesh.indices.size());
+}
+
+// A fan of 70000 triangles about vertex 0: its block of vertices spans more corners than 2 bytes
+// count, so the starts keep 4 bytes a vertex, and the lists are the same.
+TEST(TrianglesAround, AVertexOfTooManyTrianglesKeepsFourByteStarts) {
+  constexpr uint32_t kFan = 70000;
+  std::vector<uint32_t> indices;
+  for (uint32_t i = 1; i <= kFan; ++i) indices.insert(indices.end(), {0, i, i + 1});
+  const TrianglesAround around = TrianglesAround::of_mesh(kFan + 2, indices);
+  expect_lists(around, plain_lists(kFan + 2, indices));
+  EXPECT_GE(around.memory_bytes(), 4 * size_t{kFan + 3});
 }
 
 TEST(TrianglesAround, AShuffledMeshKeepsFourBytesATriangleAndTheSameLists) {

@@ -77,10 +77,10 @@ class TrianglesAround {
   // when every 3 vertices are a triangle. Every index must be below `vertex_count`.
   static TrianglesAround of_mesh(size_t vertex_count, std::span<const uint32_t> indices);
 
-  size_t vertex_count() const { return start_.empty() ? 0 : start_.size() - 1; }
+  size_t vertex_count() const { return vertex_count_; }
   size_t triangle_count() const { return triangle_count_; }
   Range of(uint32_t v) const {
-    const size_t first = start_[v], size = start_[v + 1] - first;
+    const size_t first = start(v), size = start(size_t{v} + 1) - first;
     return offsets_.empty() ? Range(nullptr, triangles_.data() + first, size, 0)
                             : Range(offsets_.data() + first, nullptr, size, anchor(v));
   }
@@ -92,8 +92,19 @@ class TrianglesAround {
   int64_t anchor(uint32_t v) const {
     return static_cast<int64_t>(uint64_t{v} * triangle_count_ / vertex_count());
   }
+  // Where vertex v's triangles start in the lists (v = vertex_count(): their end).
+  size_t start(size_t v) const {
+    return start_.empty() ? size_t{block_start_[v >> kBlockShift]} + start_in_block_[v] : start_[v];
+  }
+  // Where each vertex's triangles start, in 2 bytes a vertex: from its block of 256 vertices'
+  // start. A block whose vertices have more than 65535 triangle corners keeps 4 bytes a vertex.
+  static constexpr size_t kBlockShift = 8;
+  void compact_starts(std::vector<uint32_t>* starts);
 
-  std::vector<uint32_t> start_;
+  size_t vertex_count_ = 0;
+  std::vector<uint32_t> block_start_;     // per block of vertices 0..vertex_count()
+  std::vector<uint16_t> start_in_block_;  // per vertex and the end
+  std::vector<uint32_t> start_;           // only where the blocks' do not fit
   std::vector<int16_t> offsets_;
   std::vector<uint32_t> triangles_;  // only when not compact
   uint64_t triangle_count_ = 0;
