@@ -418,6 +418,7 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
   s.triangles_ = std::move(w.tris);
   s.node_triangles_ = std::move(w.node_tris);
   s.extent_ = static_cast<float>(extent);
+  s.drop_section_list_of_runs();
   *out = std::move(s);
   return Status::success();
 }

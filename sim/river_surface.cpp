@@ -148,6 +148,20 @@ size_t RiverSurface::memory_bytes() const {
          bytes(bank_nodes_);
 }
 
+void RiverSurface::drop_section_list_of_runs() {
+  bool ascending = true, descending = true;
+  for (const RiverSection& sec : sections_) {
+    for (uint32_t i = 0; i < sec.node_count && (ascending || descending); ++i) {
+      const uint32_t n = section_nodes_[sec.first_node + i];
+      ascending = ascending && n == sec.first_node + i;
+      descending = descending && n == sec.first_node + sec.node_count - 1 - i;
+    }
+  }
+  if (!ascending && !descending) return;
+  section_step_ = ascending ? 1 : -1;
+  section_nodes_ = std::vector<uint32_t>();
+}
+
 Status RiverSurface::share_mesh(std::span<const glm::vec3> positions,
                                std::span<const uint32_t> triangles) {
   const std::span<const glm::vec3> own_positions = node_positions();
@@ -763,6 +777,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   s.triangles_ = std::move(tris);
   s.node_triangles_ = std::move(node_tris);
   s.extent_ = static_cast<float>(extent);
+  s.drop_section_list_of_runs();
   *out = std::move(s);
   return Status::success();
 }

@@ -62,6 +62,36 @@ TEST(RiverSurface, StraightChannelSectionsBanksAndDistances) {
   }
 }
 
+// A strip numbered section after section keeps no list of its sections' nodes (4 bytes a node):
+// each section is a run of consecutive nodes. Shuffled, it keeps the list, and the sections hold
+// the same nodes, left to right.
+TEST(RiverSurface, ASectionAfterSectionStripKeepsNoListOfItsSectionsNodes) {
+  for (const bool mirrored : {false, true}) {
+    TestMesh m = test::straight_channel(10.0f, 40.0f, 21, 7);
+    if (mirrored) {  // the nodes then run from the right shore to the left across each section
+      for (glm::vec3& p : m.positions) p.x = -p.x;
+    }
+    std::vector<uint32_t> new_of_old;
+    const TestMesh mixed = test::shuffled(m, 3, &new_of_old);
+    RiverSurface runs, listed;
+    ASSERT_TRUE(build(m, &runs).ok());
+    ASSERT_TRUE(build(mixed, &listed).ok());
+    EXPECT_GE(listed.memory_bytes(), runs.memory_bytes() + 4 * runs.node_count());
+    ASSERT_EQ(runs.sections().size(), listed.sections().size());
+    for (size_t k = 0; k < runs.sections().size(); ++k) {
+      const SectionNodes a = runs.section_nodes(k), b = listed.section_nodes(k);
+      ASSERT_EQ(a.size(), b.size());
+      for (size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(new_of_old[a[i]], b[i]) << "section " << k << ", node " << i;
+        EXPECT_EQ(runs.node_section()[a[i]], k);
+      }
+      EXPECT_EQ(std::vector<uint32_t>(a.begin(), a.end()).size(), a.size());
+      EXPECT_EQ(runs.node_bank()[a.front()], Bank::kLeft);
+      EXPECT_EQ(runs.node_bank()[a.back()], Bank::kRight);
+    }
+  }
+}
+
 TEST(RiverSurface, UpstreamEndFollowsVertexZero) {
   // Vertex 0 at the z = 40 end: the river now flows along -Z, and the left bank is at -X.
   TestMesh m = test::straight_channel(10.0f, 40.0f, 11, 4);

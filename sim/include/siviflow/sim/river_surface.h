@@ -22,8 +22,10 @@
 // the welded "nodes" and every input vertex reads its node's data.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <span>
 #include <vector>
 
@@ -61,9 +63,63 @@ struct RiverSurfaceOptions {
   std::function<void(bool welded)> inputs_read;
 };
 
+// The nodes of one section, from the left shore to the right shore: a run of the surface's list,
+// or, where the surface numbers its nodes section after section, consecutive nodes (either way
+// round), which a long river then keeps no list of. Its iterators stand alone.
+class SectionNodes {
+ public:
+  class Iterator {
+   public:
+    using iterator_category = std::forward_iterator_tag;
+    using value_type = uint32_t;
+    using difference_type = std::ptrdiff_t;
+    using pointer = void;
+    using reference = uint32_t;
+
+    Iterator() = default;
+    Iterator(const uint32_t* list, int64_t first, int step, size_t i)
+        : list_(list), first_(first), step_(step), i_(i) {}
+    uint32_t operator*() const {
+      return list_ != nullptr ? list_[i_] : static_cast<uint32_t>(first_ + step_ * int64_t(i_));
+    }
+    Iterator& operator++() {
+      ++i_;
+      return *this;
+    }
+    Iterator operator++(int) {
+      const Iterator before = *this;
+      ++i_;
+      return before;
+    }
+    bool operator==(const Iterator& other) const = default;
+
+   private:
+    const uint32_t* list_ = nullptr;
+    int64_t first_ = 0;
+    int step_ = 0;
+    size_t i_ = 0;
+  };
+
+  // `size` nodes listed at `list`, or (list null) first, first + step, ... (step +1 or -1).
+  SectionNodes(const uint32_t* list, int64_t first, int step, size_t size)
+      : list_(list), first_(first), step_(step), size_(size) {}
+  uint32_t operator[](size_t i) const { return *Iterator(list_, first_, step_, i); }
+  size_t size() const { return size_; }
+  uint32_t front() const { return (*this)[0]; }
+  uint32_t back() const { return (*this)[size_ - 1]; }
+  Iterator begin() const { return {list_, first_, step_, 0}; }
+  Iterator end() const { return {list_, first_, step_, size_}; }
+
+ private:
+  const uint32_t* list_;
+  int64_t first_;
+  int step_;
+  size_t size_;
+};
+
 // One cross-section of the river, from the left shore to the right shore.
 struct RiverSection {
-  uint32_t first_node = 0;  // offset into RiverSurface::section_nodes()
+  uint32_t first_node = 0;  // offset into the surface's nodes listed section by section
   uint32_t node_count = 0;  // >= 2: the left shore, interior vertices, the right shore
   float width = 0.0f;       // length of the section polyline, metres
   float along = 0.0f;       // distance of the shore midpoint from the upstream end, along the river
@@ -209,8 +265,11 @@ class RiverSurface {
 
   std::span<const RiverSection> sections() const { return sections_; }
   // Nodes of section k, from the left shore to the right shore.
-  std::span<const uint32_t> section_nodes(size_t k) const {
-    return {section_nodes_.data() + sections_[k].first_node, sections_[k].node_count};
+  SectionNodes section_nodes(size_t k) const {
+    const RiverSection& sec = sections_[k];
+    if (section_step_ == 0) return {section_nodes_.data() + sec.first_node, 0, 0, sec.node_count};
+    const int64_t first = section_step_ > 0 ? sec.first_node : sec.first_node + sec.node_count - 1;
+    return {nullptr, first, section_step_, sec.node_count};
   }
   float widest_section() const { return widest_; }
   // Length of the bounding-box diagonal: the scale the geometric tolerances are relative to.
@@ -236,6 +295,9 @@ class RiverSurface {
                       const std::vector<uint32_t>& node_island,
                       const std::vector<uint32_t>& node_vertex, size_t section, double min_arm,
                       double* width);
+  // Once built: frees the list of the sections' nodes where every section is a run of
+  // consecutive nodes, all ascending or all descending (section_step_).
+  void drop_section_list_of_runs();
 
   std::vector<uint32_t> node_of_vertex_;  // both empty when nothing was welded
   std::vector<uint32_t> node_vertex_;
@@ -247,7 +309,8 @@ class RiverSurface {
   std::vector<uint32_t> triangles_;
   TrianglesAround node_triangles_;
   std::vector<RiverSection> sections_;
-  std::vector<uint32_t> section_nodes_;
+  std::vector<uint32_t> section_nodes_;  // empty where the sections are runs
+  int section_step_ = 0;                 // runs' step: +1, -1; 0: listed
   // Only with islands: the border on each side of every node, and the islands' shores.
   std::vector<BorderId> node_left_border_;
   std::vector<BorderId> node_right_border_;
