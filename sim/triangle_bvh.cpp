@@ -12,12 +12,12 @@
 namespace siviflow {
 namespace {
 
-// Binned SAH, split down to leaves of 16 triangles: a 100 km river's hierarchy takes 26 MB (40
-// with 8, 64 with 4); the particles' ray casts of a frame take 2-3 % longer than with 8 (0.50
-// against 0.49 ms at 1280x720).
+// Binned SAH, split down to leaves of 16 triangles: a 100 km river's hierarchy takes 21 MB with
+// its order in 2 bytes a triangle (26 in 4, 40 with leaves of 8, 64 with 4); the particles' ray
+// casts of a frame take 2-3 % longer than with 8 (0.50 against 0.49 ms at 1280x720).
 constexpr uint32_t kLeafTriangles = 16;
 // A node stays a leaf up to this size when splitting would not pay (SAH).
-constexpr uint32_t kMaxLeafTriangles = 32;
+constexpr uint32_t kMaxLeafTriangles = 32;  // a leaf's count is a byte (Node::leaf)
 constexpr int kBins = 16;
 // Below this depth splits fall back to the object median, so the traversal stack is bounded.
 constexpr int kMaxSahDepth = 40;
@@ -134,7 +134,7 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     const Aabb node_box{node.lo, node.hi};
     if (count <= kLeafTriangles) {
       node.first = task.begin;
-      node.count = count;
+      node.leaf = count;
       continue;
     }
     Aabb centroids;
@@ -188,7 +188,7 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
       const float leaf_cost = node_box.half_area() * static_cast<float>(count);
       if (count <= kMaxLeafTriangles && !(best_cost < leaf_cost)) {
         node.first = task.begin;
-        node.count = count;
+        node.leaf = count;
         continue;
       }
     }
@@ -223,14 +223,39 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     }
     const uint32_t left = static_cast<uint32_t>(bvh.nodes_.size());
     bvh.nodes_[task.node].first = left;  // `node` may dangle once the vector grows
-    bvh.nodes_[task.node].count = 0;
+    bvh.nodes_[task.node].leaf = 0;
     bvh.nodes_.push_back({left_box.lo, 0, left_box.hi, 0});
     bvh.nodes_.push_back({right_box.lo, 0, right_box.hi, 0});
     tasks.push_back({left + 1, mid, task.end, task.depth + 1});
     tasks.push_back({left, task.begin, mid, task.depth + 1});
   }
-  bvh.order_.resize(tri_count);
-  for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
+  // The order in 2 bytes an entry, from each leaf's lowest triangle down to a multiple of 256,
+  // where every leaf's triangles lie within 65536 of that; else in 4.
+  bool compact = true;
+  for (const Node& n : bvh.nodes_) {
+    if (n.leaf == 0) continue;
+    uint32_t lo = UINT32_MAX, hi = 0;
+    for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
+      lo = std::min(lo, refs[i].triangle);
+      hi = std::max(hi, refs[i].triangle);
+    }
+    compact = compact && hi - (lo & ~0xffu) <= std::numeric_limits<uint16_t>::max();
+  }
+  if (compact) {
+    bvh.order16_.resize(tri_count);
+    for (Node& n : bvh.nodes_) {
+      if (n.leaf == 0) continue;
+      uint32_t lo = UINT32_MAX;
+      for (uint32_t i = n.first; i < n.first + size_of(n); ++i) lo = std::min(lo, refs[i].triangle);
+      n.leaf = (lo & ~0xffu) | size_of(n);
+      for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
+        bvh.order16_[i] = static_cast<uint16_t>(refs[i].triangle - (lo & ~0xffu));
+      }
+    }
+  } else {
+    bvh.order_.resize(tri_count);
+    for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
+  }
   refs = std::vector<Ref>();  // before the nodes' copy to their size
   bvh.nodes_.shrink_to_fit();
   *out = std::move(bvh);
@@ -238,7 +263,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
 }
 
 size_t TriangleBvh::memory_bytes() const {
-  return nodes_.capacity() * sizeof(Node) + order_.capacity() * sizeof(uint32_t);
+  return nodes_.capacity() * sizeof(Node) + order16_.capacity() * sizeof(uint16_t) +
+         order_.capacity() * sizeof(uint32_t);
 }
 
 uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
@@ -255,13 +281,13 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
   stack[top++] = 0;
   while (top > 0) {
     const Node& n = nodes_[stack[--top]];
-    if (n.count == 0) {  // the left child is searched first
+    if (n.leaf == 0) {  // the left child is searched first
       if (holds(nodes_[n.first + 1])) stack[top++] = n.first + 1;
       if (holds(nodes_[n.first])) stack[top++] = n.first;
       continue;
     }
-    for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-      const uint32_t tri = order_[i];
+    for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
+      const uint32_t tri = triangle_at(n, i);
       const glm::vec3& a = positions_[triangle_vertex(tri, 0)];
       const glm::vec3& b = positions_[triangle_vertex(tri, 1)];
       const glm::vec3& c = positions_[triangle_vertex(tri, 2)];
@@ -310,9 +336,9 @@ bool TriangleBvh::trace(const glm::vec3& origin, const glm::vec3& direction, flo
   stack[top++] = 0;
   while (top > 0) {
     const Node& n = nodes_[stack[--top]];
-    if (n.count > 0) {
-      for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-        const uint32_t tri = order_[i];
+    if (n.leaf != 0) {
+      for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
+        const uint32_t tri = triangle_at(n, i);
         const glm::vec3& v0 = positions_[triangle_vertex(tri, 0)];
         const glm::vec3 e1 = positions_[triangle_vertex(tri, 1)] - v0;
         const glm::vec3 e2 = positions_[triangle_vertex(tri, 2)] - v0;
@@ -375,14 +401,14 @@ void TriangleBvh::append_vertices_in(const XzBox& box, std::vector<uint32_t>* ou
   if (meets(nodes_[0])) stack[top++] = 0;
   while (top > 0) {
     const Node& n = nodes_[stack[--top]];
-    if (n.count == 0) {
+    if (n.leaf == 0) {
       if (meets(nodes_[n.first + 1])) stack[top++] = n.first + 1;
       if (meets(nodes_[n.first])) stack[top++] = n.first;
       continue;
     }
-    for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+    for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
       for (int k = 0; k < 3; ++k) {
-        const uint32_t v = triangle_vertex(order_[i], k);
+        const uint32_t v = triangle_vertex(triangle_at(n, i), k);
         if (box.holds(positions_[v])) out->push_back(v);
       }
     }
@@ -409,10 +435,10 @@ uint32_t TriangleBvh::nearest_vertex(const glm::vec3& p, float radius,
   while (top > 0) {
     const Node& n = nodes_[stack[--top]];
     if (box_distance2(n.lo, n.hi, p) > std::min(best_d2, r2)) continue;
-    if (n.count > 0) {
-      for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+    if (n.leaf != 0) {
+      for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
         for (int k = 0; k < 3; ++k) {
-          const uint32_t v = triangle_vertex(order_[i], k);
+          const uint32_t v = triangle_vertex(triangle_at(n, i), k);
           const float d2 = distance2(p, positions_[v]);
           if (d2 <= r2 && (d2 < best_d2 || (d2 == best_d2 && v < best_v))) {
             best_d2 = d2;

@@ -33,7 +33,7 @@ class TriangleBvh {
   static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                       TriangleBvh* out, std::string_view mesh_name = "RiverFlowField");
 
-  size_t triangle_count() const { return order_.size(); }
+  size_t triangle_count() const { return order16_.empty() ? order_.size() : order16_.size(); }
   std::span<const glm::vec3> positions() const { return positions_; }
   std::span<const uint32_t> indices() const { return indices_; }
   uint32_t triangle_vertex(uint32_t triangle, int corner) const {
@@ -68,11 +68,18 @@ class TriangleBvh {
  private:
   struct Node {
     glm::vec3 lo;
-    uint32_t first;  // leaf: first entry of order_; inner: index of the left child (right = +1)
+    uint32_t first;  // leaf: first entry of the order; inner: index of the left child (right = +1)
     glm::vec3 hi;
-    uint32_t count;  // leaf: triangle count (> 0); inner: 0
+    // Inner: 0. Leaf: its triangle count in the low byte (> 0); with the 16-bit order, the rest
+    // is the base its entries add to (a multiple of 256).
+    uint32_t leaf;
   };
   static_assert(sizeof(Node) == 32);
+  static uint32_t size_of(const Node& n) { return n.leaf & 0xffu; }
+  // The triangle of entry i of leaf n's order.
+  uint32_t triangle_at(const Node& n, uint32_t i) const {
+    return order16_.empty() ? order_[i] : (n.leaf & ~0xffu) + order16_[i];
+  }
   template <bool kAnyHit>
   bool trace(const glm::vec3& origin, const glm::vec3& direction, float t_min, float t_max,
              RayHit* hit) const;
@@ -80,7 +87,10 @@ class TriangleBvh {
   std::span<const glm::vec3> positions_;
   std::span<const uint32_t> indices_;
   std::vector<Node> nodes_;
-  std::vector<uint32_t> order_;  // triangle indices, leaf by leaf
+  // Triangle indices, leaf by leaf: in 2 bytes each from their leaf's base where every leaf's
+  // fit (a mesh whose triangles near in space are near in number, as a river's), else in 4.
+  std::vector<uint16_t> order16_;
+  std::vector<uint32_t> order_;
 };
 
 // Squared distance, written once so every caller (and test) rounds the same way.
