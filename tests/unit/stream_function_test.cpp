@@ -373,8 +373,9 @@ TEST(StreamFunctionObstacle, BadObstacles) {
 
 // A long river's flow keeps only what a re-solve needs per node and triangle: the obstacle-free
 // psi, the triangles' areas and velocities, node areas and bank tangents are derived when asked
-// (no vertex maps either: the procedural mesh welds nothing). About 81 bytes a node for the
-// surface and 21 for the flow on a 13-vertex-wide strip; they held 89 and 79 before.
+// (no vertex maps either: the procedural mesh welds nothing). About 63 bytes a node for the
+// surface (its lists in 2 bytes an entry, no list of its sections' nodes: 81 before, 89 before
+// that) and 21 for the flow on a 13-vertex-wide strip (79 before).
 TEST(StreamFunctionMemory, KeepsNoBuildOnlyArrays) {
   ProceduralRiverParams params;
   params.length = 2000.0f;
@@ -384,7 +385,7 @@ TEST(StreamFunctionMemory, KeepsNoBuildOnlyArrays) {
   ASSERT_TRUE(RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok());
   const double nodes = static_cast<double>(surface.node_count());
   const double surface_bytes = static_cast<double>(surface.memory_bytes());
-  EXPECT_LE(surface_bytes / nodes, 84.0);
+  EXPECT_LE(surface_bytes / nodes, 65.0);
   StreamFunction flow;
   ASSERT_TRUE(StreamFunction::create(std::move(surface), {20.0f}, &flow).ok());
   EXPECT_LE((static_cast<double>(flow.memory_bytes()) - surface_bytes) / nodes, 24.0);
