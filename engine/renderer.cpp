@@ -579,6 +579,8 @@ Status Renderer::record(VkCommandBuffer cmd, const FrameInputs& inputs) {
     if (!r.frame_begun) return argument_error("record called before begin_frame and update");
     if (!r.frame_updated) return argument_error("record called before update");
     SIVIFLOW_TRY(r.check_inputs(inputs));
+    // A pipeline the frame's material needs is compiled before anything is recorded.
+    SIVIFLOW_TRY(r.flow_pass.prepare_pipeline(r.gpu, r.water_frame));
     StaticAssets& assets = r.river->assets;  // uploaded by the first view of the river to record
     if (!assets.uploaded()) {
       if (!assets.staged()) SIVIFLOW_TRY(assets.stage(r.river->gpu));

@@ -255,7 +255,7 @@ Status Renderer::Impl::bind_frame(const FrameInputs& inputs) {
   water_frame.reverse_z = view.reverse_z;
   water_frame.viewport = viewport;
   water_frame.scissor = scissor;
-  SIVIFLOW_TRY(flow_pass.prepare_frame(gpu, water_frame));
+  flow_pass.prepare_frame(gpu, water_frame);
   // What the passes read as they record: this frame's, through the graph's data handles.
   b.bind_data(flow_pass.frame_data(), &water_frame);
   b.bind_data(uploads_data, &frame_uploads);

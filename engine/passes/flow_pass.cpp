@@ -5,6 +5,7 @@
 #include <span>
 #include <string>
 
+#include "siviflow/water_look.h"
 #include "vk/device_table.h"
 #include "vk/pipeline.h"
 
@@ -215,11 +216,19 @@ Status FlowPass::ensure_material_pipeline(const GpuContext& gpu, WaterMaterial m
   if (*pipeline != VK_NULL_HANDLE) return Status::success();
   GraphicsPipelineDesc desc = material_desc_;
   desc.fragment_constants = {m, debug_views ? 1u : 0u};
-  return create_graphics_pipeline(gpu, cache_, desc, pipeline);
+  const Status made = create_graphics_pipeline(gpu, cache_, desc, pipeline);
+  if (made.ok()) return made;
+  return Status::error(std::string("the pipeline of the water material ") +
+                           water_material_name(material) +
+                           (debug_views ? " with the debug views: " : ": ") + made.message(),
+                       made.code());
 }
 
-Status FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
-  SIVIFLOW_TRY(ensure_material_pipeline(gpu, frame.material, frame.debug_view != DebugView::kNone));
+Status FlowPass::prepare_pipeline(const GpuContext& gpu, const Frame& frame) {
+  return ensure_material_pipeline(gpu, frame.material, frame.debug_view != DebugView::kNone);
+}
+
+void FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
   // The slot's previous frame is done (the host waited on it), so its set and its look block
   // may change; host-coherent writes are visible to the commands submitted after them.
   std::memcpy(static_cast<std::byte*>(look_buffer_.mapped) + kLookStride * frame.slot, &frame.look,
@@ -233,7 +242,6 @@ Status FlowPass::prepare_frame(const GpuContext& gpu, const Frame& frame) {
   w.descriptorType = kMaterialBindings[kHostDepthBinding];
   w.pImageInfo = &image;
   gpu.table->vkUpdateDescriptorSets(gpu.table->device, 1, &w, 0, nullptr);
-  return Status::success();
 }
 
 void FlowPass::declare(FrameGraph& graph, Handles* handles) {

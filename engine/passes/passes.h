@@ -145,10 +145,12 @@ class FlowPass {
     // The runs of the river's indices the view can see: the water, depth and floor draw them.
     const std::vector<IndexRange>* draws = nullptr;
   };
-  // Before recording a frame: compiles the pipeline of the frame's material and debug view if no
-  // frame drew with them yet, points the slot's descriptor set at the frame's host depth and
+  // Before anything of a frame is recorded: compiles the pipeline of its material and debug view
+  // if no frame drew with them yet (a failure leaves none, and the next frame tries again).
+  Status prepare_pipeline(const GpuContext& gpu, const Frame& frame);
+  // Before recording a frame: points the slot's descriptor set at the frame's host depth and
   // writes its look block.
-  Status prepare_frame(const GpuContext& gpu, const Frame& frame);
+  void prepare_frame(const GpuContext& gpu, const Frame& frame);
   // Where the declared passes read the frame when the graph executes (bind it every execute).
   DataHandle<Frame> frame_data() const { return frame_data_; }
 

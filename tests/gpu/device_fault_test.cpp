@@ -166,5 +166,46 @@ TEST_F(DeviceFaultTest, FirstFramesFailCleanlyAndTheNextOnesRender) {
   EXPECT_EQ(faults::state.alive, (std::array<int64_t, faults::kKindCount>{}));
 }
 
+// A material and a debug view switched to after create are compiled by the frame that first draws
+// with them: every watched call of that frame made to fail in turn is reported, and the frame
+// after it renders with them.
+TEST_F(DeviceFaultTest, AMaterialSwitchedToFailsItsFirstFrameCleanlyAndTheNextRenders) {
+  CreateInfo info = watched_info();
+  info.readback_images = 0;
+  HostTargets targets;
+  ASSERT_TRUE(create_sampled_targets({kWidth, kHeight}, &targets).ok());
+  WaterLook look;
+  look.material = WaterMaterial::kFlowMap;
+  int64_t k = 0;
+  for (;; ++k) {
+    renderer_.reset();
+    faults::state.fail_at = -1;
+    ASSERT_TRUE(Renderer::create(info, &renderer_).ok());
+    ASSERT_TRUE(one_frame(*context_, *world_, *renderer_, &targets, 0.0).ok());
+    ASSERT_TRUE(renderer_->set_look(look).ok());
+    ASSERT_TRUE(renderer_->set_debug_view(DebugView::kFlowDirection).ok());
+    fail_at(k);
+    Status status = one_frame(*context_, *world_, *renderer_, &targets, 1 / 30.0);
+    faults::state.fail_at = -1;
+    if (!injected()) {
+      ASSERT_TRUE(status.ok()) << status.message();
+      break;
+    }
+    expect_named_fault(status, "frame", k);
+    if (faults::state.failed_call == "vkCreateGraphicsPipelines") {
+      EXPECT_NE(status.message().find("water material flowmap with the debug views"),
+                std::string::npos)
+          << status.message();
+    }
+    status = one_frame(*context_, *world_, *renderer_, &targets, 2 / 30.0);
+    EXPECT_TRUE(status.ok()) << "the frame after a fault at call " << k << ": " << status.message();
+  }
+  std::printf("switched material's frame: %lld injection points, each reported\n",
+              static_cast<long long>(k));
+  EXPECT_GE(k, 3) << "the frame compiles a pipeline (2 shader modules and the pipeline)";
+  renderer_.reset();
+  EXPECT_EQ(faults::state.alive, (std::array<int64_t, faults::kKindCount>{}));
+}
+
 }  // namespace
 }  // namespace siviflow::testing

@@ -48,8 +48,8 @@ TEST(TrianglesAround, AStripHoldsItsListsInTwoBytesATriangle) {
             2 * (mesh.positions.size() + 1) + 4 * blocks + 2 * mesh.indices.size());
 }
 
-// A fan of 70000 triangles about vertex 0: its block of vertices spans more corners than 2 bytes
-// count, so the starts keep 4 bytes a vertex, and the lists are the same.
+// A fan of 70000 triangles about vertex 0: vertex 1 starts 70000 entries past its block's start,
+// more than 2 bytes count, so every start keeps 4 bytes, and the lists are the same.
 TEST(TrianglesAround, AVertexOfTooManyTrianglesKeepsFourByteStarts) {
   constexpr uint32_t kFan = 70000;
   std::vector<uint32_t> indices;

@@ -161,7 +161,10 @@ struct CreateInfo {
   bool measure_flow_floor = false;
   VkDeviceSize staging_bytes_per_slot = 0;  // per-slot staging block; 0 means 8 MiB
   bool debug_utils = false;            // the host enabled VK_EXT_debug_utils: label passes, name objects
-  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;         // optional
+  // Optional. Used by create() and by a record() that first draws with another material or a
+  // debug view: keep it until the renderer is destroyed, and if it was created
+  // VK_PIPELINE_CACHE_CREATE_EXTERNALLY_SYNCHRONIZED_BIT, use it nowhere else during record().
+  VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
   const VkAllocationCallbacks* allocation_callbacks = nullptr;  // optional
   ReflectionCallback reflection = nullptr;  // optional: the host draws the reflection instead
   void* reflection_user = nullptr;
@@ -408,11 +411,12 @@ class Renderer {
 
   // The water's look from the next update() on. A field out of its range (water_look.h) is an
   // error naming it and its value, and the look stays as it was. A material no frame drew with
-  // yet has its pipeline compiled by the next record() (create() compiles the starting one's).
+  // yet has its pipeline compiled by the next record() (create() compiles the starting one's);
+  // if that fails, record() fails before recording anything, and the next record() tries again.
   Status set_look(const WaterLook& look);
   const WaterLook& look() const;
   // The debug view from the next update() on; a value out of the enum is an error. The first
-  // frame with a debug view compiles its pipeline in record().
+  // frame with a debug view compiles its pipeline in record(), as set_look says.
   Status set_debug_view(DebugView view);
   DebugView debug_view() const;
 

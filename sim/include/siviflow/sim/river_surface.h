@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <functional>
 #include <iterator>
+#include <ranges>
 #include <span>
 #include <vector>
 
@@ -65,7 +66,8 @@ struct RiverSurfaceOptions {
 
 // The nodes of one section, from the left shore to the right shore: a run of the surface's list,
 // or, where the surface numbers its nodes section after section, consecutive nodes (either way
-// round), which a long river then keeps no list of. Its iterators stand alone.
+// round), which a long river then keeps no list of. Its iterators stay valid while the surface
+// does, whatever becomes of the range (a borrowed range).
 class SectionNodes {
  public:
   class Iterator {
@@ -116,6 +118,13 @@ class SectionNodes {
   int step_;
   size_t size_;
 };
+
+}  // namespace siviflow
+
+template <>
+inline constexpr bool std::ranges::enable_borrowed_range<siviflow::SectionNodes> = true;
+
+namespace siviflow {
 
 // One cross-section of the river, from the left shore to the right shore.
 struct RiverSection {

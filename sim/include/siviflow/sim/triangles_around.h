@@ -97,14 +97,15 @@ class TrianglesAround {
     return start_.empty() ? size_t{block_start_[v >> kBlockShift]} + start_in_block_[v] : start_[v];
   }
   // Where each vertex's triangles start, in 2 bytes a vertex: from its block of 256 vertices'
-  // start. A block whose vertices have more than 65535 triangle corners keeps 4 bytes a vertex.
+  // start. If any vertex starts more than 65535 entries past its block's start, every vertex's
+  // start is kept in 4 bytes.
   static constexpr size_t kBlockShift = 8;
   void compact_starts(std::vector<uint32_t>* starts);
 
   size_t vertex_count_ = 0;
   std::vector<uint32_t> block_start_;     // per block of vertices 0..vertex_count()
   std::vector<uint16_t> start_in_block_;  // per vertex and the end
-  std::vector<uint32_t> start_;           // only where the blocks' do not fit
+  std::vector<uint32_t> start_;           // only where the blocks' offsets do not fit
   std::vector<int16_t> offsets_;
   std::vector<uint32_t> triangles_;  // only when not compact
   uint64_t triangle_count_ = 0;
