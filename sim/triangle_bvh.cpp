@@ -231,29 +231,27 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     tasks.push_back({left, task.begin, mid, task.depth + 1});
   }
   // The order in 2 bytes an entry, from each leaf's lowest triangle down to a multiple of 256,
-  // where every leaf's triangles lie within 65536 of that; else in 4.
+  // where every leaf's triangles lie within 65536 of that; else in 4 (and the bases dropped).
   bool compact = true;
-  for (const Node& n : bvh.nodes_) {
+  for (Node& n : bvh.nodes_) {
     if (n.leaf == 0) continue;
     uint32_t lo = UINT32_MAX, hi = 0;
     for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
       lo = std::min(lo, refs[i].triangle);
       hi = std::max(hi, refs[i].triangle);
     }
+    n.leaf = (lo & ~0xffu) | size_of(n);
     compact = compact && hi - (lo & ~0xffu) <= std::numeric_limits<uint16_t>::max();
   }
   if (compact) {
     bvh.order16_.resize(tri_count);
-    for (Node& n : bvh.nodes_) {
-      if (n.leaf == 0) continue;
-      uint32_t lo = UINT32_MAX;
-      for (uint32_t i = n.first; i < n.first + size_of(n); ++i) lo = std::min(lo, refs[i].triangle);
-      n.leaf = (lo & ~0xffu) | size_of(n);
-      for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
-        bvh.order16_[i] = static_cast<uint16_t>(refs[i].triangle - (lo & ~0xffu));
+    for (const Node& n : bvh.nodes_) {
+      for (uint32_t i = n.first; n.leaf != 0 && i < n.first + size_of(n); ++i) {
+        bvh.order16_[i] = static_cast<uint16_t>(refs[i].triangle - (n.leaf & ~0xffu));
       }
     }
   } else {
+    for (Node& n : bvh.nodes_) n.leaf = size_of(n);
     bvh.order_.resize(tri_count);
     for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
   }

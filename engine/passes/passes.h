@@ -106,7 +106,7 @@ class FlowPass {
     bool with_floor = false;  // the bench's floor pipeline (declare_floor)
     bool with_depth = false;  // the surface's depth pipeline (declare_depth)
     // The material whose pipeline is compiled at create; the others, and the debug views', when
-    // a frame first draws with them (prepare_frame).
+    // a frame first draws with them (prepare_pipeline).
     WaterMaterial material = WaterMaterial::kTiledDirectionalFlow;
   };
   // One material descriptor set per frame slot (the host's depth changes per frame).
