@@ -680,7 +680,9 @@ Status Viewer::record(FrameSlot& slot, uint32_t image_index, const View& view, b
   ImGui_ImplVulkan_RenderDrawData(ImGui::GetDrawData(), cmd);
   vkCmdEndRenderPass(cmd);
 
-  const ImageState present = state(VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+  // A layout transition runs in no stage: only the barrier's second scope chains it into the
+  // semaphore's signal (ALL_COMMANDS), which the present waits on.
+  const ImageState present = state(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE,
                                    VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
   if (screenshot) {
     SIVIFLOW_TRY(screenshot_.record_copy(device_, cmd, target, overlay, extent_));

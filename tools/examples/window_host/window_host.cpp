@@ -373,9 +373,12 @@ void record_present_copy(VkCommandBuffer cmd, const FrameSlot& slot, VkImage tar
   blit.dstOffsets[1] = blit.srcOffsets[1];
   vkCmdBlitImage(cmd, slot.color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target,
                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_NEAREST);
+  // A layout transition runs in no stage: only the barrier's second scope (every stage) chains
+  // it into the semaphore the submit signals and the present waits on.
   transition(cmd, target, VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_BLIT_BIT,
              VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-             VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
+             VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_NONE,
+             VK_IMAGE_LAYOUT_PRESENT_SRC_KHR);
 }
 
 // Texels of a read-back RGBA16F frame that kept the sky, and those the water covered.
