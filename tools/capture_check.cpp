@@ -20,8 +20,8 @@ namespace siviflow {
 namespace {
 
 // Lavapipe does not enforce its 2 GiB heap (reliability notes), so the capture enforces a budget
-// on what grows with the size: the renderers' views, and per frame in flight the host's colour
-// (RGBA16F) and depth (D32) and the readback buffers.
+// on what grows with the size: the renderers' views, the host's colour (RGBA16F) and depth (D32)
+// that every frame in flight shares, and per frame in flight the readback buffers.
 constexpr uint64_t kHostBytesPerPixel = 8 + 4;
 constexpr uint64_t kMaxCaptureBytes = 2ull << 30;
 
@@ -55,7 +55,7 @@ Status check_memory_budget(const CaptureOptions& options, size_t river_count) {
   info.depth_format = kCaptureDepthFormat;
   info.frames_in_flight = kCaptureFramesInFlight;
   const uint64_t pixels = uint64_t{options.size.width} * options.size.height;
-  uint64_t needed = kCaptureFramesInFlight * pixels * kHostBytesPerPixel;
+  uint64_t needed = pixels * kHostBytesPerPixel;
   for (size_t i = 0; i < river_count; ++i) {  // the last river's renderer reads back
     info.readback_images = i + 1 == river_count ? capture_readback_images(options) : 0;
     ViewMemory view;
@@ -65,8 +65,8 @@ Status check_memory_budget(const CaptureOptions& options, size_t river_count) {
   if (needed <= kMaxCaptureBytes) return Status::success();
   return Status::error(text_format(
       "--size %ux%u (with the AOVs asked for) needs %llu MiB of device memory (the renderers' "
-      "images and staging, the frames' colour, depth and readback buffers), more than the %llu "
-      "MiB budget",
+      "images and staging, the colour and depth targets, the frames' readback buffers), more than "
+      "the %llu MiB budget",
       options.size.width, options.size.height,
       static_cast<unsigned long long>((needed + (1u << 20) - 1) >> 20),
       static_cast<unsigned long long>(kMaxCaptureBytes >> 20)));
