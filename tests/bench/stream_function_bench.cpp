@@ -1,5 +1,6 @@
 // Google Benchmark of the river simulation core: surface build, full solve and an obstacle move
-// on procedural rivers of 10k to 4M vertices (issue 3, "Speed"), and the foam after a move.
+// on procedural rivers of 10k to 4M vertices (issue 3, "Speed"), the foam after a move and the
+// ray-cast hierarchy's build.
 #include <algorithm>
 #include <cstdint>
 #include <map>
@@ -206,10 +207,21 @@ void BM_FoamAfterMove(benchmark::State& state) {
   state.counters["rederived"] = double(field.last_rederived());
 }
 
+// The ray-cast hierarchy over the river's triangles, as RiverFlow::create builds it.
+void BM_HierarchyBuild(benchmark::State& state) {
+  const RiverMesh& mesh = river_mesh(state.range(0));
+  for (auto _ : state) {
+    TriangleBvh bvh;
+    if (!TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok()) std::abort();
+    benchmark::DoNotOptimize(bvh.memory_bytes());
+  }
+}
+
 BENCHMARK(BM_SurfaceBuild)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FullSolve)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'000)
     ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_HierarchyBuild)->Arg(1'500'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MoveObstacle)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadFlow)->ArgsProduct({{100'000}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_FoamAfterMove)->ArgsProduct({{100'000, 1'500'000}, {0, 1}})
