@@ -66,7 +66,7 @@ FrameWriter::~FrameWriter() {
 
 Status FrameWriter::push(FinishedFrame frame) {
   std::unique_lock lock(mutex_);
-  changed_.wait(lock, [this] { return !failure_.ok() || queue_.size() < kQueueDepth; });
+  changed_.wait(lock, [this] { return !failure_.ok() || queue_.size() + in_hand_ < kEncoders; });
   if (!failure_.ok()) return failure_;
   queue_.emplace_back(next_ticket_++, std::move(frame));
   changed_.notify_all();
@@ -97,7 +97,6 @@ void FrameWriter::encode_loop(FrameEncoder* encoder) {
     FinishedFrame frame = std::move(queue_.front().second);
     queue_.pop_front();
     ++in_hand_;
-    changed_.notify_all();  // room in the queue
     lock.unlock();
     Status status = guarded("encode", frame.frame, [&] {
       const Status encoding = encoder->encode(frame, &encoded);

@@ -1,6 +1,7 @@
 // The capture's writer: finished frames are encoded on threads of their own while the next frames
-// render, and their files written atomically in frame order. A bounded queue keeps memory to a
-// few frames; the first failure, in frame order, stops the writing.
+// render, and their files written atomically in frame order. A frame is taken only when an
+// encoder is free for it, which bounds the memory; the first failure, in frame order, stops the
+// writing.
 #pragma once
 
 #include <condition_variable>
@@ -23,14 +24,15 @@ namespace siviflow {
 
 class FrameWriter {
  public:
-  // Frames waiting to be encoded at most: push() waits while this many are queued.
-  static constexpr size_t kQueueDepth = 2;
   // Frames encoded at once: one encoder's serial work (its planes, its file writes) overlaps
-  // the other's compression on OpenEXR's threads.
+  // the other's compression on OpenEXR's threads. push() waits while every encoder holds a
+  // frame (until that frame's files are written): a queue ahead of them held a frame each, and
+  // a frame with every AOV is 34 bytes a pixel (282 MB at 3840x2160), for no more frames a
+  // second, since the capture pushes a frame only once it has submitted the next.
   static constexpr size_t kEncoders = 2;
-  // Frames kept for their buffers at most: one per place a frame can be (the queue, the
-  // encoders, the capture's hands).
-  static constexpr size_t kSpareFrames = kQueueDepth + kEncoders + 1;
+  // Frames kept for their buffers at most: one per place a frame can be (the encoders, the
+  // capture's hands).
+  static constexpr size_t kSpareFrames = kEncoders + 1;
 
   // `layout` is the renderer's flow texture layout (fixed for the capture); `on_written` runs on
   // a writer's thread after each frame, with the count written so far.
@@ -44,8 +46,8 @@ class FrameWriter {
   // Lets OpenEXR compress on every core (process-wide; the capture tool owns its process).
   static Status start_encoding_threads();
 
-  // Queues `frame` (frames come in frame order), waiting for room; the writer's first failure
-  // instead, after which nothing more is written.
+  // Hands `frame` to an encoder (frames come in frame order), waiting for one to be free; the
+  // writer's first failure instead, after which nothing more is written.
   Status push(FinishedFrame frame);
   // Waits until every queued frame is written; the first failure.
   Status finish();
@@ -64,7 +66,9 @@ class FrameWriter {
 
   std::mutex mutex_;
   std::condition_variable changed_;
-  std::deque<std::pair<uint64_t, FinishedFrame>> queue_;  // guarded by mutex_, with those below:
+  // Pushed and not yet taken by an encoder (at most the free ones); guarded by mutex_, with those
+  // below.
+  std::deque<std::pair<uint64_t, FinishedFrame>> queue_;
   std::vector<FinishedFrame> spares_;
   uint64_t next_ticket_ = 0;  // the place in frame order of the next frame pushed
   uint64_t next_write_ = 0;   // whose files are written next
