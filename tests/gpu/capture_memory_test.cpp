@@ -1,8 +1,8 @@
 // A capture's frames after the first reuse the memory the first ones faulted in: memory freed and
 // faulted in again every frame (the process's allocator handing blocks back to the kernel) costs
 // a 720p capture a tenth of its time, and shows here as page faults that grow with the frames.
-// And a long capture holds no more frames than its encoders and its own hands can: with every
-// AOV a frame the writer holds is 34 bytes a pixel.
+// And a long capture holds no more frames than its encoders and its own hands can (with every AOV
+// a frame the writer holds is 34 bytes a pixel), and --force reads no frame it replaces.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -85,6 +85,23 @@ TEST(CaptureMemory, ALongCaptureWithEveryAovHoldsNoQueueOfFrames) {
   if (kResidentJudged) {
     EXPECT_LT(static_cast<double>(twelve_frames - one_frame), 6.7 * frame_kib)
         << one_frame << " KiB for 1 frame, " << twelve_frames << " KiB for 12";
+  }
+}
+
+TEST(CaptureMemory, AForcedCaptureReadsNoFrameItReplaces) {
+  const std::string full = fresh_test_dir("capture_memory_full").string();
+  const RunResult big = run_siviflow("capture --frames 1 --size 1920x1080 --validation --out " +
+                                     full + kEveryAov);
+  ASSERT_EQ(big.exit_code, 0) << big.output;
+  const std::string small = "capture --frames 1 --size 320x180 --validation --force --out ";
+  const long over_frame = peak_kib_of(small + full);
+  const long in_empty_folder = peak_kib_of(small + fresh_test_dir("capture_memory_empty").string());
+  ASSERT_GT(over_frame, 0) << "the capture over the 1920x1080 frame failed";
+  ASSERT_GT(in_empty_folder, 0) << "the capture into an empty folder failed";
+  // Reading the 1920x1080 frame with every AOV to check it took 55 MB more.
+  if (kResidentJudged) {
+    EXPECT_LT(over_frame - in_empty_folder, 20 * 1024)
+        << over_frame << " KiB over the frame, " << in_empty_folder << " KiB without it";
   }
 }
 
