@@ -272,12 +272,13 @@ Status Capture::run() {
     SIVIFLOW_TRY(step_floats(frame, nullptr));
   }
 
-  // One colour and depth target for every slot (12 bytes a pixel each, 100 MB at 3840x2160): a
-  // frame's readback copy hands the colour on at the copy's stage, so the next frame, whichever
-  // slot, waits on it in the queue, not on the fence of its own slot's frame. Only the readback
+  // One colour and depth target for every slot (12 bytes a pixel together, 100 MB at 3840x2160):
+  // a frame's readback copy hands the colour on at the transfer stage, so the next frame,
+  // whichever slot, waits on it in the queue, not on the fence of its own slot's frame; the depth
+  // is handed on at the fragment tests, which a depth copy is chained into. Only the readback
   // buffers, read on the CPU after that fence, are the slots' own.
   HostTargets targets;
-  const ImageState copied{VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
+  const ImageState copied{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_NONE,
                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
   SIVIFLOW_TRY(
       create_host_targets(*context_, kOutputFormat, kDepthFormat, extent, copied, &targets));

@@ -15,7 +15,9 @@
 
 namespace siviflow {
 
-// One frame slot's colour and depth images, and the states the last frame left them in.
+// A host's colour and depth images, and the states the last frame left them in: one frame slot's,
+// or every slot's where `color.final` names a real stage (the next frame then waits on the last
+// one in the queue; with VK_PIPELINE_STAGE_2_NONE only the slot's fence orders them).
 struct HostTargets {
   ExternalImage color;  // current: where the last frame left it; final: what the host wants
   ExternalImage depth;
@@ -25,8 +27,8 @@ struct HostTargets {
   ExternalImage reactive;
 };
 
-// Colour (colour attachment, sampled, copy source) and depth images for one slot; the colour
-// ends each frame in `color_final`, the depth read-only.
+// Colour (colour attachment, sampled, copy source) and depth images (HostTargets says when slots
+// may share them); the colour ends each frame in `color_final`, the depth read-only.
 Status create_host_targets(HeadlessContext& context, VkFormat color_format, VkFormat depth_format,
                            VkExtent2D extent, ImageState color_final, HostTargets* out);
 
