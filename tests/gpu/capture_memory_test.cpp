@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -58,6 +59,7 @@ long peak_kib_of(const std::string& args) {
   if (child == 0) {
     close(ends[0]);
     const RunResult r = run_siviflow(args);
+    if (r.exit_code != 0) std::fprintf(stderr, "siviflow %s:\n%s", args.c_str(), r.output.c_str());
     rusage usage{};
     getrusage(RUSAGE_CHILDREN, &usage);
     const long peak = r.exit_code == 0 ? usage.ru_maxrss : -1;
