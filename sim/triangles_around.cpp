@@ -11,29 +11,40 @@ TrianglesAround TrianglesAround::of_mesh(size_t vertex_count, std::span<const ui
   TrianglesAround around;
   around.vertex_count_ = vertex_count;
   around.triangle_count_ = corners / 3;
-  // Counted, then filled in triangle order: each vertex's come out ascending. Straight into
-  // 2 bytes a triangle, without a list of 4 beside it, until one does not fit.
+  // Counted, then filled in triangle order: each vertex's come out ascending, in the narrowest
+  // width that holds every offset (found first, so no wider list is held beside it).
   std::vector<uint32_t> start(vertex_count + 1, 0);
-  for (size_t i = 0; i < corners; ++i) ++start[corner(i) + 1];
+  int64_t lowest = 0, highest = 0;
+  for (size_t i = 0; i < corners; ++i) {
+    ++start[corner(i) + 1];
+    const int64_t offset = static_cast<int64_t>(i / 3) - around.anchor(corner(i));
+    lowest = std::min(lowest, offset);
+    highest = std::max(highest, offset);
+  }
   for (size_t v = 0; v < vertex_count; ++v) start[v + 1] += start[v];
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-  around.offsets_.resize(corners);
-  for (size_t i = 0; i < corners; ++i) {
-    const uint32_t v = corner(i);
-    const int64_t offset = static_cast<int64_t>(i / 3) - around.anchor(v);
-    if (offset < std::numeric_limits<int16_t>::min() ||
-        offset > std::numeric_limits<int16_t>::max()) {
-      around.offsets_ = std::vector<int16_t>();  // frees it, as clear() would not
-      break;
-    }
-    around.offsets_[fill[v]++] = static_cast<int16_t>(offset);
-  }
-  if (around.offsets_.empty() && corners > 0) {
-    std::copy(start.begin(), start.end() - 1, fill.begin());
-    around.triangles_.resize(corners);
+  const auto fill_lists = [&](auto* lists, auto entry_of) {
+    lists->resize(corners);
     for (size_t i = 0; i < corners; ++i) {
-      around.triangles_[fill[corner(i)]++] = static_cast<uint32_t>(i / 3);
+      const uint32_t v = corner(i);
+      (*lists)[fill[v]++] = entry_of(i, v);
     }
+  };
+  const auto fits = [&](auto narrow) {
+    using T = decltype(narrow);
+    return lowest >= std::numeric_limits<T>::min() && highest <= std::numeric_limits<T>::max();
+  };
+  const auto offset_of = [&](auto narrow) {
+    return [&around, narrow](size_t i, uint32_t v) {
+      return static_cast<decltype(narrow)>(static_cast<int64_t>(i / 3) - around.anchor(v));
+    };
+  };
+  if (fits(int8_t{})) {
+    fill_lists(&around.offsets8_, offset_of(int8_t{}));
+  } else if (fits(int16_t{})) {
+    fill_lists(&around.offsets16_, offset_of(int16_t{}));
+  } else {
+    fill_lists(&around.triangles_, [](size_t i, uint32_t) { return static_cast<uint32_t>(i / 3); });
   }
   fill = std::vector<uint32_t>();
   around.compact_starts(&start);
@@ -61,7 +72,8 @@ void TrianglesAround::compact_starts(std::vector<uint32_t>* starts) {
 size_t TrianglesAround::memory_bytes() const {
   return block_start_.capacity() * sizeof(uint32_t) +
          start_in_block_.capacity() * sizeof(uint16_t) + start_.capacity() * sizeof(uint32_t) +
-         offsets_.capacity() * sizeof(int16_t) + triangles_.capacity() * sizeof(uint32_t);
+         offsets8_.capacity() * sizeof(int8_t) + offsets16_.capacity() * sizeof(int16_t) +
+         triangles_.capacity() * sizeof(uint32_t);
 }
 
 }  // namespace siviflow

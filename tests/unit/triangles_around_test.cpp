@@ -1,6 +1,6 @@
 // The triangles around each vertex, as a long river keeps them: the same lists as a plain count
-// would give, in 2 bytes a triangle for a mesh laid out section after section, and in 4 for one
-// whose order is shuffled.
+// would give, in 1 byte a triangle for a mesh laid out section after section, in 2 for one whose
+// sections are hundreds of vertices wide, and in 4 for one whose order is shuffled.
 #include "siviflow/sim/triangles_around.h"
 
 #include <cstdint>
@@ -37,15 +37,28 @@ void expect_lists(const TrianglesAround& around, const std::vector<std::vector<u
 }
 
 // 4 km of a 13-vertex strip: 104k triangles, far more than a 16-bit offset reaches from vertex 0.
-TEST(TrianglesAround, AStripHoldsItsListsInTwoBytesATriangle) {
+TEST(TrianglesAround, AStripHoldsItsListsInOneByteATriangle) {
   const test::TestMesh mesh = test::straight_channel(12.0f, 4000.0f, 4001, 13);
   const TrianglesAround around = TrianglesAround::of_mesh(mesh.positions.size(), mesh.indices);
   EXPECT_TRUE(around.compact());
+  EXPECT_EQ(around.offset_bytes(), 1);
   expect_lists(around, plain_lists(mesh.positions.size(), mesh.indices));
   // And each vertex's start in 2 bytes, from its block of 256 vertices' start.
   const size_t blocks = mesh.positions.size() / 256 + 1;
   EXPECT_LE(around.memory_bytes(),
-            2 * (mesh.positions.size() + 1) + 4 * blocks + 2 * mesh.indices.size());
+            2 * (mesh.positions.size() + 1) + 4 * blocks + mesh.indices.size());
+}
+
+// Sections 200 vertices wide: a vertex's triangles lie about 400 from v * T / V, past what a byte
+// reaches, so they keep 2 bytes a triangle, and the same lists.
+TEST(TrianglesAround, AWideStripHoldsItsListsInTwoBytesATriangle) {
+  const test::TestMesh mesh = test::straight_channel(400.0f, 100.0f, 51, 200);
+  const TrianglesAround around = TrianglesAround::of_mesh(mesh.positions.size(), mesh.indices);
+  EXPECT_EQ(around.offset_bytes(), 2);
+  expect_lists(around, plain_lists(mesh.positions.size(), mesh.indices));
+  EXPECT_LE(around.memory_bytes(), 2 * (mesh.positions.size() + 1) +
+                                       4 * (mesh.positions.size() / 256 + 1) +
+                                       2 * mesh.indices.size());
 }
 
 // A fan of 70000 triangles about vertex 0: vertex 1 starts 70000 entries past its block's start,
@@ -65,6 +78,7 @@ TEST(TrianglesAround, AShuffledMeshKeepsFourBytesATriangleAndTheSameLists) {
       test::shuffled(test::straight_channel(12.0f, 4000.0f, 4001, 13), 7, &new_of_old);
   const TrianglesAround around = TrianglesAround::of_mesh(mesh.positions.size(), mesh.indices);
   EXPECT_FALSE(around.compact());
+  EXPECT_EQ(around.offset_bytes(), 0);
   expect_lists(around, plain_lists(mesh.positions.size(), mesh.indices));
 }
 
@@ -74,13 +88,13 @@ TEST(TrianglesAround, ANonIndexedMeshCountsEveryThreeVertices) {
   expect_lists(around, {{0}, {0}, {0}, {1}, {1}, {1}});
 }
 
-// The river surface keeps its nodes' triangles so: a procedural river's are compact, and equal
-// to a plain count over its triangles.
+// The river surface keeps its nodes' triangles so: a procedural river's in 1 byte a triangle,
+// and equal to a plain count over its triangles.
 TEST(TrianglesAround, ARiverSurfacesNodesTrianglesAreCompact) {
   const test::TestMesh mesh = test::bend(40.0f, 52.0f, 3.0f, 600, 9);
   RiverSurface surface;
   ASSERT_TRUE(RiverSurface::build(mesh.positions, mesh.indices, {}, &surface).ok());
-  EXPECT_TRUE(surface.triangles_around().compact());
+  EXPECT_EQ(surface.triangles_around().offset_bytes(), 1);
   const std::vector<uint32_t> triangles(surface.triangles().begin(), surface.triangles().end());
   expect_lists(surface.triangles_around(), plain_lists(surface.node_count(), triangles));
 }
