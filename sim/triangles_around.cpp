@@ -1,7 +1,9 @@
 #include "siviflow/sim/triangles_around.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
+#include <type_traits>
 
 namespace siviflow {
 
@@ -30,20 +32,20 @@ TrianglesAround TrianglesAround::of_mesh(size_t vertex_count, std::span<const ui
       (*lists)[fill[v]++] = entry_of(i, v);
     }
   };
-  const auto fits = [&](auto narrow) {
-    using T = decltype(narrow);
-    return lowest >= std::numeric_limits<T>::min() && highest <= std::numeric_limits<T>::max();
+  // Into `lists` when every offset fits their entries' type; false, untouched, when one does not.
+  const auto fill_offsets_if_they_fit = [&](auto* lists) {
+    using Offset = typename std::remove_pointer_t<decltype(lists)>::value_type;
+    if (lowest < std::numeric_limits<Offset>::min() ||
+        highest > std::numeric_limits<Offset>::max()) {
+      return false;
+    }
+    fill_lists(lists, [&](size_t i, uint32_t v) {
+      return static_cast<Offset>(static_cast<int64_t>(i / 3) - around.anchor(v));
+    });
+    return true;
   };
-  const auto offset_of = [&](auto narrow) {
-    return [&around, narrow](size_t i, uint32_t v) {
-      return static_cast<decltype(narrow)>(static_cast<int64_t>(i / 3) - around.anchor(v));
-    };
-  };
-  if (fits(int8_t{})) {
-    fill_lists(&around.offsets8_, offset_of(int8_t{}));
-  } else if (fits(int16_t{})) {
-    fill_lists(&around.offsets16_, offset_of(int16_t{}));
-  } else {
+  if (!fill_offsets_if_they_fit(&around.offsets8_) &&
+      !fill_offsets_if_they_fit(&around.offsets16_)) {
     fill_lists(&around.triangles_, [](size_t i, uint32_t) { return static_cast<uint32_t>(i / 3); });
   }
   fill = std::vector<uint32_t>();

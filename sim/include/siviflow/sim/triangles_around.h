@@ -94,12 +94,12 @@ class TrianglesAround {
   int64_t anchor(uint32_t v) const {
     return static_cast<int64_t>(uint64_t{v} * triangle_count_ / vertex_count());
   }
-  // Where vertex v's triangles start in the lists (v = vertex_count(): their end).
   Lists lists() const {
     return {offsets8_.empty() ? nullptr : offsets8_.data(),
             offsets16_.empty() ? nullptr : offsets16_.data(),
             triangles_.empty() ? nullptr : triangles_.data()};
   }
+  // Where vertex v's triangles start in the lists (v = vertex_count(): their end).
   size_t start(size_t v) const {
     return start_.empty() ? size_t{block_start_[v >> kBlockShift]} + start_in_block_[v] : start_[v];
   }
