@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -22,7 +24,11 @@ static_assert(kMaxLeafTriangles <= 0xff);  // a leaf's count is the low byte of 
 constexpr int kBins = 16;
 // Below this depth splits fall back to the object median, so the traversal stack is bounded.
 constexpr int kMaxSahDepth = 40;
-constexpr int kStackSize = 128;  // > kMaxSahDepth + 32 median levels
+// Where few leaves' triangles lie too far apart in number for the 1-byte order, those are split
+// (at most kMaxLeafTriangles - 1 levels more) rather than the whole order kept in 2 bytes.
+constexpr uint32_t kSplitAtMostOneLeafIn = 64;
+constexpr int kStackSize = 128;
+static_assert(kStackSize > kMaxSahDepth + 32 + int{kMaxLeafTriangles});  // + 32 median levels
 
 struct Aabb {
   glm::vec3 lo{std::numeric_limits<float>::infinity()};
@@ -230,28 +236,72 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     tasks.push_back({left + 1, mid, task.end, task.depth + 1});
     tasks.push_back({left, task.begin, mid, task.depth + 1});
   }
-  // The order in 2 bytes an entry, from each leaf's lowest triangle down to a multiple of 256,
-  // where every leaf's triangles lie within 65536 of that; else in 4 (and the bases dropped).
-  bool compact = true;
-  for (Node& n : bvh.nodes_) {
-    if (n.leaf == 0) continue;
+  // The order from each leaf's base: in 1 byte an entry where every leaf's triangles lie within
+  // 256 of its lowest (its base, which the node's upper 24 bits must hold); else in 2 where they
+  // lie within 65536 of the lowest rounded down to a multiple of 256; else in 4, no bases.
+  const auto leaf_range = [&](const Node& n) {
     uint32_t lo = UINT32_MAX, hi = 0;
     for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
       lo = std::min(lo, refs[i].triangle);
       hi = std::max(hi, refs[i].triangle);
     }
-    n.leaf = (lo & ~0xffu) | size_of(n);
-    compact = compact && hi - (lo & ~0xffu) <= std::numeric_limits<uint16_t>::max();
+    return std::pair{lo, hi};
+  };
+  constexpr uint32_t kByte = std::numeric_limits<uint8_t>::max();
+  uint32_t leaves = 0, wide = 0, spread16 = 0;  // spread16: the largest 2-byte entry
+  for (const Node& n : bvh.nodes_) {
+    if (n.leaf == 0) continue;
+    const auto [lo, hi] = leaf_range(n);
+    ++leaves;
+    wide += hi - lo > kByte ? 1 : 0;
+    spread16 = std::max(spread16, hi - (lo & ~0xffu));
   }
-  if (compact) {
-    bvh.order16_.resize(tri_count);
-    for (const Node& n : bvh.nodes_) {
-      for (uint32_t i = n.first; n.leaf != 0 && i < n.first + size_of(n); ++i) {
-        bvh.order16_[i] = static_cast<uint16_t>(refs[i].triangle - (n.leaf & ~0xffu));
+  const bool bytes_address = tri_count <= (size_t{1} << 24);
+  if (bytes_address && wide > 0 && wide <= leaves / kSplitAtMostOneLeafIn) {
+    // Each wide leaf becomes two, parted at the widest gap between its triangles' numbers, until
+    // every leaf's fit a byte (the children are appended, so this loop comes to them too).
+    for (uint32_t k = 0; k < bvh.nodes_.size(); ++k) {
+      const Node n = bvh.nodes_[k];
+      if (n.leaf == 0 || leaf_range(n).second - leaf_range(n).first <= kByte) continue;
+      Ref* const begin = refs.data() + n.first;
+      Ref* const end = begin + size_of(n);
+      std::sort(begin, end, [](const Ref& a, const Ref& b) { return a.triangle < b.triangle; });
+      Ref* cut = begin + 1;
+      for (Ref* r = begin + 2; r < end; ++r) {
+        if (r->triangle - (r - 1)->triangle > cut->triangle - (cut - 1)->triangle) cut = r;
       }
+      const auto child = [&](const Ref* from, const Ref* to) {
+        Aabb box;
+        for (const Ref* r = from; r < to; ++r) box.grow(bounds(r->triangle));
+        const auto first = static_cast<uint32_t>(from - refs.data());
+        return Node{box.lo, first, box.hi, static_cast<uint32_t>(to - from)};
+      };
+      bvh.nodes_[k].first = static_cast<uint32_t>(bvh.nodes_.size());
+      bvh.nodes_[k].leaf = 0;
+      bvh.nodes_.push_back(child(begin, cut));
+      bvh.nodes_.push_back(child(cut, end));
     }
+    wide = 0;
+  }
+  // Each leaf's base is its lowest triangle masked by `base_mask`, written into the leaf's upper
+  // bits shifted up by `shift`; its entries are its triangles less the base.
+  const auto fill_from_bases = [&](auto* order, uint32_t base_mask, int shift) {
+    using Entry = typename std::remove_pointer_t<decltype(order)>::value_type;
+    order->resize(tri_count);
+    for (Node& n : bvh.nodes_) {
+      if (n.leaf == 0) continue;
+      const uint32_t base = leaf_range(n).first & base_mask;
+      for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
+        (*order)[i] = static_cast<Entry>(refs[i].triangle - base);
+      }
+      n.leaf = (base << shift) | size_of(n);
+    }
+  };
+  if (bytes_address && wide == 0) {
+    fill_from_bases(&bvh.order8_, ~0u, 8);
+  } else if (spread16 <= std::numeric_limits<uint16_t>::max()) {
+    fill_from_bases(&bvh.order16_, ~0xffu, 0);
   } else {
-    for (Node& n : bvh.nodes_) n.leaf = size_of(n);
     bvh.order_.resize(tri_count);
     for (size_t i = 0; i < tri_count; ++i) bvh.order_[i] = refs[i].triangle;
   }
@@ -262,8 +312,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
 }
 
 size_t TriangleBvh::memory_bytes() const {
-  return nodes_.capacity() * sizeof(Node) + order16_.capacity() * sizeof(uint16_t) +
-         order_.capacity() * sizeof(uint32_t);
+  return nodes_.capacity() * sizeof(Node) + order8_.capacity() +
+         order16_.capacity() * sizeof(uint16_t) + order_.capacity() * sizeof(uint32_t);
 }
 
 uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {

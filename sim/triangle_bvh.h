@@ -33,7 +33,7 @@ class TriangleBvh {
   static Status build(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
                       TriangleBvh* out, std::string_view mesh_name = "RiverFlowField");
 
-  size_t triangle_count() const { return order16_.empty() ? order_.size() : order16_.size(); }
+  size_t triangle_count() const { return order8_.size() + order16_.size() + order_.size(); }
   std::span<const glm::vec3> positions() const { return positions_; }
   std::span<const uint32_t> indices() const { return indices_; }
   uint32_t triangle_vertex(uint32_t triangle, int corner) const {
@@ -42,6 +42,8 @@ class TriangleBvh {
   }
   // Bytes held by the hierarchy itself (not the referenced mesh).
   size_t memory_bytes() const;
+  // The bytes each triangle of the order takes: 1, 2 or 4.
+  int order_bytes() const { return !order8_.empty() ? 1 : !order16_.empty() ? 2 : 4; }
 
   // Closest intersection of origin + t * direction, t in [0, t_max], with any triangle (both
   // sides). False when the ray misses.
@@ -70,14 +72,16 @@ class TriangleBvh {
     glm::vec3 lo;
     uint32_t first;  // leaf: first entry of the order; inner: index of the left child (right = +1)
     glm::vec3 hi;
-    // Inner: 0. Leaf: its triangle count in the low byte (> 0); with the 16-bit order, the rest
-    // is the base its entries add to (a multiple of 256).
+    // Inner: 0. Leaf: its triangle count in the low byte (> 0); the rest is the base its
+    // entries add to: with the 8-bit order its lowest triangle (shifted up by 8), with the
+    // 16-bit order that triangle rounded down to a multiple of 256.
     uint32_t leaf;
   };
   static_assert(sizeof(Node) == 32);
   static uint32_t size_of(const Node& n) { return n.leaf & 0xffu; }
   // The triangle of entry i of leaf n's order.
   uint32_t triangle_at(const Node& n, uint32_t i) const {
+    if (!order8_.empty()) return (n.leaf >> 8) + order8_[i];
     return order16_.empty() ? order_[i] : (n.leaf & ~0xffu) + order16_[i];
   }
   template <bool kAnyHit>
@@ -87,8 +91,11 @@ class TriangleBvh {
   std::span<const glm::vec3> positions_;
   std::span<const uint32_t> indices_;
   std::vector<Node> nodes_;
-  // Triangle indices, leaf by leaf: in 2 bytes each from their leaf's base where every leaf's
-  // fit (a mesh whose triangles near in space are near in number, as a river's), else in 4.
+  // Triangle indices, leaf by leaf, from their leaf's base: in 1 byte each where every leaf's
+  // triangles lie within 256 of its lowest (a mesh whose triangles near in space are near in
+  // number, as a river's), else in 2 where they fit, else the triangles themselves in 4. One
+  // of the three is held.
+  std::vector<uint8_t> order8_;
   std::vector<uint16_t> order16_;
   std::vector<uint32_t> order_;
 };

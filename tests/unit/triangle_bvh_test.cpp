@@ -39,15 +39,16 @@ TEST(TriangleBvh, PositionsPastTheWorldLimitAreRefusedByIndexAndValue) {
   EXPECT_EQ(s.message(), "Mesh::positions[4] (-3.4e+38, 0, 0) lies beyond the world limit of ±1e+06 m");
 }
 
-// Leaves of up to 16 triangles and the order in 2 bytes a triangle: under 8.5 bytes a triangle
-// (nodes and the order); a 4-byte order held 10.5, and leaves of 8 14.8. Every vertex is still
-// found where it lies.
-TEST(TriangleBvh, AStripRiversHierarchyHoldsUnderNineBytesATriangle) {
+// Leaves of up to 16 triangles and the order in 1 byte a triangle: 6.5 bytes a triangle (nodes
+// and the order); the 2-byte order held 7.5, a 4-byte one 9.5, and leaves of 8 more still. Every
+// vertex is still found where it lies.
+TEST(TriangleBvh, AStripRiversHierarchyHoldsUnderSevenBytesATriangle) {
   const test::TestMesh mesh = test::straight_channel(12.0f, 2000.0f, 2001, 13);  // 2 km, as a strip's
   TriangleBvh bvh;
   ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &bvh).ok());
+  EXPECT_EQ(bvh.order_bytes(), 1);
   EXPECT_LE(static_cast<double>(bvh.memory_bytes()) / static_cast<double>(bvh.triangle_count()),
-            8.5);
+            7.0);
   for (uint32_t v = 0; v < mesh.positions.size(); v += 101) {
     const glm::vec3& p = mesh.positions[v];
     glm::dvec3 weights;
@@ -55,36 +56,91 @@ TEST(TriangleBvh, AStripRiversHierarchyHoldsUnderNineBytesATriangle) {
   }
 }
 
-// Triangles numbered in no order of their place (96000 of them, more than 2 bytes count): a leaf's
-// lie too far apart in number for 2 bytes from its base, so the order keeps 4 bytes a triangle,
-// and every ray finds the triangle the strip's hierarchy finds (renumbered) at the same t.
-TEST(TriangleBvh, TrianglesNumberedAtRandomKeepAFourByteOrderAndTheSameHits) {
-  const test::TestMesh mesh = test::straight_channel(12.0f, 4000.0f, 4001, 13);
-  const uint32_t triangles = static_cast<uint32_t>(mesh.indices.size() / 3);
-  std::vector<uint32_t> new_of_old(triangles);
-  std::iota(new_of_old.begin(), new_of_old.end(), 0u);
-  std::shuffle(new_of_old.begin(), new_of_old.end(), std::mt19937(11));
-  std::vector<uint32_t> shuffled(mesh.indices.size());
-  for (uint32_t t = 0; t < triangles; ++t) {
-    for (int k = 0; k < 3; ++k) shuffled[3 * new_of_old[t] + k] = mesh.indices[3 * t + k];
+// The mesh's indices with triangle t renumbered new_of_old[t].
+std::vector<uint32_t> renumbered(const test::TestMesh& mesh,
+                                 const std::vector<uint32_t>& new_of_old) {
+  std::vector<uint32_t> indices(mesh.indices.size());
+  for (uint32_t t = 0; t < new_of_old.size(); ++t) {
+    for (int k = 0; k < 3; ++k) indices[3 * new_of_old[t] + k] = mesh.indices[3 * t + k];
   }
+  return indices;
+}
+
+// The mesh's triangles renumbered at random: new_of_old[t] is triangle t's new number.
+std::vector<uint32_t> shuffled_triangles(const test::TestMesh& mesh,
+                                         std::vector<uint32_t>* new_of_old) {
+  new_of_old->resize(mesh.indices.size() / 3);
+  std::iota(new_of_old->begin(), new_of_old->end(), 0u);
+  std::shuffle(new_of_old->begin(), new_of_old->end(), std::mt19937(11));
+  return renumbered(mesh, *new_of_old);
+}
+
+// Random rays down onto a strip of the given half width and length find the same triangle
+// (renumbered by new_of_old) at the same t in both hierarchies, and so does locate_xz.
+void expect_the_same_hits(const TriangleBvh& a, const TriangleBvh& b,
+                          const std::vector<uint32_t>& new_of_old, float half_width, float length) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> across(-half_width, half_width), along(0.1f, length);
+  for (int n = 0; n < 2000; ++n) {
+    const glm::vec3 origin(across(random), 3.0f, along(random));
+    RayHit ha, hb;
+    ASSERT_TRUE(a.intersect(origin, {0.1f, -1.0f, 0.2f}, 10.0f, &ha)) << n;
+    ASSERT_TRUE(b.intersect(origin, {0.1f, -1.0f, 0.2f}, 10.0f, &hb)) << n;
+    EXPECT_EQ(new_of_old[ha.triangle], hb.triangle) << n;
+    EXPECT_EQ(ha.t, hb.t) << n;
+    glm::dvec3 wa, wb;
+    EXPECT_EQ(new_of_old[a.locate_xz(origin.x, origin.z, &wa)],
+              b.locate_xz(origin.x, origin.z, &wb));
+  }
+}
+
+// Sections of 200 vertices: a leaf's triangles span more than a byte from its lowest, so the
+// order keeps 2 bytes a triangle, and answers as the same strip numbered at random does (4).
+TEST(TriangleBvh, AWideStripKeepsATwoByteOrderAndTheSameHits) {
+  const test::TestMesh mesh = test::straight_channel(200.0f, 400.0f, 401, 200);
+  std::vector<uint32_t> new_of_old;
+  const std::vector<uint32_t> shuffled = shuffled_triangles(mesh, &new_of_old);
   TriangleBvh strip, mixed;
   ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &strip).ok());
   ASSERT_TRUE(TriangleBvh::build(mesh.positions, shuffled, &mixed).ok());
-  EXPECT_GE(mixed.memory_bytes(), strip.memory_bytes() + 2 * size_t{triangles});
-  std::mt19937 random(5);
-  std::uniform_real_distribution<float> across(-5.5f, 5.5f), along(0.1f, 3999.0f);
-  for (int n = 0; n < 2000; ++n) {
-    const glm::vec3 origin(across(random), 3.0f, along(random));
-    RayHit a, b;
-    ASSERT_TRUE(strip.intersect(origin, {0.1f, -1.0f, 0.2f}, 10.0f, &a)) << n;
-    ASSERT_TRUE(mixed.intersect(origin, {0.1f, -1.0f, 0.2f}, 10.0f, &b)) << n;
-    EXPECT_EQ(new_of_old[a.triangle], b.triangle) << n;
-    EXPECT_EQ(a.t, b.t) << n;
-    glm::dvec3 wa, wb;
-    EXPECT_EQ(new_of_old[strip.locate_xz(origin.x, origin.z, &wa)],
-              mixed.locate_xz(origin.x, origin.z, &wb));
-  }
+  EXPECT_EQ(strip.order_bytes(), 2);
+  EXPECT_EQ(mixed.order_bytes(), 4);
+  expect_the_same_hits(strip, mixed, new_of_old, 99.0f, 399.0f);
+}
+
+// Twenty triangles swap numbers with ones 2 km downstream: the few leaves they fall in would
+// need 2 bytes, so they are split instead and the order keeps 1 byte a triangle, with the same
+// hits as the strip numbered in order.
+TEST(TriangleBvh, AFewTrianglesNumberedFarAwaySplitTheirLeavesAndKeepAOneByteOrder) {
+  const test::TestMesh mesh = test::straight_channel(12.0f, 4000.0f, 4001, 13);
+  std::vector<uint32_t> new_of_old(mesh.indices.size() / 3);
+  std::iota(new_of_old.begin(), new_of_old.end(), 0u);
+  for (uint32_t t = 1000; t < 1000 + 20 * 997; t += 997)
+    std::swap(new_of_old[t], new_of_old[t + 48000]);
+  const std::vector<uint32_t> swapped = renumbered(mesh, new_of_old);
+  TriangleBvh strip, split;
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &strip).ok());
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, swapped, &split).ok());
+  EXPECT_EQ(split.order_bytes(), 1);
+  EXPECT_LE(split.memory_bytes(), strip.memory_bytes() + 40 * 2 * 32);  // two 32-byte nodes a split
+  expect_the_same_hits(strip, split, new_of_old, 5.5f, 3999.0f);
+}
+
+// Triangles numbered in no order of their place (96000 of them, more than 2 bytes count): a leaf's
+// lie too far apart in number for 2 bytes from its base, so the order keeps 4 bytes a triangle
+// (the strip's 1), and every ray finds the triangle the strip's hierarchy finds (renumbered) at
+// the same t.
+TEST(TriangleBvh, TrianglesNumberedAtRandomKeepAFourByteOrderAndTheSameHits) {
+  const test::TestMesh mesh = test::straight_channel(12.0f, 4000.0f, 4001, 13);
+  std::vector<uint32_t> new_of_old;
+  const std::vector<uint32_t> shuffled = shuffled_triangles(mesh, &new_of_old);
+  TriangleBvh strip, mixed;
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &strip).ok());
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, shuffled, &mixed).ok());
+  EXPECT_EQ(strip.order_bytes(), 1);
+  EXPECT_EQ(mixed.order_bytes(), 4);
+  EXPECT_GE(mixed.memory_bytes(), strip.memory_bytes() + 3 * new_of_old.size());
+  expect_the_same_hits(strip, mixed, new_of_old, 5.5f, 3999.0f);
 }
 
 }  // namespace
