@@ -189,7 +189,7 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
       SIVIFLOW_TRY(home(mesh_.positions, mesh_.indices, &placed));
     }
   }
-  std::span<const uint32_t> section = surface.node_section();
+  NodeSections section = surface.node_section();
   if (per_node_) {
     field_.positions = surface.node_positions();
     field_.indices = surface.triangles();
@@ -197,7 +197,7 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   } else {
     section_copy_.resize(count);
     for (size_t v = 0; v < count; ++v) section_copy_[v] = section[surface.node_of(v)];
-    section = section_copy_;
+    section = NodeSections(section_copy_);
     velocity_copy_.resize(count);
     field_.positions = mesh_.positions;
     field_.indices = mesh_.indices;

@@ -60,8 +60,8 @@ MarginDistances margin_distances(const RiverSurface& surface) {
 }
 
 Status FoamField::create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                         std::span<const uint32_t> section, const TriangleBvh* bvh,
-                         const FoamParams& params, FoamField* out, const TrianglesAround* around) {
+                         NodeSections section, const TriangleBvh* bvh, const FoamParams& params,
+                         FoamField* out, const TrianglesAround* around) {
   if (bvh == nullptr) return Status::error("FoamField: no ray-cast structure");
   if (section.size() != positions.size()) return Status::error("FoamField: a section per vertex");
   if (!(params.gradient_full > params.gradient_onset) || !(params.lifetime_s > 0.0f) ||
@@ -78,10 +78,10 @@ Status FoamField::create(std::span<const glm::vec3> positions, std::span<const u
   field.positions_ = positions;
   field.section_ = section;
   uint32_t sections = 0;
-  for (uint32_t s : section) sections = std::max(sections, s + 1);
+  for (size_t v = 0; v < section.size(); ++v) sections = std::max(sections, section[v] + 1);
   field.section_speed_.assign(sections, 0.0f);
   field.section_size_.assign(sections, 0);
-  for (uint32_t s : section) ++field.section_size_[s];
+  for (size_t v = 0; v < section.size(); ++v) ++field.section_size_[section[v]];
   field.bvh_ = bvh;
   field.params_ = params;
   const size_t count = positions.size();

@@ -78,9 +78,8 @@ class FoamField {
   // `around` outlive this object, and `around` stays where it is (the field keeps its address).
   // Every vertex must be a corner of a triangle.
   static Status create(std::span<const glm::vec3> positions, std::span<const uint32_t> indices,
-                       std::span<const uint32_t> section, const TriangleBvh* bvh,
-                       const FoamParams& params, FoamField* out,
-                       const TrianglesAround* around = nullptr);
+                       NodeSections section, const TriangleBvh* bvh, const FoamParams& params,
+                       FoamField* out, const TrianglesAround* around = nullptr);
   FoamField() = default;
   FoamField(FoamField&&) = default;
   FoamField& operator=(FoamField&&) = default;
@@ -133,7 +132,7 @@ class FoamField {
 
   std::span<const glm::vec3> positions_;
   std::span<const uint32_t> indices_;
-  std::span<const uint32_t> section_;
+  NodeSections section_;
   const TriangleBvh* bvh_ = nullptr;
   FoamParams params_;
   // The one-ring of a vertex is gathered from its triangles when needed: a long river keeps no

@@ -127,7 +127,7 @@ Status check_named_outflow(const RiverSurfaceOptions& options, const std::vector
 
 RiverVertex RiverSurface::node(uint32_t n) const {
   RiverVertex v;
-  v.section = node_section_[n];
+  v.section = node_section()[n];
   v.bank = node_bank_[n];
   v.width = sections_[v.section].width;
   v.d_left = node_d_left_[n];
@@ -143,9 +143,9 @@ size_t RiverSurface::memory_bytes() const {
   return bytes(node_of_vertex_) + bytes(node_vertex_) + bytes(node_positions_) +
          bytes(node_section_) + bytes(node_bank_) + bytes(node_d_left_) + bytes(node_d_right_) +
          bytes(triangles_) + node_triangles_.memory_bytes() + bytes(sections_) +
-         bytes(section_nodes_) + bytes(node_left_border_) + bytes(node_right_border_) +
-         bytes(islands_) + bytes(island_nodes_) + bytes(ends_) + bytes(end_nodes_) + bytes(banks_) +
-         bytes(bank_nodes_);
+         bytes(section_nodes_) + bytes(block_sections_) + bytes(node_left_border_) +
+         bytes(node_right_border_) + bytes(islands_) + bytes(island_nodes_) + bytes(ends_) +
+         bytes(end_nodes_) + bytes(banks_) + bytes(bank_nodes_);
 }
 
 void RiverSurface::drop_section_list_of_runs() {
@@ -160,6 +160,12 @@ void RiverSurface::drop_section_list_of_runs() {
   if (!ascending && !descending) return;
   section_step_ = ascending ? 1 : -1;
   section_nodes_ = std::vector<uint32_t>();
+  const size_t blocks = (node_section_.size() + (size_t{1} << NodeSections::kBlockBits) - 1) >>
+                        NodeSections::kBlockBits;
+  block_sections_.resize(blocks);
+  for (size_t b = 0; b < blocks; ++b)
+    block_sections_[b] = node_section_[b << NodeSections::kBlockBits];
+  node_section_ = std::vector<uint32_t>();
 }
 
 Status RiverSurface::share_mesh(std::span<const glm::vec3> positions,

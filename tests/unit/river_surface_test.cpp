@@ -92,6 +92,32 @@ TEST(RiverSurface, ASectionAfterSectionStripKeepsNoListOfItsSectionsNodes) {
   }
 }
 
+// Sections of 2 to 40 nodes, numbered section after section: the surface keeps no list of its
+// nodes' sections either (4 bytes a node, for a quarter byte), and finds each node's from the
+// sections' runs, across every block it searches from.
+TEST(RiverSurface, ASectionAfterSectionStripFindsItsNodesSectionsWithoutAList) {
+  std::vector<std::vector<glm::vec3>> rows;
+  for (uint32_t k = 0; k < 90; ++k) {
+    const float z = 2.0f * float(k);
+    rows.push_back(test::section_line({5.0f, 0.0f, z}, {-5.0f, 0.0f, z}, 2 + (k * 7) % 39));
+  }
+  const TestMesh m = test::mesh_from_sections(rows);
+  std::vector<uint32_t> new_of_old;
+  const TestMesh mixed = test::shuffled(m, 5, &new_of_old);
+  RiverSurface runs, listed;
+  ASSERT_TRUE(build(m, &runs).ok());
+  ASSERT_TRUE(build(mixed, &listed).ok());
+  EXPECT_GE(listed.memory_bytes(), runs.memory_bytes() + 7 * runs.node_count());
+  for (size_t k = 0; k < rows.size(); ++k) {
+    for (const uint32_t n : runs.section_nodes(k)) {
+      EXPECT_EQ(runs.node_section()[n], k) << "node " << n;
+      EXPECT_EQ(runs.node(n).section, k) << "node " << n;
+      EXPECT_EQ(listed.node_section()[new_of_old[n]], k) << "node " << n;
+    }
+  }
+  EXPECT_EQ(runs.node_section().size(), runs.node_count());
+}
+
 TEST(RiverSurface, UpstreamEndFollowsVertexZero) {
   // Vertex 0 at the z = 40 end: the river now flows along -Z, and the left bank is at -X.
   TestMesh m = test::straight_channel(10.0f, 40.0f, 11, 4);

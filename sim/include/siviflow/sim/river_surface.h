@@ -22,6 +22,7 @@
 // the welded "nodes" and every input vertex reads its node's data.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -136,6 +137,44 @@ struct RiverSection {
   glm::vec3 flow_direction{0.0f};  // unit, horizontal, downstream (paper §2.1)
 };
 
+// The section of every node: listed, or, where the surface numbers its nodes section after
+// section, found from the sections' first nodes, which a long river then keeps no list for. A
+// view: valid while the list, or the surface, it reads is.
+class NodeSections {
+ public:
+  // Runs are searched from the section of every 2^kBlockBits-th node: 0.25 bytes a node, and a
+  // search among a few sections.
+  static constexpr int kBlockBits = 4;
+
+  NodeSections() = default;
+  // Node n's section is list[n] (a view, as a span is).
+  NodeSections(std::span<const uint32_t> list) : list_(list) {}  // NOLINT: a list is its sections
+  NodeSections(const std::vector<uint32_t>& list) : list_(list) {}  // NOLINT
+  // Node n lies in the section whose run [first_node, first_node + node_count) holds it;
+  // `block_sections[b]` is the section of node b * 2^kBlockBits.
+  NodeSections(std::span<const RiverSection> runs, std::span<const uint32_t> block_sections)
+      : runs_(runs), block_sections_(block_sections) {}
+
+  uint32_t operator[](size_t n) const {
+    if (runs_.empty()) return list_[n];
+    const size_t b = n >> kBlockBits;
+    const auto lo = runs_.begin() + block_sections_[b];
+    const auto hi =
+        b + 1 < block_sections_.size() ? runs_.begin() + block_sections_[b + 1] + 1 : runs_.end();
+    const auto after = std::upper_bound(
+        lo, hi, n, [](size_t node, const RiverSection& run) { return node < run.first_node; });
+    return static_cast<uint32_t>(after - runs_.begin() - 1);
+  }
+  size_t size() const {
+    return runs_.empty() ? list_.size() : size_t{runs_.back().first_node} + runs_.back().node_count;
+  }
+
+ private:
+  std::span<const uint32_t> list_;
+  std::span<const RiverSection> runs_;
+  std::span<const uint32_t> block_sections_;
+};
+
 // The borders of the water: the two banks beside the upstream end (a network's root end), the
 // islands' shores, then a network's other banks (the tongues between its arms). Every vertex
 // lies between a border on its left and one on its right along its section (the two banks,
@@ -214,7 +253,10 @@ class RiverSurface {
   std::span<const glm::vec3> node_positions() const {
     return shared_positions_.data() != nullptr ? shared_positions_ : std::span(node_positions_);
   }
-  std::span<const uint32_t> node_section() const { return node_section_; }
+  NodeSections node_section() const {
+    return node_section_.empty() ? NodeSections(sections_, block_sections_)
+                                 : NodeSections(node_section_);
+  }
   std::span<const Bank> node_bank() const { return node_bank_; }
   std::span<const float> node_d_left() const { return node_d_left_; }
   std::span<const float> node_d_right() const { return node_d_right_; }
@@ -304,8 +346,8 @@ class RiverSurface {
                       const std::vector<uint32_t>& node_island,
                       const std::vector<uint32_t>& node_vertex, size_t section, double min_arm,
                       double* width);
-  // Once built: frees the list of the sections' nodes where every section is a run of
-  // consecutive nodes, all ascending or all descending (section_step_).
+  // Once built: frees the list of the sections' nodes, and of the nodes' sections, where every
+  // section is a run of consecutive nodes, all ascending or all descending (section_step_).
   void drop_section_list_of_runs();
 
   std::vector<uint32_t> node_of_vertex_;  // both empty when nothing was welded
@@ -320,6 +362,7 @@ class RiverSurface {
   std::vector<RiverSection> sections_;
   std::vector<uint32_t> section_nodes_;  // empty where the sections are runs
   int section_step_ = 0;                 // runs' step: +1, -1; 0: listed
+  std::vector<uint32_t> block_sections_;  // where the sections are runs: NodeSections'
   // Only with islands: the border on each side of every node, and the islands' shores.
   std::vector<BorderId> node_left_border_;
   std::vector<BorderId> node_right_border_;
