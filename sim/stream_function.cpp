@@ -125,7 +125,7 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
     bool wet = true;
     f.psi_[n] = f.evaluate(n, false, &wet);
   }
-  f.wet_.assign(nodes, 1);
+  f.wet_.assign(nodes, true);
   f.node_velocity_.resize(nodes);
   for (uint32_t n = 0; n < nodes; ++n) f.update_node_velocity(n);
   f.stats_ = full_update(nodes, tris);
@@ -312,7 +312,7 @@ void StreamFunction::update_node_velocity(uint32_t n) {
 
 size_t StreamFunction::memory_bytes() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  return surface_.memory_bytes() + bytes(psi_) + bytes(wet_) + bytes(node_velocity_) +
+  return surface_.memory_bytes() + bytes(psi_) + wet_.capacity() / 8 + bytes(node_velocity_) +
          bytes(junctions_) + bytes(border_psi_) + bytes(end_discharge_) + bytes(shore_tangent_) +
          bytes(obstacles_) + bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
          triangle_grid_.memory_bytes() + bytes(node_stamp_) + bytes(triangle_stamp_) +
@@ -326,7 +326,7 @@ void StreamFunction::solve_full() {
   for (uint32_t n = 0; n < nodes; ++n) {
     bool wet = true;
     psi_[n] = evaluate(n, true, &wet);
-    wet_[n] = wet ? 1 : 0;
+    wet_[n] = wet;
   }
   for (uint32_t n = 0; n < nodes; ++n) update_node_velocity(n);
   stats_ = full_update(nodes, surface_.triangle_count());
@@ -573,7 +573,7 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
   for (const uint32_t n : scratch_nodes_) {
     bool wet = true;
     psi_[n] = evaluate(n, true, &wet);
-    wet_[n] = wet ? 1 : 0;
+    wet_[n] = wet;
   }
 
   // 2. The triangles around them, 3. the vertex velocities around those.

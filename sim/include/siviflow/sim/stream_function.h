@@ -94,13 +94,13 @@ class StreamFunction {
   // --- Per input vertex.
   double psi(size_t vertex) const { return psi_[surface_.node_of(vertex)]; }
   glm::vec3 velocity(size_t vertex) const { return node_velocity_[surface_.node_of(vertex)]; }
-  bool wet(size_t vertex) const { return wet_[surface_.node_of(vertex)] != 0; }
+  bool wet(size_t vertex) const { return wet_[surface_.node_of(vertex)]; }
 
   // --- Per node (RiverSurface node indices) and per triangle (RiverSurface::triangles()).
   std::span<const double> node_psi() const { return psi_; }
   double node_psi_free(uint32_t n) const;  // without obstacles
   std::span<const glm::vec3> node_velocity() const { return node_velocity_; }
-  std::span<const uint8_t> node_wet() const { return wet_; }
+  const std::vector<bool>& node_wet() const { return wet_; }
   // Computed when asked (a long river cannot keep 12 bytes per triangle for it).
   glm::vec3 triangle_velocity(uint32_t t) const;
 
@@ -153,7 +153,7 @@ class StreamFunction {
   // Only what a re-solve cannot cheaply recompute is kept per node: the obstacle-free psi, the
   // triangles' areas and velocities, the node areas and bank tangents are derived when needed.
   std::vector<double> psi_;
-  std::vector<uint8_t> wet_;
+  std::vector<bool> wet_;  // a bit a node
   std::vector<glm::vec3> node_velocity_;
   // Where arms of a network meet: the tips of the tongues between them in one section, and the
   // water beyond, between the outermost arms' outer borders. Beyond it the streamlines parting
