@@ -12,27 +12,6 @@
 #include "siviflow/text_format.h"
 
 namespace siviflow {
-namespace {
-
-constexpr float kSlopeStep = 0.5f;         // metres: finite-difference step of the riverbed slope
-
-}  // namespace
-
-Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh,
-                             std::vector<float>* slope) {
-  RiverMesh generated;
-  SIVIFLOW_TRY(river.generate_mesh(&generated));
-  std::vector<float> slopes(generated.positions.size());
-  for (size_t v = 0; v < generated.positions.size(); ++v) {
-    const glm::vec3& p = generated.positions[v];
-    const float dx = river.terrain_height(p.x + kSlopeStep, p.z) - river.terrain_height(p.x - kSlopeStep, p.z);
-    const float dz = river.terrain_height(p.x, p.z + kSlopeStep) - river.terrain_height(p.x, p.z - kSlopeStep);
-    slopes[v] = std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
-  }
-  *mesh = std::move(generated);
-  *slope = std::move(slopes);
-  return Status::success();
-}
 
 std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float discharge) {
   std::vector<WaterRiverEnd> ends;
@@ -46,7 +25,8 @@ std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float di
 
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   RiverInput input;
-  SIVIFLOW_TRY(procedural_river_mesh(river, &input.mesh, &input.slope));
+  SIVIFLOW_TRY(river.generate_mesh(&input.mesh));
+  input.slope = std::move(input.mesh.slope);
   RiverSurfaceOptions options;
   for (const RiverMeshEnd& end : input.mesh.ends) options.ends.push_back({end.vertex, end.inflow});
   SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, options, &input.surface));

@@ -50,13 +50,10 @@ RiverSurfaceOptions river_surface_options(std::span<const WaterRiverEnd> ends);
 std::vector<float> surface_end_discharges(const RiverSurface& surface,
                                           std::span<const WaterRiverEnd> ends);
 
-// The procedural river's mesh, with the slope of the terrain under each vertex.
-Status procedural_river_mesh(const ProceduralRiver& river, RiverMesh* mesh,
-                             std::vector<float>* slope);
 // The generated river's ends (a confluence's), the outflow carrying `discharge` and the
 // tributaries sharing it by width; none for a strip.
 std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float discharge);
-// procedural_river_mesh with its surface built.
+// The procedural river's mesh with its surface built.
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
 // A host's river (CreateInfo::river): its arrays checked (sizes, finite, non-negative depth and
 // slope) and copied, its surface built. `copied` (may be empty) is called as soon as none of the

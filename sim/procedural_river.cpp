@@ -17,6 +17,11 @@
 #include "siviflow/text_format.h"
 
 namespace siviflow {
+namespace {
+
+constexpr float kSlopeStep = 0.5f;  // metres: finite-difference step of the riverbed slope
+
+}  // namespace
 
 ProceduralRiver::ProceduralRiver(const ProceduralRiverParams& params) : params_(params) {
   // std::mt19937 is specified bit-exactly by the standard, so phases are the same everywhere.
@@ -66,15 +71,22 @@ float ProceduralRiver::centreline_x(float z) const { return static_cast<float>(c
 float ProceduralRiver::width_at(float z) const { return static_cast<float>(width(z)); }
 
 float ProceduralRiver::lateral_distance(float x, float z) const {
+  return lateral_distance(x, across_at(z));
+}
+
+float ProceduralRiver::lateral_distance(float x, const Across& at) const {
   // Project the horizontal offset onto the local normal of the centreline; exact enough while
   // the meander radius is large against the valley width.
-  const double slope = centre_slope(z);
-  return static_cast<float>((x - centre_x(z)) / std::sqrt(1.0 + slope * slope));
+  return static_cast<float>((x - at.centre_x) / std::sqrt(1.0 + at.slope * at.slope));
 }
 
 float ProceduralRiver::terrain_height(float x, float z) const {
-  float lateral = lateral_distance(x, z);
-  const float half_width = 0.5f * width_at(z);
+  return terrain_height(x, z, across_at(z));
+}
+
+float ProceduralRiver::terrain_height(float x, float z, const Across& at) const {
+  float lateral = lateral_distance(x, at);
+  const float half_width = 0.5f * at.width;
   const float bank_run = 3.0f;
   // A confluence's tongue: land between the tributaries, the bed rising to it under the water
   // (and to its tip below it); out of it the tributaries' banks lie further out by its width.
@@ -82,8 +94,7 @@ float ProceduralRiver::terrain_height(float x, float z) const {
   if (params_.confluence) {
     // Along the river, where the section through (x, z) crosses the centreline (the mesh's
     // sections are square to it, so off the centreline z runs ahead of it or behind).
-    const double slope = centre_slope(z);
-    const double along = z + double(lateral) * slope / std::sqrt(1.0 + slope * slope);
+    const double along = z + double(lateral) * at.slope / std::sqrt(1.0 + at.slope * at.slope);
     const float middle = half_width * static_cast<float>(tongue_fraction_);
     const float half = static_cast<float>(tongue_half_width(along));
     const float from_middle = lateral - middle;
@@ -103,7 +114,7 @@ float ProceduralRiver::terrain_height(float x, float z) const {
     if (params_.islands.empty()) return bed;
     // An island: a dome rising to the banks' height, its shore at the waterline, its shelf
     // sloping under the water into the bed.
-    const float r = island_radius(x, z);
+    const float r = island_radius(x, z, at);
     return std::max(bed, params_.bank_height * (1.0f - r * r));
   }
   // Bank: rises to bank_height over a few metres, then the valley floor climbs to the walls.
@@ -126,18 +137,30 @@ float ProceduralRiver::terrain_height(float x, float z) const {
 }
 
 float ProceduralRiver::island_radius(float x, float z) const {
+  return island_radius(x, z, across_at(z));
+}
+
+float ProceduralRiver::island_radius(float x, float z, const Across& at) const {
   float nearest = std::numeric_limits<float>::max();
   for (const ProceduralIsland& island : params_.islands) {
     const float along = (z - island.center_z) / (0.5f * island.length);
     if (std::abs(along) >= 2.0f) continue;  // the shelf reaches no further
-    const float across = (lateral_distance(x, z) - island.offset) / (0.5f * island.width);
+    const float across = (lateral_distance(x, at) - island.offset) / (0.5f * island.width);
     nearest = std::min(nearest, std::sqrt(along * along + across * across));
   }
   return nearest;
 }
 
-float ProceduralRiver::depth_at(float x, float z) const {
-  return std::max(0.0f, water_level() - terrain_height(x, z));
+float ProceduralRiver::depth_at(float x, float z) const { return depth_at(x, z, across_at(z)); }
+
+float ProceduralRiver::depth_at(float x, float z, const Across& at) const {
+  return std::max(0.0f, water_level() - terrain_height(x, z, at));
+}
+
+float ProceduralRiver::bed_slope(float x, float z, const Across& at) const {
+  const float dx = terrain_height(x + kSlopeStep, z, at) - terrain_height(x - kSlopeStep, z, at);
+  const float dz = terrain_height(x, z + kSlopeStep) - terrain_height(x, z - kSlopeStep);
+  return std::sqrt(dx * dx + dz * dz) / (2.0f * kSlopeStep);
 }
 
 Status ProceduralRiver::validate(const ProceduralRiverParams& p) {
@@ -252,10 +275,13 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
       1024, size_t{1} << 22);
   std::vector<double> arc(samples + 1, 0.0);
   auto z_of = [&](size_t i) { return -half_length + params_.length * double(i) / double(samples); };
+  double x_before = centre_x(z_of(0));
   for (size_t i = 1; i <= samples; ++i) {
+    const double x = centre_x(z_of(i));
     const double dz = z_of(i) - z_of(i - 1);
-    const double dx = centre_x(z_of(i)) - centre_x(z_of(i - 1));
+    const double dx = x - x_before;
     arc[i] = arc[i - 1] + std::sqrt(dx * dx + dz * dz);
+    x_before = x;
   }
   const double total = arc.back();
   const uint32_t section_count =
@@ -299,12 +325,9 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
   mesh.vertices_across = across;
   const size_t vertex_count = size_t{section_count} * (across + (params_.confluence ? 1 : 0));
   mesh.positions.reserve(vertex_count);
-  mesh.depth.reserve(vertex_count);
   const float y = water_level();
   auto place = [&](const Frame& f, double offset) {
-    const glm::vec3 p(float(f.x + offset * f.left.x), y, float(f.z + offset * f.left.y));
-    mesh.positions.push_back(p);
-    mesh.depth.push_back(depth_at(p.x, p.z));
+    mesh.positions.emplace_back(float(f.x + offset * f.left.x), y, float(f.z + offset * f.left.y));
     return static_cast<uint32_t>(mesh.positions.size() - 1);
   };
   // Two triangles per quad between a section (a, left to right) and the next downstream (c),
@@ -376,6 +399,16 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
                  {left[j_tip / 2], true, float(top.half_width * (1.0 - tongue_fraction_))},
                  {right[right.size() / 2], true, float(top.half_width * (1.0 + tongue_fraction_))}};
   }
+  // Last, once the islands are cut: each vertex's depth and bed slope read the centreline at its
+  // z once.
+  mesh.depth.resize(mesh.positions.size());
+  mesh.slope.resize(mesh.positions.size());
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    const glm::vec3& p = mesh.positions[v];
+    const Across at = across_at(p.z);
+    mesh.depth[v] = depth_at(p.x, p.z, at);
+    mesh.slope[v] = bed_slope(p.x, p.z, at);
+  }
   *out = std::move(mesh);
   return Status::success();
 }
@@ -439,7 +472,7 @@ Status ProceduralRiver::cut_islands(RiverMesh* mesh) const {
   }
   cut_grid_quads(
       across, [&](uint32_t k, uint32_t j) { return owner[size_t{k} * (across - 1) + j] >= 0; },
-      &mesh->positions, &mesh->indices, &mesh->depth);
+      &mesh->positions, &mesh->indices);
   return Status::success();
 }
 

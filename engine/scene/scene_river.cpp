@@ -310,7 +310,8 @@ Status scene_river_data(const SceneFile* scene, size_t river_index, SceneRiverDa
   SceneRiverData data;
   SIVIFLOW_TRY(scene_river_shape(scene, river_index, &data));
   if (data.procedural) {
-    Status status = procedural_river_mesh(*data.procedural, &data.mesh, &data.slope);
+    Status status = data.procedural->generate_mesh(&data.mesh);
+    data.slope = std::move(data.mesh.slope);
     if (status.ok() && scene != nullptr) {
       status = resolve_ends(scene->rivers[river_index], data.mesh.positions, &data.ends);
     }

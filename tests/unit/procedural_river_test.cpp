@@ -138,6 +138,41 @@ TEST(ProceduralRiver, AConfluenceJoinsTwoTributaries) {
   }
 }
 
+// Each vertex's depth and bed slope are the terrain's under it, as the public profiles give them
+// (the mesh reads the centreline once a vertex, to the same bits): in a strip, around an island
+// and at a confluence. Across the bowl of the bed the slope grows from the middle to the banks.
+TEST(ProceduralRiver, EveryVertexsDepthAndSlopeAreTheTerrainsUnderIt) {
+  ProceduralRiverParams strip, island, confluence;
+  strip.vertices_across = 9;
+  island.vertices_across = 25;
+  island.width = 20.0f;
+  island.width_variation = 0.0f;
+  island.islands = {{10.0f, 2.0f, 30.0f, 6.0f}};
+  confluence.vertices_across = 25;
+  confluence.width = 20.0f;
+  confluence.meander_amplitude = 3.0f;
+  confluence.confluence = ProceduralConfluence{-40.0f, 2.5f, 30.0f};
+  for (const ProceduralRiverParams& params : {strip, island, confluence}) {
+    const ProceduralRiver river(params);
+    RiverMesh mesh;
+    ASSERT_TRUE(river.generate_mesh(&mesh).ok());
+    ASSERT_EQ(mesh.slope.size(), mesh.positions.size());
+    ASSERT_EQ(mesh.depth.size(), mesh.positions.size());
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+      const float x = mesh.positions[v].x, z = mesh.positions[v].z, h = 0.5f;
+      const float dx = river.terrain_height(x + h, z) - river.terrain_height(x - h, z);
+      const float dz = river.terrain_height(x, z + h) - river.terrain_height(x, z - h);
+      ASSERT_EQ(mesh.slope[v], std::sqrt(dx * dx + dz * dz) / (2.0f * h)) << "vertex " << v;
+      ASSERT_EQ(mesh.depth[v], river.depth_at(x, z)) << "vertex " << v;
+    }
+  }
+  RiverMesh mesh;
+  ASSERT_TRUE(ProceduralRiver(strip).generate_mesh(&mesh).ok());
+  const size_t k = 9 * (mesh.section_count / 2);  // a section halfway down
+  EXPECT_LT(mesh.slope[k + 4], 0.5f * mesh.slope[k + 1]);
+  EXPECT_LT(mesh.slope[k + 4], 0.5f * mesh.slope[k + 7]);
+}
+
 TEST(ProceduralRiver, ABadConfluenceNamesItsParameter) {
   for (const auto& [confluence, key] :
        {std::pair{ProceduralConfluence{0.0f, 0.0f, 0.0f}, "confluence.angle_deg"},

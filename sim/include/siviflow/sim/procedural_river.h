@@ -71,6 +71,7 @@ struct RiverMesh {
   std::vector<glm::vec3> positions;
   std::vector<uint32_t> indices;     // triangles, counter-clockwise seen from +Y
   std::vector<float> depth;          // water depth under each vertex, metres, >= 0
+  std::vector<float> slope;          // the riverbed's slope under each vertex (rise / run, >= 0)
   uint32_t section_count = 0;
   uint32_t vertices_across = 0;
   // With a confluence, its three ends (the outflow first), for RiverSurfaceOptions::ends; else
@@ -113,6 +114,20 @@ class ProceduralRiver {
   double centre_x(double z) const;
   double centre_slope(double z) const;  // dx/dz, analytic
   double width(double z) const;
+  // What the terrain reads of the centreline at one z: found once for all the points at that z
+  // (a vertex and the samples of its slope across the flow), the trigonometry being most of it.
+  struct Across {
+    double centre_x;
+    double slope;  // dx/dz
+    float width;
+  };
+  Across across_at(float z) const { return {centre_x(z), centre_slope(z), width_at(z)}; }
+  float lateral_distance(float x, const Across& at) const;
+  float terrain_height(float x, float z, const Across& at) const;
+  float depth_at(float x, float z, const Across& at) const;
+  float island_radius(float x, float z, const Across& at) const;
+  // The riverbed's slope at (x, z) by central differences.
+  float bed_slope(float x, float z, const Across& at) const;
   // Cuts the islands' quads out of `mesh` (a full grid strip), naming an island too close to a
   // bank, an end or another island.
   Status cut_islands(RiverMesh* mesh) const;
