@@ -511,6 +511,26 @@ TEST(StreamFunctionIncremental, AddTurnAndRemoveEqualFullResolve) {
   EXPECT_FALSE(live.replace_obstacle(0, boat).ok());
 }
 
+// No obstacles set on a field that has none leaves it as it is, the free flow a full solve would
+// give, reported as a full solve; set after some, they are all taken away, bit for bit.
+TEST(StreamFunctionIncremental, NoObstaclesSetEqualTheFreeFlowReportedAsAFullSolve) {
+  using C = CylinderCase;
+  const TestMesh mesh = test::straight_channel(C::kWidth, 80.0f, 161, 21);
+  const FlowParams params{C::kQ, 1.5f, 12.0f};
+  const StreamFunction free_flow = make_flow(mesh, params);
+  StreamFunction none = make_flow(mesh, params);
+  ASSERT_TRUE(none.set_obstacles({}).ok());
+  expect_same_field(none, free_flow);
+  EXPECT_EQ(none.last_update().nodes_resolved, none.surface().node_count());
+  EXPECT_EQ(none.last_update().triangles_updated, none.surface().triangle_count());
+  StreamFunction cleared = make_flow(mesh, params);
+  ASSERT_TRUE(cleared.set_obstacles({C::cylinder({-2.0f, 0.0f, 20.0f})}).ok());
+  ASSERT_TRUE(cleared.set_obstacles({}).ok());
+  EXPECT_TRUE(cleared.obstacles().empty());
+  expect_same_field(cleared, free_flow);
+  EXPECT_EQ(cleared.last_update().nodes_resolved, cleared.surface().node_count());
+}
+
 TEST(StreamFunction, Deterministic) {
   ProceduralRiverParams params;
   params.length = 80.0f;

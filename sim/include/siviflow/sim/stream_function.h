@@ -67,8 +67,9 @@ class StreamFunction {
   const FlowParams& params() const { return params_; }  // search_radius resolved
   float search_radius() const { return params_.search_radius; }
 
-  // Replaces the obstacles, places the keyframed ones at `time`, and re-solves everything.
-  // On failure (naming the obstacle) the previous obstacles stay.
+  // Replaces the obstacles, places the keyframed ones at `time`, and re-solves everything (where
+  // there were none and are none, the field already is that solve). On failure (naming the
+  // obstacle) the previous obstacles stay.
   Status set_obstacles(std::vector<Obstacle> obstacles, double time = 0.0);
   std::span<const Obstacle> obstacles() const { return obstacles_; }
   // Moves obstacle `index` to `centre` and re-solves only the vertices within s of its old or
