@@ -237,7 +237,7 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     tasks.push_back({left, task.begin, mid, task.depth + 1});
   }
   // The order from each leaf's base: in 1 byte an entry where every leaf's triangles lie within
-  // 256 of its lowest (its base, which the node's upper 24 bits must hold); else in 2 where they
+  // 255 of its lowest (its base, which the node's upper 24 bits must hold); else in 2 where they
   // lie within 65536 of the lowest rounded down to a multiple of 256; else in 4, no bases.
   const auto leaf_range = [&](const Node& n) {
     uint32_t lo = UINT32_MAX, hi = 0;
@@ -247,13 +247,13 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     }
     return std::pair{lo, hi};
   };
-  constexpr uint32_t kByte = std::numeric_limits<uint8_t>::max();
+  constexpr uint32_t kMaxByteEntry = std::numeric_limits<uint8_t>::max();
   uint32_t leaves = 0, wide = 0, spread16 = 0;  // spread16: the largest 2-byte entry
   for (const Node& n : bvh.nodes_) {
     if (n.leaf == 0) continue;
     const auto [lo, hi] = leaf_range(n);
     ++leaves;
-    wide += hi - lo > kByte ? 1 : 0;
+    wide += hi - lo > kMaxByteEntry ? 1 : 0;
     spread16 = std::max(spread16, hi - (lo & ~0xffu));
   }
   const bool bytes_address = tri_count <= (size_t{1} << 24);
@@ -262,7 +262,8 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     // every leaf's fit a byte (the children are appended, so this loop comes to them too).
     for (uint32_t k = 0; k < bvh.nodes_.size(); ++k) {
       const Node n = bvh.nodes_[k];
-      if (n.leaf == 0 || leaf_range(n).second - leaf_range(n).first <= kByte) continue;
+      if (n.leaf == 0) continue;
+      if (const auto [lo, hi] = leaf_range(n); hi - lo <= kMaxByteEntry) continue;
       Ref* const begin = refs.data() + n.first;
       Ref* const end = begin + size_of(n);
       std::sort(begin, end, [](const Ref& a, const Ref& b) { return a.triangle < b.triangle; });
@@ -335,6 +336,7 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
       if (holds(nodes_[n.first])) stack[top++] = n.first;
       continue;
     }
+    uint32_t found = UINT32_MAX;
     for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
       const uint32_t tri = triangle_at(n, i);
       const glm::vec3& a = positions_[triangle_vertex(tri, 0)];
@@ -348,11 +350,13 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
       const double v = (px * e1z - e1x * pz) / det;
       const double w = (e0x * pz - px * e0z) / det;
       const double u = 1.0 - v - w;
-      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance) {
+      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance && tri < found) {
+        found = tri;
         *weights = glm::clamp(glm::dvec3(u, v, w), 0.0, 1.0);
-        return tri;
       }
     }
+    // The lowest match of the first leaf that has one: a leaf split by number keeps it.
+    if (found != UINT32_MAX) return found;
   }
   return UINT32_MAX;
 }

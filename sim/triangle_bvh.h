@@ -54,9 +54,10 @@ class TriangleBvh {
   bool any_hit(const glm::vec3& origin, const glm::vec3& direction, float t_min,
                float t_max) const;
 
-  // The triangle whose projection on the XZ plane holds (x, z) (the first the traversal meets
-  // where several do: the same every time), with its barycentric weights; UINT32_MAX when none
-  // does. In doubles: far from the origin a float difference would lose the centimetres.
+  // The triangle whose projection on the XZ plane holds (x, z) (where several do, the lowest
+  // numbered of the first leaf the traversal meets that holds one: the same every time, in
+  // whatever order a leaf keeps its triangles), with its barycentric weights; UINT32_MAX when
+  // none does. In doubles: far from the origin a float difference would lose the centimetres.
   uint32_t locate_xz(double x, double z, glm::dvec3* weights) const;
 
   // The vertex nearest to `p` (ties: the lower index) among the vertices within `radius` of it;
@@ -92,7 +93,7 @@ class TriangleBvh {
   std::span<const uint32_t> indices_;
   std::vector<Node> nodes_;
   // Triangle indices, leaf by leaf, from their leaf's base: in 1 byte each where every leaf's
-  // triangles lie within 256 of its lowest (a mesh whose triangles near in space are near in
+  // triangles lie within 255 of its lowest (a mesh whose triangles near in space are near in
   // number, as a river's), else in 2 where they fit, else the triangles themselves in 4. One
   // of the three is held.
   std::vector<uint8_t> order8_;

@@ -75,6 +75,18 @@ std::vector<uint32_t> shuffled_triangles(const test::TestMesh& mesh,
   return renumbered(mesh, *new_of_old);
 }
 
+// The hierarchy of a strip as numbered and of the same strip numbered at random, whose indices
+// it keeps (a hierarchy reads them in place).
+struct StripAndShuffled {
+  std::vector<uint32_t> new_of_old, shuffled;
+  TriangleBvh strip, mixed;
+};
+void build_strip_and_shuffled(const test::TestMesh& mesh, StripAndShuffled* out) {
+  out->shuffled = shuffled_triangles(mesh, &out->new_of_old);
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &out->strip).ok());
+  ASSERT_TRUE(TriangleBvh::build(mesh.positions, out->shuffled, &out->mixed).ok());
+}
+
 // Random rays down onto a strip of the given half width and length find the same triangle
 // (renumbered by new_of_old) at the same t in both hierarchies, and so does locate_xz.
 void expect_the_same_hits(const TriangleBvh& a, const TriangleBvh& b,
@@ -98,14 +110,11 @@ void expect_the_same_hits(const TriangleBvh& a, const TriangleBvh& b,
 // order keeps 2 bytes a triangle, and answers as the same strip numbered at random does (4).
 TEST(TriangleBvh, AWideStripKeepsATwoByteOrderAndTheSameHits) {
   const test::TestMesh mesh = test::straight_channel(200.0f, 400.0f, 401, 200);
-  std::vector<uint32_t> new_of_old;
-  const std::vector<uint32_t> shuffled = shuffled_triangles(mesh, &new_of_old);
-  TriangleBvh strip, mixed;
-  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &strip).ok());
-  ASSERT_TRUE(TriangleBvh::build(mesh.positions, shuffled, &mixed).ok());
-  EXPECT_EQ(strip.order_bytes(), 2);
-  EXPECT_EQ(mixed.order_bytes(), 4);
-  expect_the_same_hits(strip, mixed, new_of_old, 99.0f, 399.0f);
+  StripAndShuffled trees;
+  ASSERT_NO_FATAL_FAILURE(build_strip_and_shuffled(mesh, &trees));
+  EXPECT_EQ(trees.strip.order_bytes(), 2);
+  EXPECT_EQ(trees.mixed.order_bytes(), 4);
+  expect_the_same_hits(trees.strip, trees.mixed, trees.new_of_old, 99.0f, 399.0f);
 }
 
 // Twenty triangles swap numbers with ones 2 km downstream: the few leaves they fall in would
@@ -132,15 +141,38 @@ TEST(TriangleBvh, AFewTrianglesNumberedFarAwaySplitTheirLeavesAndKeepAOneByteOrd
 // the same t.
 TEST(TriangleBvh, TrianglesNumberedAtRandomKeepAFourByteOrderAndTheSameHits) {
   const test::TestMesh mesh = test::straight_channel(12.0f, 4000.0f, 4001, 13);
-  std::vector<uint32_t> new_of_old;
-  const std::vector<uint32_t> shuffled = shuffled_triangles(mesh, &new_of_old);
-  TriangleBvh strip, mixed;
-  ASSERT_TRUE(TriangleBvh::build(mesh.positions, mesh.indices, &strip).ok());
-  ASSERT_TRUE(TriangleBvh::build(mesh.positions, shuffled, &mixed).ok());
-  EXPECT_EQ(strip.order_bytes(), 1);
-  EXPECT_EQ(mixed.order_bytes(), 4);
-  EXPECT_GE(mixed.memory_bytes(), strip.memory_bytes() + 3 * new_of_old.size());
-  expect_the_same_hits(strip, mixed, new_of_old, 5.5f, 3999.0f);
+  StripAndShuffled trees;
+  ASSERT_NO_FATAL_FAILURE(build_strip_and_shuffled(mesh, &trees));
+  EXPECT_EQ(trees.strip.order_bytes(), 1);
+  EXPECT_EQ(trees.mixed.order_bytes(), 4);
+  EXPECT_GE(trees.mixed.memory_bytes(), trees.strip.memory_bytes() + 3 * trees.new_of_old.size());
+  expect_the_same_hits(trees.strip, trees.mixed, trees.new_of_old, 5.5f, 3999.0f);
+}
+
+// Each quad's two triangles (2q and 2q + 1) share an edge; at its midpoint both hold the point.
+// Numbered in order or with each pair's numbers swapped, a hierarchy answers with the pair's
+// lower number wherever the two share a leaf, whatever order the leaf keeps them in (a leaf
+// split by number sorts its triangles).
+TEST(TriangleBvh, APointOnAnEdgeTwoTrianglesShareBelongsToTheLowerNumber) {
+  const test::TestMesh mesh = test::straight_channel(12.0f, 400.0f, 401, 13);
+  std::vector<uint32_t> new_of_old(mesh.indices.size() / 3);
+  for (uint32_t t = 0; t < new_of_old.size(); ++t) new_of_old[t] = t ^ 1u;
+  const std::vector<uint32_t> swapped = renumbered(mesh, new_of_old);
+  for (const std::vector<uint32_t>* indices : {&mesh.indices, &swapped}) {
+    TriangleBvh bvh;
+    ASSERT_TRUE(TriangleBvh::build(mesh.positions, *indices, &bvh).ok());
+    uint32_t lower = 0, pairs = 0;
+    for (uint32_t t = 0; t + 1 < new_of_old.size(); t += 2, ++pairs) {
+      // Triangle 2q is (a, a + 1, b) and 2q + 1 is (a + 1, b + 1, b): they share a + 1 and b.
+      const glm::dvec3 p = 0.5 * (glm::dvec3(mesh.positions[mesh.indices[3 * t + 1]]) +
+                                  glm::dvec3(mesh.positions[mesh.indices[3 * t + 2]]));
+      glm::dvec3 weights;
+      const uint32_t found = bvh.locate_xz(p.x, p.z, &weights);
+      ASSERT_TRUE(found == t || found == t + 1) << "pair " << t << " found " << found;
+      lower += found == t ? 1 : 0;
+    }
+    EXPECT_GE(lower, pairs * 9 / 10) << (indices == &swapped ? "swapped" : "in order");
+  }
 }
 
 }  // namespace
