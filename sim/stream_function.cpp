@@ -455,8 +455,9 @@ Status StreamFunction::set_obstacles(std::vector<Obstacle> obstacles, double tim
   }
   for (size_t i = 0; i < obstacles.size(); ++i) SIVIFLOW_TRY(validate_obstacle(obstacles[i], i));
   if (obstacles.empty() && obstacles_.empty()) {
-    // None before and none now: the field already is the obstacle-free one a full solve would
-    // give again (a long river's whole flow), and is reported as one.
+    // None before (never, or all removed: the local updates end where a full solve does, bit for
+    // bit) and none now: the field already is the obstacle-free one a full solve would give again
+    // (a long river's whole flow), and is reported as one.
     stats_ = full_update(surface_.node_count(), surface_.triangle_count());
     return Status::success();
   }
