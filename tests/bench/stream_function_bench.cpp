@@ -232,7 +232,8 @@ BENCHMARK(BM_FullSolve)->Arg(10'000)->Arg(100'000)->Arg(1'000'000)->Arg(4'000'00
 BENCHMARK(BM_HierarchyBuild)->Arg(1'500'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MoveObstacle)->Arg(1'000'000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_LoadFlow)->ArgsProduct({{100'000}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_FoamAfterMove)->ArgsProduct({{100'000, 1'500'000}, {0, 1}, {0, 1}})
+BENCHMARK(BM_FoamAfterMove)
+    ->ArgsProduct({{100'000, 1'500'000}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

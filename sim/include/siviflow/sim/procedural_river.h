@@ -104,8 +104,9 @@ class ProceduralRiver {
   // Checks the parameters (ranges, sizes); the message names the parameter.
   static Status validate(const ProceduralRiverParams& params);
   // Builds the water-surface strip following the centreline and width profile, its islands cut
-  // out, with the riverbed's depth and slope under each vertex. Fails on bad parameters, when the meander is too tight for the width (sections would
-  // cross), or when an island comes within two cells of a bank, an end or another island.
+  // out, with the riverbed's depth and slope under each vertex. Fails on bad parameters, when the
+  // meander is too tight for the width (sections would cross), or when an island comes within two
+  // cells of a bank, an end or another island.
   Status generate_mesh(RiverMesh* out) const;
 
  private:
