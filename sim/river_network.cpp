@@ -44,7 +44,7 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
   // --- Corners and sides.
   std::vector<size_t> corners;
   for (size_t i = 0; i < w.loop.size(); ++i) {
-    if (w.angles[w.loop[i]] < kNetworkCornerMaxAngle) corners.push_back(i);
+    if (w.angles[i] < kNetworkCornerMaxAngle) corners.push_back(i);
   }
   std::string corner_names;
   for (const size_t c : corners)

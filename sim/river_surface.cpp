@@ -42,19 +42,21 @@ uint64_t hash_position(const glm::vec3& p) {
   return h;
 }
 
-// Sum of the triangle angles at every node: about 90 degrees at the four corners of a strip,
-// about 180 degrees along its banks and ends.
-std::vector<double> angle_sums(const std::vector<glm::vec3>& pos, const std::vector<uint32_t>& tris,
-                               const std::vector<uint8_t>& on_border) {
-  std::vector<double> sum(pos.size(), 0.0);
-  for (size_t t = 0; t < tris.size() / 3; ++t) {
-    for (int i = 0; i < 3; ++i) {
-      const uint32_t n = tris[3 * t + i];
-      if (!on_border[n]) continue;
-      const DVec3 p = to_d(pos[n]);
+// The water's angle at each node of a border loop, the sum of its triangles' angles there in
+// triangle order: about 90 degrees at the four corners of a strip, about 180 along its banks and
+// ends. Kept for the loop only: a long river's every node would hold 8 bytes at the build's peak.
+std::vector<double> loop_angles(const std::vector<glm::vec3>& pos,
+                                const std::vector<uint32_t>& tris, const TrianglesAround& node_tris,
+                                const std::vector<uint32_t>& loop) {
+  std::vector<double> sum(loop.size(), 0.0);
+  for (size_t k = 0; k < loop.size(); ++k) {
+    const uint32_t n = loop[k];
+    const DVec3 p = to_d(pos[n]);
+    for (const uint32_t t : node_tris.of(n)) {
+      const int i = tris[3 * t] == n ? 0 : tris[3 * t + 1] == n ? 1 : 2;
       const DVec3 u = glm::normalize(to_d(pos[tris[3 * t + (i + 1) % 3]]) - p);
       const DVec3 v = glm::normalize(to_d(pos[tris[3 * t + (i + 2) % 3]]) - p);
-      sum[n] += std::acos(std::clamp(glm::dot(u, v), -1.0, 1.0));
+      sum[k] += std::acos(std::clamp(glm::dot(u, v), -1.0, 1.0));
     }
   }
   return sum;
@@ -545,7 +547,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     }
   }
 
-  std::vector<double> angles = angle_sums(pos, tris, on_border);
+  std::vector<double> angles = loop_angles(pos, tris, node_tris, loop);
   Welded welded{pos,         tris,         node_tris, adj,  node_vertex, node_of_vertex,
                 island_loops, node_island, loop,      angles, vertex_count};
   if (options.ends.size() > 2) return build_network(welded, options, out);
@@ -556,7 +558,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   std::iota(corner_at.begin(), corner_at.end(), 0u);
   std::partial_sort(corner_at.begin(), corner_at.begin() + 4, corner_at.end(),
                     [&](uint32_t i, uint32_t j) {
-                      const double ai = angles[loop[i]], aj = angles[loop[j]];
+                      const double ai = angles[i], aj = angles[j];
                       return ai != aj ? ai < aj : loop[i] < loop[j];
                     });
   corner_at.resize(4);
@@ -605,9 +607,8 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   }
   if (!found) {
     // More corners than a strip's four, and no ends named: a network whose ends are found.
-    const size_t sharp = static_cast<size_t>(std::count_if(loop.begin(), loop.end(), [&](uint32_t n) {
-      return angles[n] < kNetworkCornerMaxAngle;
-    }));
+    const size_t sharp = static_cast<size_t>(std::count_if(
+        angles.begin(), angles.end(), [](double a) { return a < kNetworkCornerMaxAngle; }));
     std::string corners;
     for (const uint32_t c : corner_at) {
       corners += (corners.empty() ? "" : ", ") + vertex_name(view_for_names, loop[c]);
@@ -629,9 +630,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     return Status::error(as_strip);
   }
   const size_t section_count = layering.chain_start.size() - 1;
-  // Layered: the adjacency and the corners' angles are not read again.
-  adj = Csr();
-  angles = std::vector<double>();
+  adj = Csr();  // layered: not read again
 
   // --- Left and right: the left bank is on the +Y x downstream side.
   std::vector<DVec3> mid(section_count);

@@ -21,7 +21,7 @@ struct RiverSurface::Welded {
   std::vector<std::vector<uint32_t>>& island_loops;
   std::vector<uint32_t>& node_island;
   const std::vector<uint32_t>& loop;  // the outer border
-  const std::vector<double>& angles;  // the water's angle at every border node
+  const std::vector<double>& angles;  // the water's angle at each node of `loop`, in its order
   size_t vertex_count;
 };
 
