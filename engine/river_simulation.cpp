@@ -151,24 +151,32 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
                          const MeshHome& home) {
   mesh_ = std::move(river.mesh);
   slope_ = std::move(river.slope);
+  per_node_ = mesh_.positions.empty();
+  // The mesh's home and the ray-cast hierarchy come before the flow's arrays: a long river's
+  // copy into its home and the hierarchy's build scratch then meet 28 MB less of them.
+  if (home) {
+    PlacedMesh placed;
+    if (per_node_) {
+      SIVIFLOW_TRY(home(river.surface.node_positions(), river.surface.triangles(), &placed));
+      if (placed.positions.data() != nullptr) {
+        SIVIFLOW_TRY(river.surface.share_mesh(placed.positions, placed.indices));
+      }
+    } else {
+      SIVIFLOW_TRY(home(mesh_.positions, mesh_.indices, &placed));
+    }
+  }
+  // On the surface's arrays before they move into the flow: a moved vector's elements stay put.
+  auto bvh = std::make_shared<TriangleBvh>();
+  SIVIFLOW_TRY(TriangleBvh::build(per_node_ ? river.surface.node_positions() : mesh_.positions,
+                                  per_node_ ? river.surface.triangles() : mesh_.indices,
+                                  bvh.get()));
+  bvh_ = std::move(bvh);
   SIVIFLOW_TRY(StreamFunction::create(std::move(river.surface), flow, &flow_));
   for (const Obstacle& obstacle : obstacles) has_keys_ = has_keys_ || !obstacle.keys.empty();
   SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
   full_solves_ = 1;
   const RiverSurface& surface = flow_.surface();
   const size_t count = surface.vertex_count();
-  per_node_ = mesh_.positions.empty();
-  if (home) {
-    PlacedMesh placed;
-    if (per_node_) {
-      SIVIFLOW_TRY(home(surface.node_positions(), surface.triangles(), &placed));
-      if (placed.positions.data() != nullptr) {
-        SIVIFLOW_TRY(flow_.share_mesh(placed.positions, placed.indices));
-      }
-    } else {
-      SIVIFLOW_TRY(home(mesh_.positions, mesh_.indices, &placed));
-    }
-  }
   NodeSections section = surface.node_section();
   if (per_node_) {
     field_.positions = surface.node_positions();
@@ -184,9 +192,6 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
     field_.flow = velocity_copy_;
   }
   foam_.resize(count);
-  auto bvh = std::make_shared<TriangleBvh>();
-  SIVIFLOW_TRY(TriangleBvh::build(field_.positions, field_.indices, bvh.get()));
-  bvh_ = std::move(bvh);
   // The surface's, when its nodes are the vertices.
   const TrianglesAround* around = per_node_ ? &surface.triangles_around() : nullptr;
   SIVIFLOW_TRY(FoamField::create(field_.positions, field_.indices, section, bvh_.get(),
