@@ -239,13 +239,15 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
   // The order from each leaf's base: in 1 byte an entry where every leaf's triangles lie within
   // 255 of its lowest (its base, which the node's upper 24 bits must hold); else in 2 where they
   // lie within 65536 of the lowest rounded down to a multiple of 256; else in 4, no bases.
+  // Each leaf's triangles in ascending number: its range is its ends, a split of it parts the
+  // numbers, and locate_xz's first match in it is its lowest.
+  const auto by_number = [](const Ref& a, const Ref& b) { return a.triangle < b.triangle; };
+  for (const Node& n : bvh.nodes_) {
+    if (n.leaf != 0)
+      std::sort(refs.begin() + n.first, refs.begin() + n.first + size_of(n), by_number);
+  }
   const auto leaf_range = [&](const Node& n) {
-    uint32_t lo = UINT32_MAX, hi = 0;
-    for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
-      lo = std::min(lo, refs[i].triangle);
-      hi = std::max(hi, refs[i].triangle);
-    }
-    return std::pair{lo, hi};
+    return std::pair{refs[n.first].triangle, refs[n.first + size_of(n) - 1].triangle};
   };
   constexpr uint32_t kMaxByteEntry = std::numeric_limits<uint8_t>::max();
   uint32_t leaves = 0, wide = 0, spread16 = 0;  // spread16: the largest 2-byte entry
@@ -266,7 +268,6 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
       if (const auto [lo, hi] = leaf_range(n); hi - lo <= kMaxByteEntry) continue;
       Ref* const begin = refs.data() + n.first;
       Ref* const end = begin + size_of(n);
-      std::sort(begin, end, [](const Ref& a, const Ref& b) { return a.triangle < b.triangle; });
       Ref* cut = begin + 1;
       for (Ref* r = begin + 2; r < end; ++r) {
         if (r->triangle - (r - 1)->triangle > cut->triangle - (cut - 1)->triangle) cut = r;
@@ -336,8 +337,7 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
       if (holds(nodes_[n.first])) stack[top++] = n.first;
       continue;
     }
-    uint32_t found = UINT32_MAX;
-    for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {
+    for (uint32_t i = n.first; i < n.first + size_of(n); ++i) {  // ascending: the lowest first
       const uint32_t tri = triangle_at(n, i);
       const glm::vec3& a = positions_[triangle_vertex(tri, 0)];
       const glm::vec3& b = positions_[triangle_vertex(tri, 1)];
@@ -350,13 +350,11 @@ uint32_t TriangleBvh::locate_xz(double x, double z, glm::dvec3* weights) const {
       const double v = (px * e1z - e1x * pz) / det;
       const double w = (e0x * pz - px * e0z) / det;
       const double u = 1.0 - v - w;
-      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance && tri < found) {
-        found = tri;
+      if (u >= -kEdgeTolerance && v >= -kEdgeTolerance && w >= -kEdgeTolerance) {
         *weights = glm::clamp(glm::dvec3(u, v, w), 0.0, 1.0);
+        return tri;
       }
     }
-    // The lowest match of the first leaf that has one: a leaf split by number keeps it.
-    if (found != UINT32_MAX) return found;
   }
   return UINT32_MAX;
 }

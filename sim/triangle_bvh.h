@@ -55,9 +55,9 @@ class TriangleBvh {
                float t_max) const;
 
   // The triangle whose projection on the XZ plane holds (x, z) (where several do, the lowest
-  // numbered of the first leaf the traversal meets that holds one: the same every time, in
-  // whatever order a leaf keeps its triangles), with its barycentric weights; UINT32_MAX when
-  // none does. In doubles: far from the origin a float difference would lose the centimetres.
+  // numbered of the first leaf the traversal meets that holds one: the same every time, a leaf
+  // split by number or not), with its barycentric weights; UINT32_MAX when none does. In doubles:
+  // far from the origin a float difference would lose the centimetres.
   uint32_t locate_xz(double x, double z, glm::dvec3* weights) const;
 
   // The vertex nearest to `p` (ties: the lower index) among the vertices within `radius` of it;

@@ -150,28 +150,46 @@ TEST(TriangleBvh, TrianglesNumberedAtRandomKeepAFourByteOrderAndTheSameHits) {
 }
 
 // Each quad's two triangles (2q and 2q + 1) share an edge; at its midpoint both hold the point.
-// Numbered in order or with each pair's numbers swapped, a hierarchy answers with the pair's
-// lower number wherever the two share a leaf, whatever order the leaf keeps them in (a leaf
-// split by number sorts its triangles).
+// Numbered in order, with each pair's numbers swapped, or with a few far apart (their leaves
+// split by number), a hierarchy answers with the pair's lower number wherever the two share a
+// leaf, whatever order its build met them in: nearly every pair, and those in split leaves.
 TEST(TriangleBvh, APointOnAnEdgeTwoTrianglesShareBelongsToTheLowerNumber) {
-  const test::TestMesh mesh = test::straight_channel(12.0f, 400.0f, 401, 13);
-  std::vector<uint32_t> new_of_old(mesh.indices.size() / 3);
-  for (uint32_t t = 0; t < new_of_old.size(); ++t) new_of_old[t] = t ^ 1u;
-  const std::vector<uint32_t> swapped = renumbered(mesh, new_of_old);
-  for (const std::vector<uint32_t>* indices : {&mesh.indices, &swapped}) {
+  const test::TestMesh mesh = test::straight_channel(12.0f, 4000.0f, 4001, 13);
+  const uint32_t triangles = static_cast<uint32_t>(mesh.indices.size() / 3);
+  std::vector<uint32_t> in_order(triangles), pairs_swapped(triangles);
+  std::iota(in_order.begin(), in_order.end(), 0u);
+  for (uint32_t t = 0; t < triangles; ++t) pairs_swapped[t] = t ^ 1u;
+  std::vector<uint32_t> far_apart = in_order;
+  std::vector<bool> moved(triangles, false);
+  for (uint32_t t = 1000; t < 1000 + 20 * 997; t += 997) {
+    std::swap(far_apart[t], far_apart[t + 48000]);
+    moved[t] = moved[t + 48000] = true;
+  }
+  for (const std::vector<uint32_t>* new_of_old : {&in_order, &pairs_swapped, &far_apart}) {
+    const std::vector<uint32_t> indices = renumbered(mesh, *new_of_old);
     TriangleBvh bvh;
-    ASSERT_TRUE(TriangleBvh::build(mesh.positions, *indices, &bvh).ok());
-    uint32_t lower = 0, pairs = 0;
-    for (uint32_t t = 0; t + 1 < new_of_old.size(); t += 2, ++pairs) {
+    ASSERT_TRUE(TriangleBvh::build(mesh.positions, indices, &bvh).ok());
+    ASSERT_EQ(bvh.order_bytes(), 1);
+    uint32_t pairs = 0, lower = 0, moved_pairs = 0, moved_lower = 0;
+    for (uint32_t t = 0; t + 1 < triangles; t += 2, ++pairs) {
       // Triangle 2q is (a, a + 1, b) and 2q + 1 is (a + 1, b + 1, b): they share a + 1 and b.
       const glm::dvec3 p = 0.5 * (glm::dvec3(mesh.positions[mesh.indices[3 * t + 1]]) +
                                   glm::dvec3(mesh.positions[mesh.indices[3 * t + 2]]));
+      const uint32_t a = (*new_of_old)[t], b = (*new_of_old)[t + 1];
       glm::dvec3 weights;
       const uint32_t found = bvh.locate_xz(p.x, p.z, &weights);
-      ASSERT_TRUE(found == t || found == t + 1) << "pair " << t << " found " << found;
-      lower += found == t ? 1 : 0;
+      ASSERT_TRUE(found == a || found == b) << "pair " << t << " found " << found;
+      lower += found == std::min(a, b) ? 1 : 0;
+      if (moved[t] || moved[t + 1]) {
+        ++moved_pairs;
+        moved_lower += found == std::min(a, b) ? 1 : 0;
+      }
     }
-    EXPECT_GE(lower, pairs * 9 / 10) << (indices == &swapped ? "swapped" : "in order");
+    const char* numbering = new_of_old == &in_order        ? "in order"
+                            : new_of_old == &pairs_swapped ? "pairs swapped"
+                                                           : "far apart";
+    EXPECT_GE(lower, pairs * 9 / 10) << numbering;
+    EXPECT_GE(moved_lower, moved_pairs * 9 / 10) << numbering;
   }
 }
 
