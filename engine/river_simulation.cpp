@@ -152,6 +152,7 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   mesh_ = std::move(river.mesh);
   slope_ = std::move(river.slope);
   per_node_ = mesh_.positions.empty();
+  SIVIFLOW_TRY(StreamFunction::validate_params(flow));  // before the costly work below
   // The mesh's home and the ray-cast hierarchy come before the flow's arrays: a long river's
   // copy into its home and the hierarchy's build scratch then meet 28 MB less of them.
   if (home) {
@@ -170,10 +171,10 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
   SIVIFLOW_TRY(TriangleBvh::build(per_node_ ? river.surface.node_positions() : mesh_.positions,
                                   per_node_ ? river.surface.triangles() : mesh_.indices,
                                   bvh.get()));
-  bvh_ = std::move(bvh);
   SIVIFLOW_TRY(StreamFunction::create(std::move(river.surface), flow, &flow_));
   for (const Obstacle& obstacle : obstacles) has_keys_ = has_keys_ || !obstacle.keys.empty();
   SIVIFLOW_TRY(flow_.set_obstacles(std::move(obstacles), 0.0));
+  bvh_ = std::move(bvh);  // only now: on a failure above its arrays are gone with the surface
   full_solves_ = 1;
   const RiverSurface& surface = flow_.surface();
   const size_t count = surface.vertex_count();

@@ -45,8 +45,8 @@ Status SharedRiver::create(const DeviceTable& table, const VkAllocationCallbacks
   river->table = table;
   river->gpu = make_gpu_context(river->table, callbacks);
   StaticAssets& assets = river->assets;
-  // The mesh's buffers are made before the flow's ray-cast structure and foam: on a
-  // unified-memory device the flow then reads them and frees its own copy first.
+  // The mesh's buffers are made before the flow is solved: on a unified-memory device the solve,
+  // the ray-cast structure and the foam then read them, the flow's own copy freed first.
   const auto home = [&river, &assets](std::span<const glm::vec3> positions,
                                       std::span<const uint32_t> indices,
                                       RiverFlow::PlacedMesh* placed) {

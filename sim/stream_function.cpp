@@ -50,7 +50,7 @@ glm::vec3 pos_of(const RiverSurface& s, uint32_t n) { return s.node_positions()[
 
 }  // namespace
 
-Status StreamFunction::create(RiverSurface surface, const FlowParams& params, StreamFunction* out) {
+Status StreamFunction::validate_params(const FlowParams& params) {
   if (!std::isfinite(params.discharge)) {
     return Status::error(text_format("flow discharge %g is not finite", params.discharge));
   }
@@ -62,6 +62,11 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
         "flow search radius %g m: it must be positive (or 0 for %g x the widest section)",
         params.search_radius, kDefaultSearchRadiusFactor));
   }
+  return Status::success();
+}
+
+Status StreamFunction::create(RiverSurface surface, const FlowParams& params, StreamFunction* out) {
+  SIVIFLOW_TRY(validate_params(params));
   if (surface.node_count() == 0) return Status::error("the river surface is empty");
 
   StreamFunction f;

@@ -58,12 +58,11 @@ class StreamFunction {
   // Takes the surface and solves the obstacle-free field. Fails on bad parameters, or naming the
   // section and vertex, when an interior vertex does not have both banks within s.
   static Status create(RiverSurface surface, const FlowParams& params, StreamFunction* out);
+  // The checks of create() that need no surface: a finite discharge, p in (0, 16], a search
+  // radius >= 0. A caller with costly work before create() makes them first.
+  static Status validate_params(const FlowParams& params);
 
   const RiverSurface& surface() const { return surface_; }
-  // RiverSurface::share_mesh of its surface.
-  Status share_mesh(std::span<const glm::vec3> positions, std::span<const uint32_t> triangles) {
-    return surface_.share_mesh(positions, triangles);
-  }
   const FlowParams& params() const { return params_; }  // search_radius resolved
   float search_radius() const { return params_.search_radius; }
 
