@@ -67,7 +67,7 @@ const RiverMesh& river_with_islands(int64_t vertices) {
           return dk * dk + dj * dj < 1.0;
         },
         &slot->positions, &slot->indices, &slot->depth);
-    slot->slope.clear();  // the cut compacts the depth only; an empty slope reads as level
+    slot->slope.clear();  // the cut compacts the depth only: the slope, stale, is not read here
   }
   return *slot;
 }
