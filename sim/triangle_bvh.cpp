@@ -236,9 +236,6 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
     tasks.push_back({left + 1, mid, task.end, task.depth + 1});
     tasks.push_back({left, task.begin, mid, task.depth + 1});
   }
-  // The order from each leaf's base: in 1 byte an entry where every leaf's triangles lie within
-  // 255 of its lowest (its base, which the node's upper 24 bits must hold); else in 2 where they
-  // lie within 65536 of the lowest rounded down to a multiple of 256; else in 4, no bases.
   // Each leaf's triangles in ascending number: its range is its ends, a split of it parts the
   // numbers, and locate_xz's first match in it is its lowest.
   const auto by_number = [](const Ref& a, const Ref& b) { return a.triangle < b.triangle; };
@@ -249,6 +246,9 @@ Status TriangleBvh::build(std::span<const glm::vec3> positions, std::span<const 
   const auto leaf_range = [&](const Node& n) {
     return std::pair{refs[n.first].triangle, refs[n.first + size_of(n) - 1].triangle};
   };
+  // The order from each leaf's base: in 1 byte an entry where every leaf's triangles lie within
+  // 255 of its lowest (its base, which the node's upper 24 bits must hold); else in 2 where they
+  // lie within 65536 of the lowest rounded down to a multiple of 256; else in 4, no bases.
   constexpr uint32_t kMaxByteEntry = std::numeric_limits<uint8_t>::max();
   uint32_t leaves = 0, wide = 0, spread16 = 0;  // spread16: the largest 2-byte entry
   for (const Node& n : bvh.nodes_) {
