@@ -77,7 +77,6 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
   f.surface_ = std::move(surface);
   const RiverSurface& s = f.surface_;
   const size_t nodes = s.node_count();
-  const size_t tris = s.triangle_count();
   const double radius = f.params_.search_radius;
 
   // Eq. 2.1 is undefined with a single boundary in reach: every vertex not on a bank needs both.
@@ -124,16 +123,7 @@ Status StreamFunction::create(RiverSurface surface, const FlowParams& params, St
   std::sort(f.shore_tangent_.begin(), f.shore_tangent_.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
 
-  // No obstacles yet: the field is the obstacle-free one.
-  f.psi_.resize(nodes);
-  for (uint32_t n = 0; n < nodes; ++n) {
-    bool wet = true;
-    f.psi_[n] = f.evaluate(n, false, &wet);
-  }
-  f.wet_.assign(nodes, true);
-  f.node_velocity_.resize(nodes);
-  for (uint32_t n = 0; n < nodes; ++n) f.update_node_velocity(n);
-  f.stats_ = full_update(nodes, tris);
+  f.solve_all(false);  // no obstacles yet: the field is the obstacle-free one
   *out = std::move(f);
   return Status::success();
 }
@@ -262,20 +252,40 @@ bool StreamFunction::influences(const ObstacleState& st, size_t obstacle, uint32
   return footprint_distance(obstacles_[obstacle], xz(st.centre), xz(p)) < s;
 }
 
-StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t) const {
+double StreamFunction::node_psi(uint32_t n) const {
+  bool wet = true;
+  return evaluate(n, true, &wet);
+}
+
+float StreamFunction::triangle_area2(uint32_t t) const {
   const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
   const auto pos = surface_.node_positions();
   const DVec3 a(pos[tri[0]]), b(pos[tri[1]]), c(pos[tri[2]]);
   // 2 x area, as the P1 gradient wants it, rounded to float as the velocities are.
-  const auto area2 = static_cast<float>(glm::length(glm::cross(b - a, c - a)));
-  const double pa = psi_[tri[0]];
+  return static_cast<float>(glm::length(glm::cross(b - a, c - a)));
+}
+
+StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t,
+                                                           const std::array<double, 3>& psi) const {
+  const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
+  const auto pos = surface_.node_positions();
+  const DVec3 a(pos[tri[0]]), b(pos[tri[1]]), c(pos[tri[2]]);
+  const float area2 = triangle_area2(t);
   // grad(psi) x n = sum_i psi_i e_i / (2 area), e_i the edge opposite vertex i, counter-clockwise
   // about n; the edges sum to zero, so psi_a drops out (and with it the rounding of large psi).
-  const DVec3 g = (psi_[tri[1]] - pa) * (a - c) + (psi_[tri[2]] - pa) * (b - a);
+  const DVec3 g = (psi[1] - psi[0]) * (a - c) + (psi[2] - psi[0]) * (b - a);
   return {area2, glm::vec3(g / double{area2})};
 }
 
-glm::vec3 StreamFunction::triangle_velocity(uint32_t t) const { return triangle_flow(t).velocity; }
+template <class PsiOf>
+StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t, const PsiOf& psi_of) const {
+  const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
+  return triangle_flow(t, {psi_of(tri[0]), psi_of(tri[1]), psi_of(tri[2])});
+}
+
+glm::vec3 StreamFunction::triangle_velocity(uint32_t t) const {
+  return triangle_flow(t, [this](uint32_t n) { return node_psi(n); }).velocity;
+}
 
 glm::vec3 StreamFunction::bank_tangent(uint32_t n) const {
   if (surface_.on_island(n) || surface_.network()) {
@@ -297,7 +307,8 @@ glm::vec3 StreamFunction::bank_tangent(uint32_t n) const {
   return glm::vec3(glm::normalize(DVec3(pos[shore(next)]) - DVec3(pos[shore(prev)])));
 }
 
-void StreamFunction::update_node_velocity(uint32_t n) {
+template <class PsiOf>
+void StreamFunction::update_node_velocity(uint32_t n, const PsiOf& psi_of) {
   if (!wet_[n]) {
     node_velocity_[n] = glm::vec3(0.0f);
     return;
@@ -305,7 +316,7 @@ void StreamFunction::update_node_velocity(uint32_t n) {
   DVec3 sum(0.0);
   double area = 0.0;
   for (const uint32_t t : surface_.node_triangles(n)) {
-    const TriangleFlow flow = triangle_flow(t);
+    const TriangleFlow flow = triangle_flow(t, psi_of);
     sum += double{flow.area2} * DVec3(flow.velocity);
     area += flow.area2;
   }
@@ -317,23 +328,27 @@ void StreamFunction::update_node_velocity(uint32_t n) {
 
 size_t StreamFunction::memory_bytes() const {
   const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  return surface_.memory_bytes() + bytes(psi_) + wet_.capacity() / 8 + bytes(node_velocity_) +
-         bytes(junctions_) + bytes(border_psi_) + bytes(end_discharge_) + bytes(shore_tangent_) +
-         bytes(obstacles_) + bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
+  return surface_.memory_bytes() + wet_.capacity() / 8 + bytes(node_velocity_) + bytes(junctions_) +
+         bytes(border_psi_) + bytes(end_discharge_) + bytes(shore_tangent_) + bytes(obstacles_) +
+         bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
          triangle_grid_.memory_bytes() + bytes(node_stamp_) + bytes(triangle_stamp_) +
-         bytes(scratch_nodes_) + bytes(scratch_triangles_);
+         bytes(scratch_nodes_) + bytes(scratch_triangles_) + bytes(psi_nodes_) + bytes(psi_values_);
 }
 
-void StreamFunction::solve_full() {
+void StreamFunction::solve_full() { solve_all(true); }
+
+void StreamFunction::solve_all(bool use_obstacles) {
   const size_t nodes = surface_.node_count();
-  psi_.resize(nodes);
+  std::vector<double> psi(nodes);
   wet_.resize(nodes);
   for (uint32_t n = 0; n < nodes; ++n) {
     bool wet = true;
-    psi_[n] = evaluate(n, true, &wet);
+    psi[n] = evaluate(n, use_obstacles, &wet);
     wet_[n] = wet;
   }
-  for (uint32_t n = 0; n < nodes; ++n) update_node_velocity(n);
+  node_velocity_.resize(nodes);
+  const auto psi_of = [&psi](uint32_t n) { return psi[n]; };
+  for (uint32_t n = 0; n < nodes; ++n) update_node_velocity(n, psi_of);
   stats_ = full_update(nodes, surface_.triangle_count());
 }
 
@@ -348,7 +363,7 @@ void StreamFunction::build_grids() {
   // Cells of about two triangle edges hold a few vertices each in the river, whatever its shape.
   double mean_area2 = 0.0;
   const size_t tris = surface_.triangle_count();
-  for (uint32_t t = 0; t < tris; ++t) mean_area2 += triangle_flow(t).area2;
+  for (uint32_t t = 0; t < tris; ++t) mean_area2 += triangle_area2(t);
   mean_area2 /= static_cast<double>(std::max<size_t>(tris, 1));
   const double cell = std::max(2.0 * std::sqrt(mean_area2), 1e-6 * surface_.extent());
   const size_t max_cells = static_cast<size_t>(kMaxGridCellsPerVertex * static_cast<double>(pos.size())) + 16;
@@ -582,11 +597,6 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
   }
   state_[j] = new_state;
   if (new_wet != old_wet) refresh_active();
-  for (const uint32_t n : scratch_nodes_) {
-    bool wet = true;
-    psi_[n] = evaluate(n, true, &wet);
-    wet_[n] = wet;
-  }
 
   // 2. The triangles around them, 3. the vertex velocities around those.
   scratch_triangles_.clear();
@@ -612,7 +622,6 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
       if (node_stamp_[n] != gen) {
         node_stamp_[n] = gen;
         scratch_nodes_.push_back(n);
-        update_node_velocity(n);
         const bool old_side =
             old_wet && (!new_wet || box_distance2(old_state.lo, old_state.hi, pos[n]) <=
                                         box_distance2(new_state.lo, new_state.hi, pos[n]));
@@ -620,6 +629,33 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
       }
     }
   }
+  // 4. psi (and wet) at the corners of their triangles: the re-solved nodes' anew, the others' as
+  // their last solve left them, since no obstacle reaching them changed.
+  gen = next_stamp();
+  psi_nodes_.clear();
+  for (const uint32_t n : scratch_nodes_) {
+    for (const uint32_t t : surface_.node_triangles(n)) {
+      for (int i = 0; i < 3; ++i) {
+        const uint32_t corner = tri[3 * size_t{t} + i];
+        if (node_stamp_[corner] != gen) {
+          node_stamp_[corner] = gen;
+          psi_nodes_.push_back(corner);
+        }
+      }
+    }
+  }
+  std::sort(psi_nodes_.begin(), psi_nodes_.end());
+  psi_values_.resize(psi_nodes_.size());
+  for (size_t i = 0; i < psi_nodes_.size(); ++i) {
+    bool wet = true;
+    psi_values_[i] = evaluate(psi_nodes_[i], true, &wet);
+    wet_[psi_nodes_[i]] = wet;
+  }
+  const auto psi_of = [this](uint32_t n) {
+    const auto at = std::lower_bound(psi_nodes_.begin(), psi_nodes_.end(), n);
+    return psi_values_[static_cast<size_t>(at - psi_nodes_.begin())];
+  };
+  for (const uint32_t n : scratch_nodes_) update_node_velocity(n, psi_of);
   for (const XzBox& box : {near_old, near_new}) {
     if (!box.empty()) stats_.velocity_changed.push_back(box);
   }

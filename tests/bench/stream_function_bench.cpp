@@ -115,7 +115,7 @@ void BM_LoadFlow(benchmark::State& state) {
       state.SkipWithError(("the river did not load: " + built.message()).c_str());
       return;
     }
-    benchmark::DoNotOptimize(flow.node_psi().data());
+    benchmark::DoNotOptimize(flow.node_velocity().data());
   }
   state.counters["islands"] = double(kind != 0 ? 10 : 0);
   state.counters["ends"] = double(kind == 2 ? 4 : 2);
@@ -140,7 +140,7 @@ void BM_FullSolve(benchmark::State& state) {
   if (!flow.set_obstacles({rock}).ok()) std::abort();
   for (auto _ : state) {
     flow.solve_full();
-    benchmark::DoNotOptimize(flow.node_psi().data());
+    benchmark::DoNotOptimize(flow.node_velocity().data());
   }
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(mesh.positions.size()));
 }

@@ -115,7 +115,7 @@ std::vector<ArmFlux> arm_fluxes(const StreamFunction& flow) {
       const double dx = std::abs(pa.x - pb.x);
       arm.width += dx;
       arm.from_vertices += 0.5 * double(flow.node_velocity()[a].z + flow.node_velocity()[b].z) * dx;
-      arm.from_triangles += std::abs(flow.node_psi()[a] - flow.node_psi()[b]);
+      arm.from_triangles += std::abs(flow.node_psi(a) - flow.node_psi(b));
       const bool last = i + 1 == nodes.size();
       if (!s.on_island(b) && !last) continue;
       const double end_psi = flow.border_psi(last ? kRightBankBorder : s.node(b).left_border);
@@ -178,7 +178,7 @@ TEST(IslandFlow, ARockMovedInAnArmEqualsAFreshSolve) {
     ASSERT_TRUE(fresh.set_obstacles({rock}).ok());
     EXPECT_EQ(test::nodes_that_differ(moved, fresh), 0u) << "rock at z = " << centre.z;
     for (const uint32_t n : moved.surface().island_nodes(0)) {
-      EXPECT_EQ(moved.node_psi()[n], moved.island_psi(0)) << "shore vertex " << n;
+      EXPECT_EQ(moved.node_psi(n), moved.island_psi(0)) << "shore vertex " << n;
     }
   }
 }

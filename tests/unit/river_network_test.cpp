@@ -68,7 +68,7 @@ double mesh_crossing(const StreamFunction& flow, float z, double value) {
   const RiverSurface& s = flow.surface();
   std::vector<std::pair<float, double>> row;
   for (uint32_t n = 0; n < s.node_count(); ++n) {
-    if (s.node_positions()[n].z == z) row.emplace_back(s.node_positions()[n].x, flow.node_psi()[n]);
+    if (s.node_positions()[n].z == z) row.emplace_back(s.node_positions()[n].x, flow.node_psi(n));
   }
   std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
   for (size_t i = 0; i + 1 < row.size(); ++i) {
@@ -166,7 +166,7 @@ TEST(RiverNetwork, EveryArmOfEverySectionCarriesItsDischarge) {
         const bool arm_ends =
             i == nodes.size() || triangle_on_edge(s, nodes[i - 1], nodes[i]) == UINT32_MAX;
         if (!arm_ends) continue;
-        const double expected = flow.node_psi()[nodes[first]] - flow.node_psi()[nodes[i - 1]];
+        const double expected = flow.node_psi(nodes[first]) - flow.node_psi(nodes[i - 1]);
         double by_vertices = 0.0;
         const double by_triangles = test::triangle_flux(flow, k, first, i - 1);
         for (size_t j = first; j + 1 < i; ++j) {

@@ -167,11 +167,18 @@ inline double vertex_flux(const StreamFunction& flow, size_t k) {
   return flux;
 }
 
+// psi at every node.
+inline std::vector<double> node_psis(const StreamFunction& flow) {
+  std::vector<double> psi(flow.surface().node_count());
+  for (uint32_t n = 0; n < psi.size(); ++n) psi[n] = flow.node_psi(n);
+  return psi;
+}
+
 // How many nodes' psi or velocity differ between two solves of one river.
 inline size_t nodes_that_differ(const StreamFunction& a, const StreamFunction& b) {
   size_t differ = 0;
-  for (size_t n = 0; n < a.node_psi().size(); ++n) {
-    differ += a.node_psi()[n] != b.node_psi()[n] || a.node_velocity()[n] != b.node_velocity()[n];
+  for (uint32_t n = 0; n < a.surface().node_count(); ++n) {
+    differ += a.node_psi(n) != b.node_psi(n) || a.node_velocity()[n] != b.node_velocity()[n];
   }
   return differ;
 }

@@ -212,8 +212,8 @@ TEST(StreamFunctionObstacle, CylinderInAStraightChannel) {
   for (uint32_t n = 0; n < s.node_count(); ++n) {
     const uint32_t m = node_at(-pos[n].x, pos[n].z);
     const uint32_t u = node_at(pos[n].x, C::kLength - pos[n].z);
-    EXPECT_NEAR(flow.node_psi()[n] + flow.node_psi()[m], C::kQ, 1e-5 * C::kQ);
-    EXPECT_NEAR(flow.node_psi()[n], flow.node_psi()[u], 1e-5 * C::kQ);
+    EXPECT_NEAR(flow.node_psi(n) + flow.node_psi(m), C::kQ, 1e-5 * C::kQ);
+    EXPECT_NEAR(flow.node_psi(n), flow.node_psi(u), 1e-5 * C::kQ);
     const glm::vec3 v = flow.node_velocity()[n], vm = flow.node_velocity()[m];
     const glm::vec3 vu = flow.node_velocity()[u];
     EXPECT_NEAR(v.z, vm.z, 1e-4f);
@@ -292,11 +292,11 @@ TEST(StreamFunctionObstacle, OnLandOrOutsideHasNoEffect) {
   using C = CylinderCase;
   StreamFunction flow = make_flow(test::straight_channel(C::kWidth, C::kLength, 41, 11),
                                   {C::kQ, 1.5f, 0.0f});
-  const std::vector<double> free(flow.node_psi().begin(), flow.node_psi().end());
+  const std::vector<double> free = test::node_psis(flow);
   ASSERT_TRUE(flow.set_obstacles({C::cylinder({9.0f, 0.0f, 20.0f}), C::cylinder({0.0f, 0.0f, -8.0f})}).ok());
   EXPECT_FALSE(flow.obstacle_in_water(0));
   EXPECT_FALSE(flow.obstacle_in_water(1));
-  for (uint32_t n = 0; n < flow.surface().node_count(); ++n) EXPECT_EQ(flow.node_psi()[n], free[n]);
+  for (uint32_t n = 0; n < flow.surface().node_count(); ++n) EXPECT_EQ(flow.node_psi(n), free[n]);
 }
 
 TEST(StreamFunctionObstacle, EnteringTheWaterDoesNotPop) {
@@ -305,24 +305,24 @@ TEST(StreamFunctionObstacle, EnteringTheWaterDoesNotPop) {
   using C = CylinderCase;
   StreamFunction flow = make_flow(test::straight_channel(C::kWidth, C::kLength, 41, 11),
                                   {C::kQ, 1.5f, 0.0f});
-  const std::vector<double> free(flow.node_psi().begin(), flow.node_psi().end());
+  const std::vector<double> free = test::node_psis(flow);
   ASSERT_TRUE(flow.set_obstacles({C::cylinder({5.0f + C::kRadius - 0.05f, 0.0f, 20.0f})}).ok());
   ASSERT_TRUE(flow.obstacle_in_water(0));
   EXPECT_EQ(flow.obstacle_bank(0), Bank::kLeft);
   EXPECT_NEAR(flow.obstacle_psi(0), C::kQ, 1e-6 * C::kQ);
   double worst = 0.0;
   for (uint32_t n = 0; n < flow.surface().node_count(); ++n) {
-    worst = std::max(worst, std::abs(flow.node_psi()[n] - free[n]));
+    worst = std::max(worst, std::abs(flow.node_psi(n) - free[n]));
   }
   EXPECT_LT(worst, 0.01 * C::kQ);
   // Sliding in further, the field changes smoothly with the position (no jumps).
-  std::vector<double> previous(flow.node_psi().begin(), flow.node_psi().end());
+  std::vector<double> previous = test::node_psis(flow);
   for (float x = 6.4f; x > 4.6f; x -= 0.1f) {
     ASSERT_TRUE(flow.move_obstacle(0, {x, 0.0f, 20.0f}).ok());
     double step = 0.0;
     for (uint32_t n = 0; n < flow.surface().node_count(); ++n) {
-      step = std::max(step, std::abs(flow.node_psi()[n] - previous[n]));
-      previous[n] = flow.node_psi()[n];
+      step = std::max(step, std::abs(flow.node_psi(n) - previous[n]));
+      previous[n] = flow.node_psi(n);
     }
     EXPECT_LT(step, 0.05 * C::kQ) << "x = " << x;
   }
@@ -338,7 +338,7 @@ TEST(StreamFunctionObstacle, CoveringTheWholeRiverStaysFinite) {
   huge.radius = 8.0f;  // spans both banks
   ASSERT_TRUE(flow.set_obstacles({huge}).ok());
   for (uint32_t n = 0; n < flow.surface().node_count(); ++n) {
-    EXPECT_TRUE(std::isfinite(flow.node_psi()[n]));
+    EXPECT_TRUE(std::isfinite(flow.node_psi(n)));
     const glm::vec3 v = flow.node_velocity()[n];
     EXPECT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z));
   }
@@ -371,11 +371,11 @@ TEST(StreamFunctionObstacle, BadObstacles) {
 
 // --- Memory -------------------------------------------------------------------------------------
 
-// A long river's flow keeps only what a re-solve needs per node and triangle: the obstacle-free
-// psi, the triangles' areas and velocities, node areas and bank tangents are derived when asked
-// (no vertex maps either: the procedural mesh welds nothing). About 63 bytes a node for the
-// surface (its lists in 2 bytes an entry, no list of its sections' nodes: 81 before, 89 before
-// that) and 21 for the flow on a 13-vertex-wide strip (79 before).
+// A long river's flow keeps only what a re-solve needs per node and triangle: psi, the
+// triangles' areas and velocities, node areas and bank tangents are derived when asked (no
+// vertex maps either: the procedural mesh welds nothing). About 63 bytes a node for the surface
+// (its lists in 2 bytes an entry, no list of its sections' nodes: 81 before, 89 before that) and
+// 13 for the flow on a 13-vertex-wide strip (21 with psi kept, 79 before).
 TEST(StreamFunctionMemory, KeepsNoBuildOnlyArrays) {
   ProceduralRiverParams params;
   params.length = 2000.0f;
@@ -388,20 +388,20 @@ TEST(StreamFunctionMemory, KeepsNoBuildOnlyArrays) {
   EXPECT_LE(surface_bytes / nodes, 65.0);
   StreamFunction flow;
   ASSERT_TRUE(StreamFunction::create(std::move(surface), {20.0f}, &flow).ok());
-  EXPECT_LE((static_cast<double>(flow.memory_bytes()) - surface_bytes) / nodes, 24.0);
-  // What is derived equals what was stored: the obstacle-free psi is psi without obstacles.
+  EXPECT_LE((static_cast<double>(flow.memory_bytes()) - surface_bytes) / nodes, 14.0);
+  // Without obstacles, psi under the obstacles is the obstacle-free psi.
   for (uint32_t n = 0; n < flow.surface().node_count(); n += 97) {
-    EXPECT_EQ(flow.node_psi_free(n), flow.node_psi()[n]);
+    EXPECT_EQ(flow.node_psi_free(n), flow.node_psi(n));
   }
 }
 
 // --- Incremental re-solves -----------------------------------------------------------------------
 
 void expect_same_field(const StreamFunction& a, const StreamFunction& b) {
-  ASSERT_EQ(a.node_psi().size(), b.node_psi().size());
+  ASSERT_EQ(a.surface().node_count(), b.surface().node_count());
   size_t psi_diff = 0, vel_diff = 0, wet_diff = 0, tri_diff = 0;
-  for (size_t n = 0; n < a.node_psi().size(); ++n) {
-    psi_diff += a.node_psi()[n] != b.node_psi()[n];
+  for (uint32_t n = 0; n < a.surface().node_count(); ++n) {
+    psi_diff += a.node_psi(n) != b.node_psi(n);
     vel_diff += a.node_velocity()[n] != b.node_velocity()[n];
     wet_diff += a.node_wet()[n] != b.node_wet()[n];
   }

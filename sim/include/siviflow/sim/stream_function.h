@@ -15,13 +15,13 @@
 // vertex (a bank is a streamline), zero on a dry vertex (inside an obstacle).
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 #include <span>
 #include <utility>
 #include <vector>
-
-#include <glm/vec2.hpp>
-#include <glm/vec3.hpp>
 
 #include "siviflow/sim/obstacle.h"
 #include "siviflow/sim/river_surface.h"
@@ -44,7 +44,7 @@ struct FlowParams {
 
 // What the last update re-solved (a full solve counts everything).
 struct FlowUpdateStats {
-  size_t nodes_resolved = 0;     // psi evaluated
+  size_t nodes_resolved = 0;     // psi re-solved (within reach of an obstacle that moved)
   size_t triangles_updated = 0;  // triangle velocities recomputed
   size_t nodes_velocity = 0;     // vertex velocities recomputed
   // Boxes holding every node whose velocity was recomputed, one about each place an obstacle
@@ -92,12 +92,14 @@ class StreamFunction {
   size_t memory_bytes() const;
 
   // --- Per input vertex.
-  double psi(size_t vertex) const { return psi_[surface_.node_of(vertex)]; }
+  double psi(size_t vertex) const { return node_psi(surface_.node_of(vertex)); }
   glm::vec3 velocity(size_t vertex) const { return node_velocity_[surface_.node_of(vertex)]; }
   bool wet(size_t vertex) const { return wet_[surface_.node_of(vertex)]; }
 
   // --- Per node (RiverSurface node indices) and per triangle (RiverSurface::triangles()).
-  std::span<const double> node_psi() const { return psi_; }
+  // Evaluated when asked, under the obstacles where they are (a long river cannot keep 8 bytes
+  // per node for it): the value the last solve used, bit for bit.
+  double node_psi(uint32_t n) const;
   double node_psi_free(uint32_t n) const;  // without obstacles
   std::span<const glm::vec3> node_velocity() const { return node_velocity_; }
   const std::vector<bool>& node_wet() const { return wet_; }
@@ -138,8 +140,19 @@ class StreamFunction {
     float area2;         // 2 x area
     glm::vec3 velocity;  // grad(psi) x n
   };
-  TriangleFlow triangle_flow(uint32_t t) const;
-  void update_node_velocity(uint32_t n);
+  float triangle_area2(uint32_t t) const;
+  // From psi at the triangle's corners. Out of line: inlined into the velocity's sum, GCC 12 at
+  // -O3 kept the velocity's x and y in double (its rounding to float dropped), and a node's
+  // velocity would hang on the caller it was inlined into, a full solve against an update.
+  [[gnu::noinline]] TriangleFlow triangle_flow(uint32_t t, const std::array<double, 3>& psi) const;
+  // `psi_of(node)` gives psi at a node (the triangle's corners, a node's triangles' corners).
+  template <class PsiOf>
+  TriangleFlow triangle_flow(uint32_t t, const PsiOf& psi_of) const;
+  template <class PsiOf>
+  void update_node_velocity(uint32_t n, const PsiOf& psi_of);
+  // psi at every node from `evaluate(n, use_obstacles)` (and each node's wet), then every node's
+  // velocity from it; the psi is dropped after.
+  void solve_all(bool use_obstacles);
   // Unit, downstream, on a bank node (its section's shore); zero elsewhere.
   glm::vec3 bank_tangent(uint32_t n) const;
   void build_grids();
@@ -150,9 +163,9 @@ class StreamFunction {
 
   RiverSurface surface_;
   FlowParams params_;
-  // Only what a re-solve cannot cheaply recompute is kept per node: the obstacle-free psi, the
-  // triangles' areas and velocities, the node areas and bank tangents are derived when needed.
-  std::vector<double> psi_;
+  // Only what a re-solve cannot cheaply recompute is kept per node: psi (evaluated per node
+  // from the margin distances), the triangles' areas and velocities, the node areas and bank
+  // tangents are derived when needed.
   std::vector<bool> wet_;  // a bit a node
   std::vector<glm::vec3> node_velocity_;
   // Where arms of a network meet: the tips of the tongues between them in one section, and the
@@ -184,6 +197,10 @@ class StreamFunction {
   uint32_t stamp_ = 0;
   std::vector<uint32_t> scratch_nodes_;
   std::vector<uint32_t> scratch_triangles_;
+  // An update's psi: the corners of the triangles around the nodes whose velocity it
+  // recomputes, ascending, and their values.
+  std::vector<uint32_t> psi_nodes_;
+  std::vector<double> psi_values_;
   FlowUpdateStats stats_;
 };
 
