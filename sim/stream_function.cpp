@@ -46,6 +46,11 @@ double ratio_pow(double r, double p) {
 
 glm::dvec2 xz(const glm::vec3& v) { return {v.x, v.z}; }
 
+// 2 x a triangle's area, as the P1 gradient wants it, rounded to float as the velocities are.
+float area2_of(const DVec3& a, const DVec3& b, const DVec3& c) {
+  return static_cast<float>(glm::length(glm::cross(b - a, c - a)));
+}
+
 glm::vec3 pos_of(const RiverSurface& s, uint32_t n) { return s.node_positions()[n]; }
 
 }  // namespace
@@ -260,27 +265,25 @@ double StreamFunction::node_psi(uint32_t n) const {
 float StreamFunction::triangle_area2(uint32_t t) const {
   const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
   const auto pos = surface_.node_positions();
-  const DVec3 a(pos[tri[0]]), b(pos[tri[1]]), c(pos[tri[2]]);
-  // 2 x area, as the P1 gradient wants it, rounded to float as the velocities are.
-  return static_cast<float>(glm::length(glm::cross(b - a, c - a)));
+  return area2_of(DVec3(pos[tri[0]]), DVec3(pos[tri[1]]), DVec3(pos[tri[2]]));
 }
 
-StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t,
-                                                           const std::array<double, 3>& psi) const {
+StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t, double psi_a, double psi_b,
+                                                           double psi_c) const {
   const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
   const auto pos = surface_.node_positions();
   const DVec3 a(pos[tri[0]]), b(pos[tri[1]]), c(pos[tri[2]]);
-  const float area2 = triangle_area2(t);
+  const float area2 = area2_of(a, b, c);
   // grad(psi) x n = sum_i psi_i e_i / (2 area), e_i the edge opposite vertex i, counter-clockwise
   // about n; the edges sum to zero, so psi_a drops out (and with it the rounding of large psi).
-  const DVec3 g = (psi[1] - psi[0]) * (a - c) + (psi[2] - psi[0]) * (b - a);
-  return {area2, glm::vec3(g / double{area2})};
+  const DVec3 g = (psi_b - psi_a) * (a - c) + (psi_c - psi_a) * (b - a);
+  return {glm::vec3(g / double{area2}), area2};
 }
 
 template <class PsiOf>
 StreamFunction::TriangleFlow StreamFunction::triangle_flow(uint32_t t, const PsiOf& psi_of) const {
   const auto tri = surface_.triangles().subspan(3 * size_t{t}, 3);
-  return triangle_flow(t, {psi_of(tri[0]), psi_of(tri[1]), psi_of(tri[2])});
+  return triangle_flow(t, psi_of(tri[0]), psi_of(tri[1]), psi_of(tri[2]));
 }
 
 glm::vec3 StreamFunction::triangle_velocity(uint32_t t) const {
@@ -332,7 +335,7 @@ size_t StreamFunction::memory_bytes() const {
          bytes(border_psi_) + bytes(end_discharge_) + bytes(shore_tangent_) + bytes(obstacles_) +
          bytes(state_) + bytes(active_) + node_grid_.memory_bytes() +
          triangle_grid_.memory_bytes() + bytes(node_stamp_) + bytes(triangle_stamp_) +
-         bytes(scratch_nodes_) + bytes(scratch_triangles_) + bytes(psi_nodes_) + bytes(psi_values_);
+         bytes(scratch_nodes_) + bytes(scratch_triangles_) + bytes(psi_values_);
 }
 
 void StreamFunction::solve_full() { solve_all(true); }
@@ -564,15 +567,19 @@ Status StreamFunction::set_time(double t) {
 
 void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) {
   const double s = params_.search_radius;
-  // Fresh generation stamps (on wrap-around, clear them).
-  auto next_stamp = [&] {
-    if (++stamp_ == 0) {
+  // `count` fresh generation stamps, the first returned (where they would wrap around, the stamps
+  // are cleared first).
+  auto fresh_stamps = [&](size_t count) {
+    if (stamp_ > std::numeric_limits<uint32_t>::max() - count) {
       std::fill(node_stamp_.begin(), node_stamp_.end(), 0u);
       std::fill(triangle_stamp_.begin(), triangle_stamp_.end(), 0u);
-      stamp_ = 1;
+      stamp_ = 0;
     }
-    return stamp_;
+    const uint32_t first = stamp_ + 1;
+    stamp_ += static_cast<uint32_t>(count);
+    return first;
   };
+  auto next_stamp = [&] { return fresh_stamps(1); };
 
   // 1. The vertices within s of the old or of the new footprint, in one sweep of the grid over
   // both boxes (a drifting object's old and new reach mostly overlap).
@@ -630,31 +637,23 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
     }
   }
   // 4. psi (and wet) at the corners of their triangles: the re-solved nodes' anew, the others' as
-  // their last solve left them, since no obstacle reaching them changed.
-  gen = next_stamp();
-  psi_nodes_.clear();
+  // their last solve left them, since no obstacle reaching them changed. A corner's stamp is its
+  // own, base + its place among the values: it marks the corner and finds its psi.
+  const uint32_t base = fresh_stamps(surface_.node_count());
+  psi_values_.clear();
   for (const uint32_t n : scratch_nodes_) {
     for (const uint32_t t : surface_.node_triangles(n)) {
       for (int i = 0; i < 3; ++i) {
         const uint32_t corner = tri[3 * size_t{t} + i];
-        if (node_stamp_[corner] != gen) {
-          node_stamp_[corner] = gen;
-          psi_nodes_.push_back(corner);
-        }
+        if (node_stamp_[corner] >= base) continue;
+        node_stamp_[corner] = base + static_cast<uint32_t>(psi_values_.size());
+        bool wet = true;
+        psi_values_.push_back(evaluate(corner, true, &wet));
+        wet_[corner] = wet;
       }
     }
   }
-  std::sort(psi_nodes_.begin(), psi_nodes_.end());
-  psi_values_.resize(psi_nodes_.size());
-  for (size_t i = 0; i < psi_nodes_.size(); ++i) {
-    bool wet = true;
-    psi_values_[i] = evaluate(psi_nodes_[i], true, &wet);
-    wet_[psi_nodes_[i]] = wet;
-  }
-  const auto psi_of = [this](uint32_t n) {
-    const auto at = std::lower_bound(psi_nodes_.begin(), psi_nodes_.end(), n);
-    return psi_values_[static_cast<size_t>(at - psi_nodes_.begin())];
-  };
+  const auto psi_of = [&](uint32_t n) { return psi_values_[node_stamp_[n] - base]; };
   for (const uint32_t n : scratch_nodes_) update_node_velocity(n, psi_of);
   for (const XzBox& box : {near_old, near_new}) {
     if (!box.empty()) stats_.velocity_changed.push_back(box);

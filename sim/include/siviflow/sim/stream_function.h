@@ -15,7 +15,6 @@
 // vertex (a bank is a streamline), zero on a dry vertex (inside an obstacle).
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -136,15 +135,18 @@ class StreamFunction {
 
   double evaluate(uint32_t node, bool use_obstacles, bool* wet) const;
   bool influences(const ObstacleState& state, size_t obstacle, uint32_t node) const;
+  // The velocity first: returned in two registers, (x, y) and (z, area2), which the caller reads
+  // back whole (area2 first, x and y straddled them, and each read waited on both).
   struct TriangleFlow {
-    float area2;         // 2 x area
     glm::vec3 velocity;  // grad(psi) x n
+    float area2;         // 2 x area
   };
   float triangle_area2(uint32_t t) const;
   // From psi at the triangle's corners. Out of line: inlined into the velocity's sum, GCC 12 at
   // -O3 kept the velocity's x and y in double (its rounding to float dropped), and a node's
   // velocity would hang on the caller it was inlined into, a full solve against an update.
-  [[gnu::noinline]] TriangleFlow triangle_flow(uint32_t t, const std::array<double, 3>& psi) const;
+  [[gnu::noinline]] TriangleFlow triangle_flow(uint32_t t, double psi_a, double psi_b,
+                                               double psi_c) const;
   // `psi_of(node)` gives psi at a node (the triangle's corners, a node's triangles' corners).
   template <class PsiOf>
   TriangleFlow triangle_flow(uint32_t t, const PsiOf& psi_of) const;
@@ -197,9 +199,8 @@ class StreamFunction {
   uint32_t stamp_ = 0;
   std::vector<uint32_t> scratch_nodes_;
   std::vector<uint32_t> scratch_triangles_;
-  // An update's psi: the corners of the triangles around the nodes whose velocity it
-  // recomputes, ascending, and their values.
-  std::vector<uint32_t> psi_nodes_;
+  // An update's psi at the corners of the triangles around the nodes whose velocity it
+  // recomputes (each corner's found by its stamp).
   std::vector<double> psi_values_;
   FlowUpdateStats stats_;
 };
