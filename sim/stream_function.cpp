@@ -605,7 +605,7 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
   state_[j] = new_state;
   if (new_wet != old_wet) refresh_active();
 
-  // 2. The triangles around them, 3. the vertex velocities around those.
+  // 2. The triangles around them, 3. the nodes around those, whose velocities are re-derived.
   scratch_triangles_.clear();
   for (const uint32_t n : scratch_nodes_) {
     for (const uint32_t t : surface_.node_triangles(n)) {
@@ -639,7 +639,11 @@ void StreamFunction::move_incremental(size_t j, const ObstacleState& new_state) 
   // 4. psi (and wet) at the corners of their triangles: the re-solved nodes' anew, the others' as
   // their last solve left them, since no obstacle reaching them changed. A corner's stamp is its
   // own, base + its place among the values: it marks the corner and finds its psi.
-  const uint32_t base = fresh_stamps(surface_.node_count());
+  // As many stamps as there are corners to visit, not one a node: a river's stamps are cleared
+  // once the generations run out, and a move that reaches nothing uses none.
+  size_t corners = 0;
+  for (const uint32_t n : scratch_nodes_) corners += 3 * surface_.node_triangles(n).size();
+  const uint32_t base = fresh_stamps(corners);
   psi_values_.clear();
   for (const uint32_t n : scratch_nodes_) {
     for (const uint32_t t : surface_.node_triangles(n)) {

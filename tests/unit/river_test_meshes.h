@@ -174,7 +174,8 @@ inline std::vector<double> node_psis(const StreamFunction& flow) {
   return psi;
 }
 
-// How many nodes' psi or velocity differ between two solves of one river.
+// How many nodes' psi or velocity differ between two solves of one river (psi, evaluated when
+// asked, differs only where the obstacles do: the velocities tell the updates apart).
 inline size_t nodes_that_differ(const StreamFunction& a, const StreamFunction& b) {
   size_t differ = 0;
   for (uint32_t n = 0; n < a.surface().node_count(); ++n) {

@@ -397,6 +397,8 @@ TEST(StreamFunctionMemory, KeepsNoBuildOnlyArrays) {
 
 // --- Incremental re-solves -----------------------------------------------------------------------
 
+// psi is evaluated from the obstacles where they are, so its comparison holds for any two fields
+// under the same obstacles: the velocities', kept from each update, are what guard the updates.
 void expect_same_field(const StreamFunction& a, const StreamFunction& b) {
   ASSERT_EQ(a.surface().node_count(), b.surface().node_count());
   size_t psi_diff = 0, vel_diff = 0, wet_diff = 0, tri_diff = 0;

@@ -102,7 +102,8 @@ class StreamFunction {
   double node_psi_free(uint32_t n) const;  // without obstacles
   std::span<const glm::vec3> node_velocity() const { return node_velocity_; }
   const std::vector<bool>& node_wet() const { return wet_; }
-  // Computed when asked (a long river cannot keep 12 bytes per triangle for it).
+  // Computed when asked (a long river cannot keep 12 bytes per triangle for it), psi at each
+  // corner evaluated too.
   glm::vec3 triangle_velocity(uint32_t t) const;
 
   // --- Per island: psi on its shore. The discharge passing on its left is psi_left_border -
@@ -143,8 +144,9 @@ class StreamFunction {
   };
   float triangle_area2(uint32_t t) const;
   // From psi at the triangle's corners. Out of line: inlined into the velocity's sum, GCC 12 at
-  // -O3 kept the velocity's x and y in double (its rounding to float dropped), and a node's
-  // velocity would hang on the caller it was inlined into, a full solve against an update.
+  // -O3 kept the velocity's x and y in double (the disassembly multiplies g / area2 by area2 with
+  // no rounding to float between; likely a compiler bug, not reduced), so a node's velocity hung
+  // on its caller, a full solve against an update. Returned, the rounding is kept.
   [[gnu::noinline]] TriangleFlow triangle_flow(uint32_t t, double psi_a, double psi_b,
                                                double psi_c) const;
   // `psi_of(node)` gives psi at a node (the triangle's corners, a node's triangles' corners).
@@ -193,7 +195,8 @@ class StreamFunction {
   std::vector<uint32_t> active_;             // obstacles in the water, ascending
   XzGrid node_grid_;
   XzGrid triangle_grid_;
-  // Scratch for incremental updates: generation stamps avoid clearing per update.
+  // Scratch for incremental updates: generation stamps avoid clearing per update; an update's
+  // last stamps also place each corner's psi in psi_values_.
   std::vector<uint32_t> node_stamp_;
   std::vector<uint32_t> triangle_stamp_;
   uint32_t stamp_ = 0;
