@@ -402,11 +402,14 @@ Status RiverSurface::build_network(const Welded& w, const RiverSurfaceOptions& o
 
   // --- Wind every triangle counter-clockwise seen from above (+Y).
   std::vector<uint32_t>& tris = w.tris;
+  if (options.rewound != nullptr) options.rewound->assign(tris.size() / 3, false);
   for (size_t t = 0; t < tris.size() / 3; ++t) {
     uint32_t* tri = &tris[3 * t];
     const DVec3 a(pos[tri[0]]);
-    if (glm::cross(DVec3(pos[tri[1]]) - a, DVec3(pos[tri[2]]) - a).y < 0.0)
+    if (glm::cross(DVec3(pos[tri[1]]) - a, DVec3(pos[tri[2]]) - a).y < 0.0) {
       std::swap(tri[1], tri[2]);
+      if (options.rewound != nullptr) (*options.rewound)[t] = true;
+    }
   }
 
   if (node_count != w.vertex_count) {

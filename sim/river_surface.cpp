@@ -741,6 +741,7 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
   }
 
   // --- Wind every triangle counter-clockwise about the river's up: downstream x (left - right).
+  if (options.rewound != nullptr) options.rewound->assign(tri_count, false);
   for (size_t t = 0; t < tri_count; ++t) {
     uint32_t* tri = &tris[3 * t];
     const uint32_t k = std::min({s.node_section_[tri[0]], s.node_section_[tri[1]],
@@ -751,7 +752,10 @@ Status RiverSurface::build(std::span<const glm::vec3> positions, std::span<const
     const DVec3 up = glm::cross(mid[k + 1] - mid[k], across);
     const DVec3 a = to_d(pos[tri[0]]);
     const DVec3 normal = glm::cross(to_d(pos[tri[1]]) - a, to_d(pos[tri[2]]) - a);
-    if (glm::dot(normal, up) < 0.0) std::swap(tri[1], tri[2]);
+    if (glm::dot(normal, up) < 0.0) {
+      std::swap(tri[1], tri[2]);
+      if (options.rewound != nullptr) (*options.rewound)[t] = true;
+    }
   }
 
   // --- The two ends; a named outflow must lie on the downstream one.

@@ -113,6 +113,27 @@ TEST(RiverNetwork, AConfluenceHasThreeEndsTwoArmsAndATongue) {
               kShape.main_length + kShape.left_length, 0.05 * kShape.main_length);
 }
 
+// A network's build flags the triangles it wound otherwise, as a strip's does.
+TEST(RiverNetwork, RewoundFlagsTheTrianglesGivenClockwise) {
+  YMesh y = y_mesh();
+  const std::vector<uint32_t> input = y.mesh.indices;
+  for (size_t t = 0; t < y.mesh.indices.size() / 3; t += 2) {
+    std::swap(y.mesh.indices[3 * t + 1], y.mesh.indices[3 * t + 2]);
+  }
+  std::vector<bool> rewound;
+  RiverSurfaceOptions options = confluence_ends(y);
+  options.rewound = &rewound;
+  const RiverSurface s = surface_of(y, options);
+  ASSERT_EQ(rewound.size(), input.size() / 3);
+  std::vector<uint32_t> given_back(s.triangles().begin(), s.triangles().end());
+  for (size_t t = 0; t < rewound.size(); ++t) {
+    if (rewound[t]) std::swap(given_back[3 * t + 1], given_back[3 * t + 2]);
+  }
+  EXPECT_EQ(given_back, y.mesh.indices);
+  EXPECT_GT(std::ranges::count(rewound, true), 0);
+  EXPECT_LT(std::ranges::count(rewound, true), static_cast<long>(rewound.size()));
+}
+
 // The streamline parting the two inflows (psi = the tongue's) against the oracle's, row by row
 // from half a metre past the tip to 16 m on: within 3 % of the 8 m channel everywhere, so it leaves
 // from the tip and bends to where the discharges put it as potential flow does. With p = 1 and

@@ -290,6 +290,38 @@ TEST(RiverSurface, InputsAreNotReadAfterInputsRead) {
   EXPECT_EQ(calls, 0);
 }
 
+// `rewound` flags the triangles whose winding the build reversed: a triangle given the other way
+// round is flagged where it was not, and with their last two corners swapped back the
+// triangles are the input's indices.
+TEST(RiverSurface, RewoundFlagsTheTrianglesItWoundOtherwise) {
+  const TestMesh wound = test::bend(5.0f, 9.0f, 2.0f, 40, 7);
+  TestMesh mixed = wound;
+  std::vector<bool> reversed(mixed.indices.size() / 3, false);
+  for (size_t t = 0; t < reversed.size(); t += 3) {
+    std::swap(mixed.indices[3 * t + 1], mixed.indices[3 * t + 2]);
+    reversed[t] = true;
+  }
+  std::vector<bool> wound_flags;
+  RiverSurface plain;
+  RiverSurfaceOptions wound_options;
+  wound_options.rewound = &wound_flags;
+  ASSERT_TRUE(build(wound, &plain, wound_options).ok());
+  ASSERT_EQ(wound_flags.size(), reversed.size());
+  std::vector<bool> rewound;
+  RiverSurfaceOptions options;
+  options.rewound = &rewound;
+  RiverSurface s;
+  ASSERT_TRUE(build(mixed, &s, options).ok());
+  EXPECT_TRUE(std::ranges::equal(s.triangles(), plain.triangles()));
+  ASSERT_EQ(rewound.size(), reversed.size());
+  std::vector<uint32_t> given_back(s.triangles().begin(), s.triangles().end());
+  for (size_t t = 0; t < rewound.size(); ++t) {
+    EXPECT_EQ(rewound[t], wound_flags[t] != reversed[t]) << t;
+    if (rewound[t]) std::swap(given_back[3 * t + 1], given_back[3 * t + 2]);
+  }
+  EXPECT_EQ(given_back, mixed.indices);
+}
+
 TEST(RiverSurface, SharedMeshIsReadFromTheSharerAndFreesItsOwn) {
   const TestMesh m = test::bend(5.0f, 9.0f, 2.0f, 40, 7);
   RiverSurface s;
