@@ -370,17 +370,18 @@ bool TriangleBvh::trace(const glm::vec3& origin, const glm::vec3& direction, flo
                                                      : direction[a];
     inv[a] = 1.0f / d;
   }
-  // Each slab distance is off by at most 3 roundings (a difference and a product, gamma(3)
-  // relative): the far one grown by twice that, a ray that grazes a box still enters it
-  // (Ize 2013, "Robust BVH Ray Traversal"), as every triangle it meets inside is.
+  // Each slab distance rounds three times (the difference, 1/d, the product) and the growth once
+  // more: grown by twice gamma(4), a ray that grazes a box enters it (Ize 2013, "Robust BVH Ray
+  // Traversal"). The nearest hit so far is grown too, so a box that ties it within rounding is
+  // still searched and the tie goes to the lower triangle.
   constexpr float kEps = std::numeric_limits<float>::epsilon() / 2.0f;
-  constexpr float kFarGrowth = 1.0f + 2.0f * (3.0f * kEps / (1.0f - 3.0f * kEps));
+  constexpr float kFarGrowth = 1.0f + 2.0f * (4.0f * kEps / (1.0f - 4.0f * kEps));
   const auto enter = [&](const Node& n, float limit) {
     const glm::vec3 t0 = (n.lo - origin) * inv;
     const glm::vec3 t1 = (n.hi - origin) * inv;
     const glm::vec3 tn = glm::min(t0, t1), tf = glm::max(t0, t1);
     const float t_near = std::max(std::max(tn.x, tn.y), std::max(tn.z, 0.0f));
-    const float t_far = std::min(std::min(std::min(tf.x, tf.y), tf.z) * kFarGrowth, limit);
+    const float t_far = std::min(std::min(std::min(tf.x, tf.y), tf.z), limit) * kFarGrowth;
     return t_near <= t_far ? t_near : std::numeric_limits<float>::infinity();
   };
 

@@ -63,9 +63,9 @@ struct RiverSurfaceOptions {
   // it welded vertices: a caller may free the arrays there, or copy what it keeps of them. Not
   // called when build() fails before. May be empty.
   std::function<void(bool welded)> inputs_read;
-  // Where given, set to one flag per triangle, true where build() reversed its winding (swapped
-  // its last two corners): what a caller that freed an unwelded mesh's indices at inputs_read
-  // needs to give them back from triangles().
+  // Where given, set by a build that succeeds to one flag per triangle in triangles() order, true
+  // where it reversed the winding (swapped the last two corners): what a caller that freed an
+  // unwelded mesh's indices at inputs_read needs to give them back. Unspecified on a failure.
   std::vector<bool>* rewound = nullptr;
 };
 
