@@ -3,6 +3,8 @@
 // and all-water views, fades, advection and determinism whatever frame a run starts from.
 #include "sim/particles.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -13,11 +15,10 @@
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-
 #include "sim/flow_textures.h"
 #include "sim/triangle_bvh.h"
 #include "siviflow/sim/procedural_river.h"
+#include "unit/brute_force_ray.h"
 #include "unit/particle_scenes.h"
 
 namespace siviflow {
@@ -190,31 +191,6 @@ TEST(TriangleBvh, ClosestHitIsTheBruteForceOne) {
   ASSERT_TRUE(ProceduralRiver(params).generate_mesh(&r).ok());
   TriangleBvh bvh;
   ASSERT_TRUE(TriangleBvh::build(r.positions, r.indices, &bvh).ok());
-  // Moeller-Trumbore as the hierarchy computes it, over every triangle.
-  const auto brute = [&](const glm::vec3& o, const glm::vec3& d, float t_max, RayHit* hit) {
-    bool found = false;
-    for (uint32_t tri = 0; tri < r.indices.size() / 3; ++tri) {
-      const glm::vec3& v0 = r.positions[r.indices[3 * tri]];
-      const glm::vec3 e1 = r.positions[r.indices[3 * tri + 1]] - v0;
-      const glm::vec3 e2 = r.positions[r.indices[3 * tri + 2]] - v0;
-      const glm::vec3 p = glm::cross(d, e2);
-      const float det = glm::dot(e1, p);
-      if (det == 0.0f || !std::isfinite(det) || !std::isfinite(1.0f / det)) continue;
-      const float inv_det = 1.0f / det;
-      const glm::vec3 s = o - v0;
-      const float u = glm::dot(s, p) * inv_det;
-      if (u < 0.0f || u > 1.0f) continue;
-      const glm::vec3 q = glm::cross(s, e1);
-      const float v = glm::dot(d, q) * inv_det;
-      if (v < 0.0f || u + v > 1.0f) continue;
-      const float t = glm::dot(e2, q) * inv_det;
-      if (t < 0.0f || t > t_max || (found && t >= hit->t)) continue;
-      found = true;
-      hit->t = t;
-      hit->triangle = tri;
-    }
-    return found;
-  };
   UnitRandom random(7);
   const auto next = [&] { return random.next(); };
   int hits = 0;
@@ -224,7 +200,8 @@ TEST(TriangleBvh, ClosestHitIsTheBruteForceOne) {
     const glm::vec3 direction(4.0f * next() - 2.0f, -1.0f, 4.0f * next() - 2.0f);
     RayHit got, want;
     const bool hit = bvh.intersect(origin, direction, 10.0f, &got);
-    ASSERT_EQ(hit, brute(origin, direction, 10.0f, &want)) << n;
+    ASSERT_EQ(hit, test::brute_force_hit(r.positions, r.indices, origin, direction, 10.0f, &want))
+        << n;
     if (!hit) continue;
     ++hits;
     EXPECT_EQ(got.triangle, want.triangle) << n;

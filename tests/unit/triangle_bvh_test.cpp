@@ -13,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "brute_force_ray.h"
 #include "river_test_meshes.h"
 
 namespace siviflow {
@@ -195,38 +196,6 @@ TEST(TriangleBvh, APointOnAnEdgeTwoTrianglesShareBelongsToTheLowerNumber) {
   }
 }
 
-// The hierarchy's own triangle test, the same float operations in the same order, over every
-// triangle: the nearest hit in (0, t_max], ties to the lower triangle.
-bool brute_force_hit(const test::TestMesh& mesh, const glm::vec3& origin,
-                     const glm::vec3& direction, float t_max, RayHit* hit) {
-  bool found = false;
-  float best = t_max;
-  for (uint32_t tri = 0; tri < mesh.indices.size() / 3; ++tri) {
-    const glm::vec3& v0 = mesh.positions[mesh.indices[3 * tri]];
-    const glm::vec3 e1 = mesh.positions[mesh.indices[3 * tri + 1]] - v0;
-    const glm::vec3 e2 = mesh.positions[mesh.indices[3 * tri + 2]] - v0;
-    const glm::vec3 p = glm::cross(direction, e2);
-    const float det = glm::dot(e1, p);
-    if (det == 0.0f || !std::isfinite(det)) continue;
-    const float inv_det = 1.0f / det;
-    if (!std::isfinite(inv_det)) continue;
-    const glm::vec3 s = origin - v0;
-    const float u = glm::dot(s, p) * inv_det;
-    if (u < 0.0f || u > 1.0f) continue;
-    const glm::vec3 q = glm::cross(s, e1);
-    const float v = glm::dot(direction, q) * inv_det;
-    if (v < 0.0f || u + v > 1.0f) continue;
-    const float t = glm::dot(e2, q) * inv_det;
-    if (t < 0.0f || t > best) continue;
-    if (found && t == best && tri > hit->triangle) continue;
-    best = t;
-    found = true;
-    hit->t = t;
-    hit->triangle = tri;
-  }
-  return found;
-}
-
 // Rays from an eye a few metres above a rippled strip, aimed at its vertices (where its leaves'
 // boxes end) at grazing angles, hit where a search of every triangle hits. The slab test's
 // rounding rejected a box such a ray only just enters (53 of these 8190 rays missed the
@@ -247,7 +216,8 @@ TEST(TriangleBvh, ARayGrazingABoxHitsWhereEveryTriangleSearchedHits) {
       const glm::vec3 origin(eye_x(random), eye_y(random), eye_z(random));
       const glm::vec3 direction = mesh.positions[v] - origin;
       RayHit expected, got;
-      const bool want = brute_force_hit(mesh, origin, direction, 2.0f, &expected);
+      const bool want =
+          test::brute_force_hit(mesh.positions, mesh.indices, origin, direction, 2.0f, &expected);
       const bool have = bvh.intersect(origin, direction, 2.0f, &got);
       hits += want ? 1 : 0;
       if (want && !have) ++missed;
