@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "sim/half_float.h"
 #include "siviflow/sim/river_surface.h"
 #include "siviflow/sim/world_limits.h"
 #include "siviflow/text_format.h"
@@ -26,7 +27,10 @@ std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float di
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out) {
   RiverInput input;
   SIVIFLOW_TRY(river.generate_mesh(&input.mesh));
-  input.slope = std::move(input.mesh.slope);
+  input.depth = halves_of(input.mesh.depth);
+  input.slope = halves_of(input.mesh.slope);
+  input.mesh.depth = std::vector<float>();  // freed: `= {}` would keep the capacity
+  input.mesh.slope = std::vector<float>();
   RiverSurfaceOptions options;
   for (const RiverMeshEnd& end : input.mesh.ends) options.ends.push_back({end.vertex, end.inflow});
   SIVIFLOW_TRY(RiverSurface::build(input.mesh.positions, input.mesh.indices, options, &input.surface));
@@ -80,13 +84,15 @@ Status river_input_from(const WaterRiver& river, const std::function<void()>& co
     if (!within_world(p)) {
       return Status::error(text_format("CreateInfo::river->positions[%zu] ", v) + world_limit_problem(p));
     }
-    if (!(river.depth[v] >= 0.0f) || !std::isfinite(river.depth[v])) {
-      return Status::error(text_format("CreateInfo::river->depth[%zu] %g is not a finite depth >= 0",
-                                       v, double(river.depth[v])));
+    if (!(river.depth[v] >= 0.0f && river.depth[v] <= kLargestHalf)) {
+      return Status::error(
+          text_format("CreateInfo::river->depth[%zu] %g is not a depth from 0 to 65504 m", v,
+                      double(river.depth[v])));
     }
-    if (!(river.slope[v] >= 0.0f) || !std::isfinite(river.slope[v])) {
-      return Status::error(text_format("CreateInfo::river->slope[%zu] %g is not a finite slope >= 0",
-                                       v, double(river.slope[v])));
+    if (!(river.slope[v] >= 0.0f && river.slope[v] <= kLargestHalf)) {
+      return Status::error(
+          text_format("CreateInfo::river->slope[%zu] %g is not a slope from 0 to 65504", v,
+                      double(river.slope[v])));
     }
   }
   for (size_t e = 0; e < river.ends.size(); ++e) {
@@ -97,8 +103,8 @@ Status river_input_from(const WaterRiver& river, const std::function<void()>& co
     }
   }
   RiverInput input;
-  input.mesh.depth.assign(river.depth.begin(), river.depth.end());
-  input.slope.assign(river.slope.begin(), river.slope.end());
+  input.depth = halves_of(river.depth);
+  input.slope = halves_of(river.slope);
   RiverSurfaceOptions options = river_surface_options(river.ends);
   // Past this the host's arrays are not read, and the host frees them: the mesh is copied where
   // vertices were welded. Unwelded, its positions are the surface's nodes and its indices the
@@ -157,6 +163,7 @@ Status check_obstacle(const WaterObstacle& placed, size_t index) {
 Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
                          const MeshHome& home) {
   mesh_ = std::move(river.mesh);
+  depth_ = std::move(river.depth);
   slope_ = std::move(river.slope);
   per_node_ = mesh_.positions.empty();
   SIVIFLOW_TRY(StreamFunction::validate_params(flow));  // before the costly work below
@@ -206,7 +213,7 @@ Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<O
                                  FoamParams{}, &foam_field_, around));
   refresh_velocity();
   // No speed: the particles take |flow|, as it would have held.
-  field_.depth = mesh_.depth;
+  field_.depth = depth_;
   field_.slope = slope_;
   field_.foam = foam_;
   water_query_ = WaterQuery(field_, bvh_.get());

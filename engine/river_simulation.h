@@ -30,13 +30,14 @@
 
 namespace siviflow {
 
-// What the simulation runs on: the river's mesh (positions, indices, depth), the riverbed slope
-// under each vertex (rise over run), and the surface built from the mesh (built once). The mesh
+// What the simulation runs on: the river's mesh (positions, indices), the water depth and the
+// riverbed slope under each vertex, and the surface built from the mesh (built once). The mesh
 // has no positions and indices when the surface's are the same (it welded nothing and kept the
 // winding): one copy of a long river, not two.
 struct RiverInput {
-  RiverMesh mesh;
-  std::vector<float> slope;
+  RiverMesh mesh;               // its depth and slope empty: they are below
+  std::vector<uint16_t> depth;  // metres, binary16 (sim/half_float.h)
+  std::vector<uint16_t> slope;  // rise over run, binary16
   RiverSurface surface;
   std::vector<float> end_discharges;  // FlowParams::end_discharges: per surface end, or none
 };
@@ -55,8 +56,8 @@ std::vector<float> surface_end_discharges(const RiverSurface& surface,
 std::vector<WaterRiverEnd> procedural_river_ends(const RiverMesh& mesh, float discharge);
 // The procedural river's mesh with its surface built.
 Status procedural_river_input(const ProceduralRiver& river, RiverInput* out);
-// A host's river (CreateInfo::river): its arrays checked (sizes, finite, non-negative depth and
-// slope) and copied, its surface built. `copied` (may be empty) is called as soon as none of the
+// A host's river (CreateInfo::river): its arrays checked (sizes, finite, depth and slope from 0
+// to 65504) and copied, its surface built. `copied` (may be empty) is called as soon as none of the
 // river's arrays is read any more, before the surface finds its sections. Errors name the field
 // and the vertex.
 Status river_input_from(const WaterRiver& river, const std::function<void()>& copied,
@@ -139,7 +140,8 @@ class RiverFlow {
   RiverMesh mesh_;
   StreamFunction flow_;
   std::vector<glm::vec3> velocity_copy_;  // per vertex, m/s
-  std::vector<float> slope_;              // riverbed slope under the vertex (rise over run)
+  std::vector<uint16_t> depth_;           // RiverInput's
+  std::vector<uint16_t> slope_;
   std::vector<uint32_t> section_copy_;
   std::vector<float> foam_;          // 0..1 per vertex (sim/foam.h)
   FoamField foam_field_;

@@ -97,4 +97,10 @@ void to_halves(std::span<const float> values, std::span<uint16_t> halves) {
   for (size_t i = 0; i < values.size(); ++i) halves[i] = to_half(values[i]);
 }
 
+std::vector<uint16_t> halves_of(std::span<const float> values) {
+  std::vector<uint16_t> halves(values.size());
+  to_halves(values, halves);
+  return halves;
+}
+
 }  // namespace siviflow

@@ -223,7 +223,7 @@ Status check_inputs(const RiverFlowField& river, const ParticleParams& params, f
     return Status::error("particles: the river has " + std::to_string(n) + " positions but " +
                          std::to_string(river.flow.size()) + " flow vectors");
   }
-  const auto check_scalars = [n](std::span<const float> s, const char* what) {
+  const auto check_scalars = [n](const auto& s, const char* what) {
     if (!s.empty() && s.size() != n) {
       return Status::error(std::string("particles: the river has ") + std::to_string(n) +
                            " positions but " + std::to_string(s.size()) + " " + what +

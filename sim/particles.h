@@ -52,6 +52,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "sim/half_float.h"
 #include "sim/particle_tuning.h"
 #include "sim/triangle_bvh.h"
 #include "siviflow/sim/obstacle.h"
@@ -63,14 +64,15 @@ namespace siviflow {
 // function's output, or any mesh with the same data). Spans into caller-owned arrays: they must
 // outlive the ParticleField. Positions and indices must not change after create() (the BVH is
 // built on them); flow, speed, depth, slope and foam may change between updates (they are re-read
-// every update, so a re-solved flow reaches the particles the next frame).
+// every update, so a re-solved flow reaches the particles the next frame). Depth and slope are
+// binary16: a long river keeps them for its whole life, and its textures carry no more.
 struct RiverFlowField {
   std::span<const glm::vec3> positions;  // world space, metres, +Y up
   std::span<const uint32_t> indices;     // 3 per triangle; empty: every 3 positions are one
   std::span<const glm::vec3> flow;       // flow vector per vertex (direction, or velocity)
   std::span<const float> speed;          // m/s per vertex; empty: |flow|
-  std::span<const float> depth;          // water depth per vertex, metres; empty: 0
-  std::span<const float> slope;          // riverbed slope per vertex; empty: 0
+  HalfValues depth;                      // water depth per vertex, metres; empty: 0
+  HalfValues slope;                      // riverbed slope per vertex; empty: 0
   std::span<const float> foam;           // foam per vertex, 0..1 (sim/foam.h); empty: 0
 };
 

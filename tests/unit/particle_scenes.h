@@ -15,6 +15,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "sim/half_float.h"
 #include "sim/particles.h"
 
 namespace siviflow::test {
@@ -24,8 +25,8 @@ struct GridRiver {
   std::vector<uint32_t> indices;
   std::vector<glm::vec3> flow;
   std::vector<float> speed;
-  std::vector<float> depth;
-  std::vector<float> slope;
+  std::vector<uint16_t> depth;  // binary16, as the river keeps them
+  std::vector<uint16_t> slope;
   RiverFlowField field() const { return {positions, indices, flow, speed, depth, slope}; }
 };
 
@@ -55,8 +56,8 @@ GridRiver grid_river(uint32_t nx, uint32_t nz, glm::vec2 lo, glm::vec2 hi, Heigh
       r.flow.push_back(f);
       r.speed.push_back(glm::length(f));
       const float across = (p.x - lo.x) / (hi.x - lo.x);
-      r.depth.push_back(2.0f * 4.0f * across * (1.0f - across) + 0.01f * float(j % 7));
-      r.slope.push_back(0.001f * float(1 + (i + 3 * j) % 5));
+      r.depth.push_back(to_half(2.0f * 4.0f * across * (1.0f - across) + 0.01f * float(j % 7)));
+      r.slope.push_back(to_half(0.001f * float(1 + (i + 3 * j) % 5)));
     }
   }
   r.indices.reserve(size_t{nx - 1} * (nz - 1) * 6);

@@ -821,8 +821,8 @@ TEST(Particles, FlowIsTheNearestVertexs) {
       ASSERT_EQ(p.vertex, want) << "particle " << p.id;
       EXPECT_EQ(p.flow, r.flow[want]);
       EXPECT_EQ(p.speed, r.speed[want]);
-      EXPECT_EQ(p.depth, r.depth[want]);
-      EXPECT_EQ(p.slope, r.slope[want]);
+      EXPECT_EQ(p.depth, from_half(r.depth[want]));
+      EXPECT_EQ(p.slope, from_half(r.slope[want]));
     }
   };
   ASSERT_TRUE(field.update(cam, 0, kDt).ok());

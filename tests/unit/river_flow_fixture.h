@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "river_simulation.h"
+#include "sim/half_float.h"
 #include "unit/river_test_meshes.h"
 
 namespace siviflow::test {
@@ -21,7 +22,7 @@ inline std::unique_ptr<RiverFlow> river_flow(const TestMesh& m, const FlowParams
   RiverInput input;
   input.mesh.positions = m.positions;
   input.mesh.indices = m.indices;
-  input.mesh.depth.assign(m.positions.size(), depth);
+  input.depth.assign(m.positions.size(), to_half(depth));
   EXPECT_TRUE(RiverSurface::build(m.positions, m.indices, {}, &input.surface).ok());
   auto flow = std::make_unique<RiverFlow>();
   const Status created = flow->create(std::move(input), params, std::move(obstacles));

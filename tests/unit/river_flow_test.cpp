@@ -9,6 +9,7 @@
 #include <tuple>
 #include <vector>
 
+#include "sim/half_float.h"
 #include "unit/river_flow_fixture.h"
 
 namespace siviflow {
@@ -146,6 +147,50 @@ TEST(RiverFlowTest, AHostsRiverKeepsACopyOfItsMeshOnlyWhereTheSurfaceDiffers) {
       EXPECT_TRUE(std::ranges::equal(input.mesh.indices, mesh->indices));
     }
   }
+}
+
+// A host's depth and slope are kept to 11 significant bits (binary16) and read back as such
+// (by the particles and the queries); values a half cannot hold are refused, naming the vertex.
+TEST(RiverFlowTest, AHostsDepthAndSlopeAreKeptAsHalvesAndRefusedBeyondThem) {
+  const test::TestMesh mesh = test::straight_channel(6.0f, 40.0f, 21, 5);
+  std::vector<float> depth(mesh.positions.size()), slope(mesh.positions.size());
+  for (size_t v = 0; v < depth.size(); ++v) {
+    depth[v] = 0.1f + 0.37f * float(v);
+    slope[v] = 0.0013f * float(v % 7);
+  }
+  depth[1] = kLargestHalf;
+  WaterRiver river;
+  river.positions = mesh.positions;
+  river.indices = mesh.indices;
+  river.depth = depth;
+  river.slope = slope;
+  RiverInput input;
+  ASSERT_TRUE(river_input_from(river, {}, &input).ok());
+  ASSERT_EQ(input.depth.size(), depth.size());
+  ASSERT_EQ(input.slope.size(), slope.size());
+  EXPECT_TRUE(input.mesh.depth.empty());
+  for (size_t v = 0; v < depth.size(); ++v) {
+    EXPECT_EQ(input.depth[v], to_half(depth[v])) << "vertex " << v;
+    EXPECT_EQ(input.slope[v], to_half(slope[v])) << "vertex " << v;
+    EXPECT_NEAR(from_half(input.depth[v]), depth[v], depth[v] / 2048.0f) << "vertex " << v;
+  }
+
+  const auto refused = [&](const std::vector<float>& d, const std::vector<float>& s,
+                           const char* part) {
+    WaterRiver bad = river;
+    bad.depth = d;
+    bad.slope = s;
+    RiverInput out;
+    const Status status = river_input_from(bad, {}, &out);
+    ASSERT_FALSE(status.ok()) << part;
+    EXPECT_NE(status.message().find(part), std::string::npos) << status.message();
+  };
+  std::vector<float> deep = depth;
+  deep[4] = 70000.0f;
+  refused(deep, slope, "CreateInfo::river->depth[4] 70000 is not a depth from 0 to 65504 m");
+  std::vector<float> cliff = slope;
+  cliff[9] = std::numeric_limits<float>::infinity();
+  refused(depth, cliff, "CreateInfo::river->slope[9] inf is not a slope from 0 to 65504");
 }
 
 }  // namespace

@@ -61,8 +61,9 @@ struct WaterRiver {
   // +Y up.
   std::span<const glm::vec3> positions;
   std::span<const uint32_t> indices;
-  std::span<const float> depth;  // per vertex: water depth under it, metres, >= 0
-  std::span<const float> slope;  // per vertex: the bed's slope under it (rise over run), >= 0
+  // Per vertex, kept to 11 significant bits (binary16; the paper's auxiliary texture keeps 8):
+  std::span<const float> depth;  // water depth under it, metres, 0 to 65504
+  std::span<const float> slope;  // the bed's slope under it (rise over run), 0 to 65504
   RiverFlowParams flow;
   std::span<const WaterObstacle> obstacles;
   // Every end, each once, with its discharge (their inflows then make flow.discharge), or none:
