@@ -162,6 +162,15 @@ Status check_obstacle(const WaterObstacle& placed, size_t index) {
 
 Status RiverFlow::create(RiverInput river, const FlowParams& flow, std::vector<Obstacle> obstacles,
                          const MeshHome& home) {
+  const size_t vertices = river.surface.vertex_count();
+  if (!river.mesh.depth.empty() || !river.mesh.slope.empty() ||
+      (!river.depth.empty() && river.depth.size() != vertices) ||
+      (!river.slope.empty() && river.slope.size() != vertices)) {
+    return Status::error(text_format(
+        "RiverFlow::create: %zu depths and %zu slopes for %zu vertices (give RiverInput's "
+        "halves, one a vertex or none, and leave the mesh's empty)",
+        river.depth.size(), river.slope.size(), vertices));
+  }
   mesh_ = std::move(river.mesh);
   depth_ = std::move(river.depth);
   slope_ = std::move(river.slope);

@@ -27,6 +27,7 @@ class HalfValues {
   HalfValues() = default;
   HalfValues(std::span<const uint16_t> bits) : bits_(bits) {}     // NOLINT: a view, as span is
   HalfValues(const std::vector<uint16_t>& bits) : bits_(bits) {}  // NOLINT: as above
+  HalfValues(std::vector<uint16_t>&&) = delete;                   // it would dangle
   float operator[](size_t i) const { return from_half(bits_[i]); }
   size_t size() const { return bits_.size(); }
   bool empty() const { return bits_.empty(); }

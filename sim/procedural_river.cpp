@@ -13,6 +13,7 @@
 #include <glm/vec2.hpp>
 
 #include "grid_holes.h"
+#include "half_float.h"
 #include "siviflow/sim/river_tuning.h"
 #include "siviflow/text_format.h"
 
@@ -186,6 +187,11 @@ Status ProceduralRiver::validate(const ProceduralRiverParams& p) {
       return Status::error(text_format("procedural river: %s = %g must be finite and %s %g",
                                        r.name, r.value, r.min_inclusive ? ">=" : ">", r.min));
     }
+  }
+  if (p.depth > kLargestHalf) {
+    return Status::error(text_format(
+        "procedural river: depth = %g must be at most 65504 (a river keeps its depth in binary16)",
+        p.depth));
   }
   if (p.width_variation >= 1.0f) {
     return Status::error(text_format(
@@ -408,6 +414,14 @@ Status ProceduralRiver::generate_mesh(RiverMesh* out) const {
     const Across at = across_at(p.z);
     mesh.depth[v] = depth_at(p.x, p.z, at);
     mesh.slope[v] = bed_slope(p.x, p.z, at);
+    // Kept in binary16 by the river (sim/half_float.h); `depth` is bounded by validate(), the
+    // slope only by the depth over the width.
+    if (!(mesh.slope[v] <= kLargestHalf)) {
+      return Status::error(text_format(
+          "procedural river: the bed's slope at vertex %zu is %g, above 65504, the steepest a "
+          "river keeps (make it wider or shallower)",
+          v, double(mesh.slope[v])));
+    }
   }
   *out = std::move(mesh);
   return Status::success();

@@ -207,6 +207,12 @@ TEST(ProceduralRiver, BadParametersNameTheParameter) {
       {[](ProceduralRiverParams& p) { p.width = NAN; }, "width"},
       {[](ProceduralRiverParams& p) { p.width_variation = 1.0f; }, "width_variation"},
       {[](ProceduralRiverParams& p) { p.section_spacing = 0.0f; }, "section_spacing"},
+      {[](ProceduralRiverParams& p) { p.depth = 70000.0f; }, "depth = 70000 must be at most 65504"},
+      {[](ProceduralRiverParams& p) {
+         p.depth = 60000.0f;
+         p.width = 2.0f;
+       },
+       "the bed's slope at vertex"},
       {[](ProceduralRiverParams& p) { p.vertices_across = 1; }, "vertices_across"},
       {[](ProceduralRiverParams& p) { p.valley_half_width = 5.0f; }, "valley_half_width"},
       {[](ProceduralRiverParams& p) { p.section_spacing = 1e-6f; }, "limit"},

@@ -9,7 +9,9 @@
 #include <tuple>
 #include <vector>
 
+#include "default_river.h"
 #include "sim/half_float.h"
+#include "siviflow/sim/procedural_river.h"
 #include "unit/river_flow_fixture.h"
 
 namespace siviflow {
@@ -191,6 +193,38 @@ TEST(RiverFlowTest, AHostsDepthAndSlopeAreKeptAsHalvesAndRefusedBeyondThem) {
   std::vector<float> cliff = slope;
   cliff[9] = std::numeric_limits<float>::infinity();
   refused(depth, cliff, "CreateInfo::river->slope[9] inf is not a slope from 0 to 65504");
+  std::vector<float> unknown = depth;
+  unknown[2] = std::numeric_limits<float>::quiet_NaN();
+  refused(unknown, slope, "CreateInfo::river->depth[2] nan is not a depth from 0 to 65504 m");
+
+  // The procedural river's too, and its mesh's floats freed.
+  const ProceduralRiver procedural(default_river_params());
+  RiverMesh generated;
+  ASSERT_TRUE(procedural.generate_mesh(&generated).ok());
+  RiverInput made;
+  ASSERT_TRUE(procedural_river_input(procedural, &made).ok());
+  EXPECT_TRUE(made.mesh.depth.empty() && made.mesh.slope.empty());
+  ASSERT_EQ(made.depth.size(), generated.depth.size());
+  ASSERT_EQ(made.slope.size(), generated.slope.size());
+  for (size_t v = 0; v < made.depth.size(); ++v) {
+    ASSERT_EQ(made.depth[v], to_half(generated.depth[v])) << "vertex " << v;
+    ASSERT_EQ(made.slope[v], to_half(generated.slope[v])) << "vertex " << v;
+  }
+}
+
+// RiverFlow::create takes the depth and slope as halves, one a vertex or none.
+TEST(RiverFlowTest, CreateRefusesDepthsThatAreNotOneHalfAVertex) {
+  const test::TestMesh mesh = test::straight_channel(6.0f, 40.0f, 21, 5);
+  for (const int wrong : {0, 1}) {
+    RiverInput input;
+    if (wrong == 0) input.mesh.depth.assign(mesh.positions.size(), 1.0f);
+    if (wrong == 1) input.depth.assign(mesh.positions.size() - 1, to_half(1.0f));
+    ASSERT_TRUE(RiverSurface::build(mesh.positions, mesh.indices, {}, &input.surface).ok());
+    RiverFlow flow;
+    const Status status = flow.create(std::move(input), FlowParams{}, {});
+    ASSERT_FALSE(status.ok()) << wrong;
+    EXPECT_NE(status.message().find("RiverFlow::create: "), std::string::npos) << status.message();
+  }
 }
 
 }  // namespace
